@@ -1,0 +1,130 @@
+#include "device/prom.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include <fmt/format.h>
+
+namespace shd {
+
+namespace {
+
+double parseNumber(std::string_view tok, std::string_view whole) {
+  const std::string s(tok);
+  char* end = nullptr;
+  errno = 0;
+  const double v = std::strtod(s.c_str(), &end);
+  if (s.empty() || end != s.c_str() + s.size() || errno != 0 || !std::isfinite(v))
+    throw std::invalid_argument(fmt::format("n '{}': '{}' is not a number", whole, tok));
+  return v;
+}
+
+std::vector<std::string_view> split(std::string_view s, char sep) {
+  std::vector<std::string_view> out;
+  size_t start = 0;
+  for (;;) {
+    const size_t pos = s.find(sep, start);
+    out.push_back(s.substr(start, pos == std::string_view::npos ? std::string_view::npos : pos - start));
+    if (pos == std::string_view::npos) return out;
+    start = pos + 1;
+  }
+}
+
+}  // namespace
+
+NSpec NSpec::parse(std::string_view text, bool is_list) {
+  NSpec spec;
+  spec.text = std::string(text);
+  spec.is_list = is_list;
+  if (is_list) {
+    for (std::string_view tok : split(text, ',')) spec.values.push_back(parseNumber(tok, text));
+  } else {
+    const auto parts = split(text, ':');
+    if (parts.size() < 2 || parts.size() > 3)
+      throw std::invalid_argument(fmt::format("n range '{}': expected lo:hi or lo:hi:step", text));
+    const double lo = parseNumber(parts[0], text), hi = parseNumber(parts[1], text);
+    const double step = parts.size() == 3 ? parseNumber(parts[2], text) : 1.0;
+    if (!(step > 0)) throw std::invalid_argument(fmt::format("n range '{}': step must be positive", text));
+    if (hi < lo) throw std::invalid_argument(fmt::format("n range '{}': hi is below lo", text));
+    const double count = std::floor((hi - lo) / step + 1e-9) + 1;
+    if (count > 65536) throw std::invalid_argument(fmt::format("n range '{}': more than 65536 codes", text));
+    for (long i = 0; i < static_cast<long>(count); ++i) spec.values.push_back(lo + static_cast<double>(i) * step);
+  }
+  if (spec.values.empty()) throw std::invalid_argument(fmt::format("n '{}': no values", text));
+  for (double n : spec.values)
+    if (!(n >= kMinShininess && n <= kMaxShininess))
+      throw std::invalid_argument(
+          fmt::format("n '{}': shininess {} outside [{}, {}]", text, n, kMinShininess, kMaxShininess));
+  return spec;
+}
+
+PromRequest PromRequest::fromContent(const PromContent& c) {
+  PromRequest r;
+  r.fit = parseFitKind(c.fit);
+  r.level = c.level;
+  r.n = NSpec::parse(c.n, c.is_list);
+  return r;
+}
+
+std::string PromRequest::describe() const {
+  return fmt::format("fit={} level={} n{}={} ({} codes) coef-round={}", toString(fit), level,
+                     n.is_list ? "-list" : "", n.text, n.values.size(), toString(coef_round));
+}
+
+int PromTable::addressOf(double n) const {
+  for (const PromEntry& e : entries)
+    if (e.n == n) return static_cast<int>(e.address);
+  return -1;
+}
+
+int addressBitsFor(size_t count) {
+  int bits = 1;
+  while ((size_t{1} << bits) < count) ++bits;
+  return bits;
+}
+
+PromTable buildPromTable(const PromRequest& req, const SpecUnitParams& unit) {
+  unit.validate();
+  PromTable t;
+  t.unit = unit;
+  t.request = req;
+  if (req.n.values.size() > static_cast<size_t>(unit.promDepth()))
+    throw std::invalid_argument(fmt::format(
+        "n '{}' has {} codes but ShinBits = {} addresses only {}; use ShinBits >= {}", req.n.text,
+        req.n.values.size(), unit.ShinBits, unit.promDepth(), addressBitsFor(req.n.values.size())));
+  const FixedFormat cf = unit.coefFormat();
+  auto quantise = [&](double x, const char* what, double n) {
+    try {
+      return Fixed::fromDouble(x, cf, req.coef_round, Overflow::Error).raw();
+    } catch (const std::exception&) {
+      throw std::invalid_argument(fmt::format(
+          "fit {}: coefficient {} = {} at n = {} does not fit {} (range {} .. {})", toString(req.fit),
+          what, x, n, cf.str(), Fixed::fromRaw(cf.rawMin(), cf).toDouble(),
+          Fixed::fromRaw(cf.rawMax(), cf).toDouble()));
+    }
+  };
+  t.words.assign(static_cast<size_t>(unit.promDepth()), PromWord{0});
+  for (size_t i = 0; i < req.n.values.size(); ++i) {
+    PromEntry e;
+    e.address = static_cast<uint32_t>(i);
+    e.n = req.n.values[i];
+    e.approx = fitApprox(req.fit, unit.Degree, e.n, req.level);
+    if (unit.Degree == 2) {
+      e.u_real = e.approx.a;
+      e.code.u = quantise(e.u_real, "a", e.n);
+    } else {
+      e.u_real = e.approx.a1;
+      e.v_real = e.approx.a1 + e.approx.b1;
+      e.cut_real = e.approx.cut;
+      e.code.u = quantise(e.u_real, "a1", e.n);
+      e.code.v = quantise(e.v_real, "a1+b1", e.n);
+      e.code.cut = static_cast<int64_t>(std::ceil(std::ldexp(e.cut_real, unit.CosFracBits)));
+    }
+    t.words[i] = encodePromWord(e.code, unit);
+    t.entries.push_back(e);
+  }
+  return t;
+}
+
+}  // namespace shd

@@ -1,0 +1,406 @@
+#include "device/prom_io.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "approx/fit.h"
+
+#ifndef SHD_VERSION
+#error "SHD_VERSION must be defined by the build"
+#endif
+
+namespace shd {
+
+namespace {
+
+// Lattice Memory Generator limits (srec_mem(5): #Depth=1 to 65536, #Width=1 to 256).
+constexpr int kLatticeMaxDepth = 65536;
+constexpr int kLatticeMaxWidth = 256;
+
+// 17 significant digits: every double prints to a text that parses back to the same double.
+std::string real17(double x) { return fmt::format("{:.17g}", x); }
+
+struct Field {
+  std::string name;    // "a", "a1", "v = a1+b1", "cut"
+  std::string format;  // "uQ10.14"
+  int msb = 0, lsb = 0;
+};
+
+// Everything the provenance says, computed once so that the comment lines of every format and
+// the JSON sidecar state the same facts.
+struct Provenance {
+  std::string tool;
+  std::string fit;
+  int degree = 2;
+  double level = 0.5;
+  bool level_used = false;
+  std::string n_text;
+  bool n_is_list = false;
+  size_t n_count = 0;
+  std::string coef_format, coef_round, cos_format;
+  int word_bits = 0, depth = 0, shin_bits = 0, cos_frac_bits = 0;
+  std::vector<Field> layout;  // MSB first
+  size_t used = 0;            // addresses 0 .. used-1 hold entries
+};
+
+Provenance provenanceOf(const PromTable& t) {
+  const SpecUnitParams& u = t.unit;
+  Provenance p;
+  p.tool = std::string("shadesim ") + SHD_VERSION;
+  p.fit = toString(t.request.fit);
+  p.degree = u.Degree;
+  p.level = t.request.level;
+  p.level_used = t.request.fit == FitKind::Level;
+  p.n_text = t.request.n.text;
+  p.n_is_list = t.request.n.is_list;
+  p.n_count = t.request.n.values.size();
+  p.coef_format = u.coefFormat().str();
+  p.coef_round = toString(t.request.coef_round);
+  p.cos_format = u.cosFormat().str();
+  p.word_bits = u.promWordBits();
+  p.depth = u.promDepth();
+  p.shin_bits = u.ShinBits;
+  p.cos_frac_bits = u.CosFracBits;
+  const int cw = u.coefFormat().width();
+  if (u.Degree == 2) {
+    p.layout.push_back({"a", p.coef_format, cw - 1, 0});
+  } else {
+    p.layout.push_back({"cut", p.cos_format, 2 * cw + u.CosFracBits, 2 * cw});
+    p.layout.push_back({"v = a1+b1", p.coef_format, 2 * cw - 1, cw});
+    p.layout.push_back({"a1", p.coef_format, cw - 1, 0});
+  }
+  p.used = t.entries.size();
+  return p;
+}
+
+std::string layoutText(const Provenance& p) {
+  std::string s = "{";
+  for (size_t i = 0; i < p.layout.size(); ++i) {
+    const Field& f = p.layout[i];
+    s += fmt::format("{}{} {} [{}:{}]", i ? ", " : "", f.name, f.format, f.msb, f.lsb);
+  }
+  return s + "}";
+}
+
+// The provenance as comment lines without the comment marker.
+std::vector<std::string> provenanceLines(const Provenance& p) {
+  std::vector<std::string> l;
+  l.push_back(fmt::format("{}: specular unit coefficient PROM (rtl/shd_coef_rom.v)", p.tool));
+  l.push_back(fmt::format("fit: {}, degree {}, level {}{}", p.fit, p.degree, p.level,
+                          p.level_used ? "" : " (not used by this fit)"));
+  l.push_back(fmt::format("n: {} '{}', {} codes; address i holds the i-th n{}",
+                          p.n_is_list ? "list" : "range", p.n_text, p.n_count,
+                          p.n_is_list ? " of the list (address map: <file>.map.csv)" : ""));
+  if (p.degree == 2) {
+    l.push_back(fmt::format("coefficient: a {}, {}; cos: {}", p.coef_format, p.coef_round,
+                            p.cos_format));
+  } else {
+    l.push_back(fmt::format(
+        "coefficients: a1 and v = a1+b1 {}, {}; cos and cut: {}, cut code = ceil(cut * 2^{})",
+        p.coef_format, p.coef_round, p.cos_format, p.cos_frac_bits));
+  }
+  l.push_back(fmt::format("word: {} bits = {} (MSB to LSB)", p.word_bits, layoutText(p)));
+  l.push_back(fmt::format("depth: {} words (ShinBits = {}), addresses 0..{} hold the {} codes",
+                          p.depth, p.shin_bits, p.used - 1, p.used));
+  if (p.used < static_cast<size_t>(p.depth)) {
+    l.push_back(fmt::format(
+        "padding: addresses {}..{} are unused and hold the all-zero word ({}: f = c)", p.used,
+        p.depth - 1, p.degree == 2 ? "a = 0" : "a1 = v = 0, no cut"));
+  } else {
+    l.push_back("padding: none, every address holds a code");
+  }
+  return l;
+}
+
+// A comment line must stay one line and, in a MIF, must not open a % block comment.
+std::string commentBlock(const Provenance& p, std::string_view marker) {
+  std::string out;
+  for (std::string line : provenanceLines(p)) {
+    for (char& ch : line)
+      if (ch == '\n' || ch == '\r' || (marker == "--" && ch == '%')) ch = ' ';
+    out += fmt::format("{} {}\n", marker, line);
+  }
+  return out;
+}
+
+void checkTable(const PromTable& t) {
+  const size_t depth = static_cast<size_t>(t.unit.promDepth());
+  if (t.words.size() != depth)
+    throw std::invalid_argument(fmt::format("PROM table holds {} words, the unit addresses {}",
+                                            t.words.size(), depth));
+  if (t.entries.empty())
+    throw std::invalid_argument("PROM table has no entries");
+  // hexWord checks each word's width when the data is rendered.
+}
+
+std::string csvTable(const PromTable& t) {
+  std::string out;
+  if (t.unit.Degree == 2) {
+    out += "n,address,a_real,a_code\n";
+    for (const PromEntry& e : t.entries)
+      out += fmt::format("{},{},{},{}\n", real17(e.n), e.address, real17(e.u_real), e.code.u);
+  } else {
+    out += "n,address,a1_real,a1_code,v_real,v_code,cut_real,cut_code\n";
+    for (const PromEntry& e : t.entries)
+      out += fmt::format("{},{},{},{},{},{},{},{}\n", real17(e.n), e.address, real17(e.u_real),
+                         e.code.u, real17(e.v_real), e.code.v, real17(e.cut_real), e.code.cut);
+  }
+  return out;
+}
+
+bool isHexDigit(char c) {
+  return (c >= '0' && c <= '9') || (c >= 'a' && c <= 'f') || (c >= 'A' && c <= 'F');
+}
+
+int hexValue(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  return c - 'A' + 10;
+}
+
+std::string errnoText(int err) { return std::strerror(err); }
+
+}  // namespace
+
+PromFormat parsePromFormat(std::string_view s) {
+  if (s == "hex") return PromFormat::Hex;
+  if (s == "mem") return PromFormat::Mem;
+  if (s == "coe") return PromFormat::Coe;
+  if (s == "mif") return PromFormat::Mif;
+  if (s == "csv") return PromFormat::Csv;
+  throw std::invalid_argument(
+      fmt::format("unknown PROM format '{}' (expected hex, mem, coe, mif or csv)", s));
+}
+
+const char* toString(PromFormat f) {
+  switch (f) {
+    case PromFormat::Hex: return "hex";
+    case PromFormat::Mem: return "mem";
+    case PromFormat::Coe: return "coe";
+    case PromFormat::Mif: return "mif";
+    case PromFormat::Csv: return "csv";
+  }
+  return "?";
+}
+
+std::string hexWord(PromWord w, int bits) {
+  if (bits < 1 || bits > 128)
+    throw std::invalid_argument(fmt::format("hexWord: width {} outside 1..128", bits));
+  if (bits < 128 && (w >> bits) != 0)
+    throw std::invalid_argument(fmt::format("hexWord: word has bits above the {}-bit width", bits));
+  static constexpr char kDigits[] = "0123456789abcdef";
+  const int digits = (bits + 3) / 4;
+  std::string s(static_cast<size_t>(digits), '0');
+  for (int i = digits - 1; i >= 0; --i) {
+    s[static_cast<size_t>(i)] = kDigits[static_cast<unsigned>(w & 0xf)];
+    w >>= 4;
+  }
+  return s;
+}
+
+std::string renderProm(const PromTable& t, PromFormat f) {
+  checkTable(t);
+  const Provenance p = provenanceOf(t);
+  const int bits = p.word_bits;
+  std::string out;
+  switch (f) {
+    case PromFormat::Hex:
+      out += commentBlock(p, "//");
+      out += fmt::format("// $readmemh: {} words of {} hex digits follow, address 0 first\n",
+                         p.depth, (bits + 3) / 4);
+      for (PromWord w : t.words) out += hexWord(w, bits) + "\n";
+      break;
+    case PromFormat::Mem:
+      if (p.depth > kLatticeMaxDepth || bits > kLatticeMaxWidth)
+        throw std::invalid_argument(fmt::format(
+            "Lattice .mem allows depth <= {} and width <= {}; this PROM is {} x {}",
+            kLatticeMaxDepth, kLatticeMaxWidth, p.depth, bits));
+      // The header admits no comments (srec_mem(5)); radix index 3 = hexadecimal.
+      out += fmt::format("#Format=Hex\n#Depth={}\n#Width={}\n#AddrRadix=3\n#DataRadix=3\n#Data\n",
+                         p.depth, bits);
+      out += commentBlock(p, "//");
+      for (PromWord w : t.words) out += hexWord(w, bits) + "\n";
+      break;
+    case PromFormat::Coe:
+      out += commentBlock(p, ";");
+      out += "memory_initialization_radix=16;\nmemory_initialization_vector=\n";
+      for (size_t i = 0; i < t.words.size(); ++i)
+        out += hexWord(t.words[i], bits) + (i + 1 < t.words.size() ? ",\n" : ";\n");
+      break;
+    case PromFormat::Mif:
+      out += commentBlock(p, "--");
+      out += fmt::format("WIDTH={};\nDEPTH={};\nADDRESS_RADIX=UNS;\nDATA_RADIX=HEX;\n\nCONTENT BEGIN\n",
+                         bits, p.depth);
+      for (size_t i = 0; i < t.words.size(); ++i)
+        out += fmt::format("  {} : {};\n", i, hexWord(t.words[i], bits));
+      out += "END;\n";
+      break;
+    case PromFormat::Csv:
+      out += csvTable(t);
+      break;
+  }
+  return out;
+}
+
+std::string renderAddressMap(const PromTable& t) {
+  std::string out = "address,n\n";
+  for (const PromEntry& e : t.entries) out += fmt::format("{},{}\n", e.address, real17(e.n));
+  return out;
+}
+
+std::string renderProvenanceJson(const PromTable& t) {
+  checkTable(t);
+  const Provenance p = provenanceOf(t);
+  nlohmann::ordered_json j;
+  j["tool"] = p.tool;
+  j["content"] = "specular unit coefficient PROM";
+  j["fit"] = p.fit;
+  j["degree"] = p.degree;
+  j["level"] = p.level;
+  j["level_used"] = p.level_used;
+  j["n"] = {{"spec", p.n_text}, {"is_list", p.n_is_list}, {"count", p.n_count}};
+  j["coef_format"] = p.coef_format;
+  j["coef_round"] = p.coef_round;
+  j["cos_format"] = p.cos_format;
+  if (p.degree == 3) j["cut_code"] = fmt::format("ceil(cut * 2^{})", p.cos_frac_bits);
+  j["word_bits"] = p.word_bits;
+  j["depth"] = p.depth;
+  nlohmann::ordered_json layout = nlohmann::ordered_json::array();
+  for (const Field& f : p.layout)
+    layout.push_back({{"field", f.name}, {"format", f.format}, {"msb", f.msb}, {"lsb", f.lsb}});
+  j["layout_msb_first"] = layout;
+  j["used_addresses"] = {0, p.used - 1};
+  if (p.used < static_cast<size_t>(p.depth))
+    j["padding"] = {{"first", p.used}, {"last", p.depth - 1}, {"word", "all-zero"}};
+  else
+    j["padding"] = nullptr;
+  nlohmann::ordered_json rtl;
+  const nlohmann::json params = t.unit.toJson();  // std::map order: alphabetical, deterministic
+  for (const auto& [key, value] : params.items()) rtl[key] = value;
+  j["rtl"] = rtl;
+  return j.dump(2) + "\n";
+}
+
+void writeFileAtomic(const std::string& path, const std::string& content) {
+  static std::atomic<unsigned long> counter{0};
+  auto fail = [&](const char* step, int err) -> std::runtime_error {
+    return std::runtime_error(fmt::format("cannot write '{}': {}: {}", path, step, errnoText(err)));
+  };
+
+  std::string tmp;
+  int fd = -1;
+  // O_EXCL: never reuse a stale temporary (a crashed run with a recycled pid); try a few names.
+  for (int attempt = 0; attempt < 16 && fd < 0; ++attempt) {
+    tmp = fmt::format("{}.tmp.{}.{}", path, static_cast<long>(::getpid()), counter++);
+    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0) throw fail("create temporary file", errno);
+
+  auto abandon = [&](const char* step, int err) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(tmp.c_str());
+    throw fail(step, err);
+  };
+
+  const char* data = content.data();
+  size_t left = content.size();
+  while (left > 0) {
+    const ssize_t n = ::write(fd, data, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      abandon("write", errno);
+    }
+    data += n;
+    left -= static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) abandon("fsync", errno);
+  const int rc = ::close(fd);
+  fd = -1;
+  if (rc != 0) abandon("close", errno);
+  if (::rename(tmp.c_str(), path.c_str()) != 0) abandon("rename", errno);
+
+  // Make the rename itself durable. The new file is already in place, so a failure here is not
+  // reported (the content is complete either way).
+  const size_t slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    (void)::fsync(dfd);
+    ::close(dfd);
+  }
+}
+
+std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int depth) {
+  if (word_bits < 1 || word_bits > 128)
+    throw std::invalid_argument(fmt::format("readPromHex: word width {} outside 1..128", word_bits));
+  if (depth < 1) throw std::invalid_argument(fmt::format("readPromHex: depth {} below 1", depth));
+
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("cannot open PROM file {}: {}", path, errnoText(errno)));
+
+  auto lineError = [&](long line, const std::string& what) {
+    return std::runtime_error(fmt::format("PROM file {}, line {}: {}", path, line, what));
+  };
+
+  std::vector<PromWord> words;
+  words.reserve(static_cast<size_t>(depth));
+  std::string line;
+  long line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    const size_t comment = line.find("//");
+    if (comment != std::string::npos) line.resize(comment);
+    size_t pos = 0;
+    for (;;) {
+      // Whitespace as $readmemh defines it: space, tab, newline (a CR of a CRLF file), form-feed.
+      pos = line.find_first_not_of(" \t\r\f\v", pos);
+      if (pos == std::string::npos) break;
+      const size_t end = std::min(line.find_first_of(" \t\r\f\v", pos), line.size());
+      const std::string tok = line.substr(pos, end - pos);
+      pos = end;
+
+      if (tok[0] == '@')
+        throw lineError(line_no, fmt::format("address directive '{}' is not supported (the file "
+                                             "must list every word from address 0)", tok));
+      for (char c : tok)
+        if (!isHexDigit(c)) throw lineError(line_no, fmt::format("'{}' is not a hex word", tok));
+      if (words.size() == static_cast<size_t>(depth))
+        throw lineError(line_no, fmt::format("word '{}' is beyond the {} words the unit addresses",
+                                             tok, depth));
+
+      const size_t first = std::min(tok.find_first_not_of('0'), tok.size());
+      const std::string sig = tok.substr(first);  // significant digits
+      const auto tooWide = [&] {
+        return lineError(line_no, fmt::format("word 0x{} has bits above the {}-bit width",
+                                              sig, word_bits));
+      };
+      if (sig.size() > 32) throw tooWide();
+      PromWord w = 0;
+      for (char c : sig) w = (w << 4) | static_cast<PromWord>(hexValue(c));
+      if (word_bits < 128 && (w >> word_bits) != 0) throw tooWide();
+      words.push_back(w);
+    }
+  }
+  if (in.bad())
+    throw std::runtime_error(fmt::format("cannot read PROM file {}: {}", path, errnoText(errno)));
+  if (words.size() != static_cast<size_t>(depth))
+    throw std::runtime_error(fmt::format("PROM file {} holds {} words, the unit addresses {} "
+                                         "(file ends at line {})",
+                                         path, words.size(), depth, line_no));
+  return words;
+}
+
+}  // namespace shd

@@ -1,0 +1,78 @@
+// PROM files: the coefficient table of the specular unit written for simulators and FPGA tools,
+// read back strictly, and written atomically.
+//
+// Formats (PromFormat), each holding exactly unit.promDepth() words, address 0 first:
+//   hex  Verilog $readmemh (what rtl/shd_coef_rom.v loads in Verilator, Icarus and yosys):
+//        `//` provenance lines, then one word per line, ceil(bits/4) lowercase hex digits,
+//        zero-padded. IEEE 1364 allows // and /* */ comments and whitespace between words.
+//   mem  Lattice Diamond/Radiant Memory Generator initialisation file, Hex format. The header
+//        may not carry comments, so it comes first, exactly:
+//          #Format=Hex  #Depth=<depth>  #Width=<bits>  #AddrRadix=3  #DataRadix=3  #Data
+//        (one per line; radix index 3 = hexadecimal; Depth 1..65536, Width 1..256), then `//`
+//        provenance lines (comments are allowed anywhere after the header, with # or //), then
+//        one word per line from address 0. Source: Lattice's .mem syntax as documented in
+//        srecord's srec_mem(5).
+//   coe  Xilinx: `;` provenance lines, memory_initialization_radix=16; then
+//        memory_initialization_vector= and the words separated by `,`, the last ending in `;`.
+//   mif  Intel/Altera: `--` provenance lines, WIDTH=, DEPTH=, ADDRESS_RADIX=UNS, DATA_RADIX=HEX,
+//        CONTENT BEGIN, `  <addr> : <word>;` per address, END;
+//   csv  one row per entry (not the padding) with the real coefficients and their codes:
+//          degree 2: n,address,a_real,a_code
+//          degree 3: n,address,a1_real,a1_code,v_real,v_code,cut_real,cut_code
+//        v = a1 + b1 is the second word field (the Horner form p = c - c(1-c)(a1 c + v)); cut is
+//        the cut-off cosine and cut_code = ceil(cut * 2^Wc) the stored uQ1.Wc code. Reals carry
+//        17 significant digits (they round-trip to the same double), codes are signed decimal.
+//        CSV has no comment syntax, so its provenance is the JSON sidecar
+//        (renderProvenanceJson), which the other formats' comments restate.
+// Provenance: tool and version, fit, degree, level, n spec and count, coefficient format and
+// rounding, cos format, word width and layout, depth, and which addresses are unused padding
+// (they hold the all-zero word). No timestamps or paths: the output is a pure function of the
+// table, so checked-in files can be compared byte for byte with a fresh regeneration.
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "device/prom.h"
+#include "device/spec_unit.h"
+
+namespace shd {
+
+enum class PromFormat { Hex, Mem, Coe, Mif, Csv };
+
+// "hex", "mem", "coe", "mif", "csv"; std::invalid_argument("unknown PROM format 'x' (expected
+// hex, mem, coe, mif or csv)") otherwise.
+PromFormat parsePromFormat(std::string_view s);
+const char* toString(PromFormat f);
+
+// w as exactly ceil(bits/4) lowercase hex digits, zero-padded. std::invalid_argument unless
+// 1 <= bits <= 128 and w has no bit at or above `bits`.
+std::string hexWord(PromWord w, int bits);
+
+// The whole file text in format f. std::invalid_argument if t.words does not hold
+// unit.promDepth() words of unit.promWordBits() bits, or (mem) the depth or width exceeds what
+// the Lattice format allows.
+std::string renderProm(const PromTable& t, PromFormat f);
+
+// CSV "address,n", one row per entry (n with 17 significant digits): the address map of an
+// n list, written beside the PROM as <file>.map.csv.
+std::string renderAddressMap(const PromTable& t);
+
+// The provenance as a JSON object text (pretty-printed, keys in a fixed order, trailing
+// newline): the sidecar of a csv table, or of any PROM file.
+std::string renderProvenanceJson(const PromTable& t);
+
+// Writes content to path through a temporary file in the same directory
+// (path + ".tmp.<pid>.<counter>"): write, fsync, close, rename over path. A reader sees either
+// the old file or the whole new one. On any failure the temporary file is removed and
+// std::runtime_error names the path, the step and strerror. The new file gets mode 0666 & ~umask.
+void writeFileAtomic(const std::string& path, const std::string& content);
+
+// Strict reader of a hex ($readmemh) PROM file as renderProm writes it: `//` comments and blank
+// lines are skipped; every other whitespace-separated token must be hex digits only (no x/z,
+// no underscores, no @address directives) and fit word_bits; the file must hold exactly `depth`
+// words. std::runtime_error with the path, the line number and what is wrong otherwise.
+std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int depth);
+
+}  // namespace shd

@@ -1,0 +1,154 @@
+#include "device/spec_unit.h"
+
+#include <fmt/format.h>
+
+namespace shd {
+
+namespace {
+
+uint64_t lowMask(int bits) { return bits >= 64 ? ~uint64_t{0} : (uint64_t{1} << bits) - 1; }
+
+int64_t signExtend(uint64_t v, int bits) {
+  const uint64_t sign = uint64_t{1} << (bits - 1);
+  return static_cast<int64_t>((v ^ sign) - sign);
+}
+
+}  // namespace
+
+PromWord encodePromWord(const SpecCoef& coef, const SpecUnitParams& p) {
+  const FixedFormat cf = p.coefFormat();
+  const int cw = cf.width();
+  if (!cf.holds(coef.u)) throw std::out_of_range(fmt::format("coefficient code {} outside {}", coef.u, cf.str()));
+  PromWord w = static_cast<uint64_t>(coef.u) & lowMask(cw);
+  if (p.Degree == 3) {
+    if (!cf.holds(coef.v)) throw std::out_of_range(fmt::format("coefficient code {} outside {}", coef.v, cf.str()));
+    if (coef.cut < 0 || coef.cut > p.cosOne())
+      throw std::out_of_range(fmt::format("cut-off code {} outside 0..{}", coef.cut, p.cosOne()));
+    w |= static_cast<PromWord>(static_cast<uint64_t>(coef.v) & lowMask(cw)) << cw;
+    w |= static_cast<PromWord>(static_cast<uint64_t>(coef.cut)) << (2 * cw);
+  }
+  return w;
+}
+
+SpecCoef decodePromWord(PromWord word, const SpecUnitParams& p) {
+  const FixedFormat cf = p.coefFormat();
+  const int cw = cf.width();
+  SpecCoef c;
+  const uint64_t u = static_cast<uint64_t>(word) & lowMask(cw);
+  if (p.Degree == 2) {
+    c.u = static_cast<int64_t>(u);
+    return c;
+  }
+  c.u = signExtend(u, cw);
+  c.v = signExtend(static_cast<uint64_t>(word >> cw) & lowMask(cw), cw);
+  c.cut = static_cast<int64_t>(static_cast<uint64_t>(word >> (2 * cw)) & lowMask(p.CosFracBits + 1));
+  return c;
+}
+
+SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
+    : p_(params), prom_(std::move(prom)) {
+  p_.validate();
+  if (prom_.size() != static_cast<size_t>(p_.promDepth()))
+    throw std::invalid_argument(fmt::format("PROM has {} words, the unit addresses {} (ShinBits = {})",
+                                            prom_.size(), p_.promDepth(), p_.ShinBits));
+  const int wb = p_.promWordBits();
+  for (size_t i = 0; i < prom_.size(); ++i) {
+    if (wb < 128 && (prom_[i] >> wb) != 0)
+      throw std::invalid_argument(fmt::format("PROM word {} has bits above its {}-bit width", i, wb));
+    coef_.push_back(decodePromWord(prom_[i], p_));
+  }
+  reset();
+}
+
+SpecTrace SpecUnitModel::trace(uint32_t shin, uint32_t cos) const {
+  if (shin >= static_cast<uint32_t>(p_.promDepth()))
+    throw std::out_of_range(fmt::format("shininess code {} outside 0..{}", shin, p_.promDepth() - 1));
+  if (cos >= (uint32_t{2} << p_.CosFracBits))
+    throw std::out_of_range(fmt::format("cos code {} does not fit uQ1.{}", cos, p_.CosFracBits));
+  const SpecCoef& k = coef_[shin];
+  SpecTrace t;
+  // RG2: N.H computed upstream may overshoot 1.0 by rounding; the unit saturates it.
+  t.c = Fixed::fromRaw(std::min<int64_t>(cos, p_.cosOne()), p_.cosFormat());
+  t.sq = t.c * t.c;                                                      // MUL1
+  t.d = t.sq - t.c;                                                      // BI + Sm1, carry-in 1
+  t.dt = t.d.convert(p_.diffFormat(), Quant::Trunc, Overflow::Error);   // drop 2Wc - Df LSBs
+  const Fixed u = Fixed::fromRaw(k.u, p_.coefFormat());
+  if (p_.Degree == 2) {
+    t.p = u * t.dt;                                                      // MUL2
+  } else {
+    const Fixed v = Fixed::fromRaw(k.v, p_.coefFormat());
+    t.g = (u * t.c + v).convert(p_.hornerFormat(), Quant::Trunc, Overflow::Error);
+    t.p = t.dt * t.g;                                                    // MUL2
+  }
+  // Pr keeps the product's integer bits: its range is proved in rtl/shd_spec_unit.v.
+  const FixedFormat pr_fmt(true, t.p.format().int_bits, p_.SpecFracBits);
+  t.pr = t.p.convert(pr_fmt, Quant::RoundHalfUp, Overflow::Error);
+  const Fixed sum = t.c + t.pr;                                          // Sm2
+  const Fixed one = Fixed::fromInt(1, p_.specFormat());
+  Fixed f = sum.convert(p_.specFormat(), Quant::Trunc, Overflow::Saturate);  // clamp below 0
+  if (f > one) f = one;                                                  // clamp above 1
+  t.cut = p_.Degree == 3 && t.c.raw() < k.cut;
+  t.f = t.cut ? Fixed::fromInt(0, p_.specFormat()) : f;
+  return t;
+}
+
+SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
+  // The hot path: the same datapath as trace() on raw integers, wire by wire as in the RTL.
+  // validate() bounds every intermediate to 62 bits, so int64_t holds each exactly, and
+  // test_spec_unit checks evaluate() against trace() (the Fixed formulation) bit for bit.
+  if (shin >= static_cast<uint32_t>(p_.promDepth()) || cos >= (uint32_t{2} << p_.CosFracBits)) {
+    trace(shin, cos);  // throws the descriptive error
+  }
+  const int wc = p_.CosFracBits, wf = p_.SpecFracBits;
+  const SpecCoef& k = coef_[shin];
+  const int64_t c = std::min<int64_t>(cos, p_.cosOne());            // RG2 saturation
+  const int64_t dt = (c * c - (c << wc)) >> (2 * wc - p_.DiffFracBits);  // MUL1, Sm1, Trunc
+  int64_t prod;                                                     // MUL2
+  int prod_frac;
+  if (p_.Degree == 2) {
+    prod = k.u * dt;
+    prod_frac = p_.CoefFracBits + p_.DiffFracBits;
+  } else {
+    const int64_t g = k.u * c + (k.v << wc);                        // Horner, exact
+    prod = (g >> (p_.CoefFracBits + wc - p_.HornerFracBits)) * dt;  // Trunc, MUL2
+    prod_frac = p_.HornerFracBits + p_.DiffFracBits;
+  }
+  const int sh = prod_frac - wf;
+  const int64_t pr = sh == 0 ? prod : (prod + (int64_t{1} << (sh - 1))) >> sh;  // RoundHalfUp
+  const int64_t one = int64_t{1} << wf;
+  int64_t f = (c << (wf - wc)) + pr;                                // Sm2
+  f = f < 0 ? 0 : (f > one ? one : f);                              // clamp to [0, 1]
+  if (p_.Degree == 3 && c < k.cut) f = 0;                           // cut-off
+  SpecOut out;
+  out.valid = true;
+  out.spec = static_cast<uint32_t>(f);
+  for (int ch = 0; ch < 3; ++ch) {
+    if (light[ch] > p_.lightMax())
+      throw std::out_of_range(fmt::format("light code {} does not fit {} bits", light[ch], p_.LightBits));
+    // f <= 1, so round(f * L) <= L fits the light's width.          MUL3..MUL5, RoundHalfUp
+    out.rgb[ch] = static_cast<uint32_t>((f * light[ch] + (one >> 1)) >> wf);
+  }
+  return out;
+}
+
+void SpecUnitModel::reset() {
+  pipe_.assign(static_cast<size_t>(p_.latency()), Stage{});
+  head_ = 0;
+  out_ = SpecOut{};
+  cycle_ = 0;
+}
+
+SpecOut SpecUnitModel::tick(const SpecIn& in) {
+  Stage s;
+  s.valid = in.valid;
+  if (in.valid) s.value = evaluate(in.shin, in.cos, in.light);
+  pipe_[head_] = s;
+  head_ = (head_ + 1) % pipe_.size();
+  const Stage& oldest = pipe_[head_];  // written latency - 1 ticks ago
+  if (oldest.valid) out_ = oldest.value;
+  out_.valid = oldest.valid;
+  ++cycle_;
+  return out_;
+}
+
+}  // namespace shd

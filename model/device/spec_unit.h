@@ -1,0 +1,99 @@
+// SpecUnitModel: the bit-exact, cycle-accurate twin of rtl/shd_spec_unit.v.
+//
+// Datapath (paper Fig. 11, errata 4.3), formats from SpecUnitParams, rounding named where the
+// RTL rounds:
+//   c   = min(cos_i, 1.0)                              uQ1.Wc   (RG2; N.H may overshoot 1)
+//   sq  = c * c                                        MUL1, exact
+//   d   = sq + ~c + 1 = c^2 - c  in [-1/4, 0]           BI + Sm1 with carry-in, exact
+//   dt  = d -> sQ1.Df                                  Trunc (floor)
+//   degree 2:  P = a * dt                              MUL2, exact
+//   degree 3:  g = u*c + v -> sQ(Ci+1).Hf (Trunc);  P = dt * g    (Horner; u = a1, v = a1 + b1)
+//   Pr  = P -> Wf fraction bits                        RoundHalfUp
+//   f   = c + Pr, saturated to [0, 1] (degree 3: 0 when c < cut)   Sm2 + clamp, uQ1.Wf
+//   out = f * L_k -> integer                           MUL3..MUL5, RoundHalfUp, unorm LightBits
+// Pipeline: registered inputs and PROM read (cycle 1), PipeStages optional registers, registered
+// outputs; latency 2 + PipeStages, one result per cycle. The output registers load only when
+// their stage is valid, so outputs hold the last valid result; they reset to zero.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "device/spec_params.h"
+#include "fixed/fixed.h"
+
+namespace shd {
+
+using PromWord = unsigned __int128;
+
+// The fields of one PROM word as raw codes. Degree 2: u = a (uQCi.Cf), v = cut = 0.
+// Degree 3: u = a1, v = a1 + b1 (sQCi.Cf), cut = cos code below which f = 0.
+struct SpecCoef {
+  int64_t u = 0;
+  int64_t v = 0;
+  int64_t cut = 0;
+};
+PromWord encodePromWord(const SpecCoef& coef, const SpecUnitParams& p);
+SpecCoef decodePromWord(PromWord word, const SpecUnitParams& p);
+
+struct SpecIn {
+  bool valid = false;
+  uint32_t shin = 0;                // RG1, shininess code (PROM address)
+  uint32_t cos = 0;                 // RG2, uQ1.Wc code
+  std::array<uint32_t, 3> light{};  // RG3..RG5, k_s * light R, G, B as unorm codes
+};
+
+struct SpecOut {
+  bool valid = false;
+  uint32_t spec = 0;              // f, uQ1.Wf code
+  std::array<uint32_t, 3> rgb{};  // specular colour, unorm LightBits
+  friend bool operator==(const SpecOut& a, const SpecOut& b) {
+    return a.valid == b.valid && a.spec == b.spec && a.rgb == b.rgb;
+  }
+  friend bool operator!=(const SpecOut& a, const SpecOut& b) { return !(a == b); }
+};
+
+// Intermediate values of one evaluation, for reports and mismatch diagnostics.
+struct SpecTrace {
+  Fixed c, sq, d, dt, g, p, pr, f;
+  bool cut = false;
+};
+
+class SpecUnitModel {
+ public:
+  // prom holds promDepth() words; std::invalid_argument if not, or if a word has bits above
+  // promWordBits().
+  SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom);
+
+  const SpecUnitParams& params() const { return p_; }
+  const std::vector<PromWord>& prom() const { return prom_; }
+
+  // The combinational function the pipeline delivers latency() cycles later, on raw integers
+  // (the fast path the co-simulation runs). Inputs must fit their ports (std::out_of_range).
+  SpecOut evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const;
+  // The same datapath written with Fixed values in their formats, with every intermediate:
+  // the readable formulation, for diagnostics and reports; trace().f equals evaluate().spec.
+  SpecTrace trace(uint32_t shin, uint32_t cos) const;
+
+  // Cycle-accurate: state after reset, and the outputs after one rising clock edge with `in`
+  // on the input ports.
+  void reset();
+  SpecOut tick(const SpecIn& in);
+  uint64_t cycle() const { return cycle_; }
+
+ private:
+  struct Stage {
+    bool valid = false;
+    SpecOut value;
+  };
+  SpecUnitParams p_;
+  std::vector<PromWord> prom_;
+  std::vector<SpecCoef> coef_;  // decoded prom_
+  std::vector<Stage> pipe_;     // ring buffer, latency() entries
+  size_t head_ = 0;
+  SpecOut out_;
+  uint64_t cycle_ = 0;
+};
+
+}  // namespace shd

@@ -1,0 +1,185 @@
+#include "spec_cosim.h"
+
+#include <chrono>
+#include <deque>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "device/prom_io.h"
+
+namespace shd {
+
+ExhaustiveSpecStimulus::ExhaustiveSpecStimulus(const SpecUnitParams& p, uint64_t seed) : p_(p), rng_(seed) {}
+
+uint64_t ExhaustiveSpecStimulus::total() const {
+  return static_cast<uint64_t>(p_.promDepth()) << (p_.CosFracBits + 1);
+}
+
+bool ExhaustiveSpecStimulus::next(SpecIn& in) {
+  if (index_ >= total()) return false;
+  const int cos_bits = p_.CosFracBits + 1;
+  in.valid = true;
+  in.shin = static_cast<uint32_t>(index_ >> cos_bits);
+  in.cos = static_cast<uint32_t>(index_ & ((uint64_t{1} << cos_bits) - 1));
+  const uint64_t r = rng_();
+  const uint32_t lmask = static_cast<uint32_t>(p_.lightMax());
+  const bool full = (r >> 61) == 0;  // one in eight
+  for (int k = 0; k < 3; ++k)
+    in.light[k] = full ? lmask : static_cast<uint32_t>(r >> (16 * k)) & lmask;
+  ++index_;
+  return true;
+}
+
+RandomSpecStimulus::RandomSpecStimulus(const SpecUnitParams& p, uint64_t seed, uint64_t vectors, double gap_prob)
+    : p_(p), rng_(seed), vectors_(vectors), gap_prob_(gap_prob) {}
+
+bool RandomSpecStimulus::next(SpecIn& in) {
+  if (sent_ >= vectors_) return false;
+  if (gap_left_ == 0 && gap_prob_ > 0 && std::uniform_real_distribution<double>(0, 1)(rng_) < gap_prob_)
+    gap_left_ = 1 + static_cast<int>(rng_() % 3);
+  const uint64_t r = rng_();
+  const uint32_t one = static_cast<uint32_t>(p_.cosOne());
+  // Inputs change on idle cycles too: the unit must ignore them.
+  in.shin = static_cast<uint32_t>(r % static_cast<uint64_t>(p_.promDepth()));
+  const uint64_t r2 = rng_();
+  const unsigned sel = static_cast<unsigned>(r2 & 31);
+  if (sel == 0) in.cos = one + static_cast<uint32_t>((r2 >> 8) % one);            // above 1.0
+  else if (sel < 9) in.cos = one - static_cast<uint32_t>((r2 >> 8) % (one / 64 + 1));  // near 1
+  else in.cos = static_cast<uint32_t>((r2 >> 8) % (one + 1));
+  const uint32_t lmask = static_cast<uint32_t>(p_.lightMax());
+  for (int k = 0; k < 3; ++k) in.light[k] = static_cast<uint32_t>(r >> (20 + 12 * k)) & lmask;
+  if (gap_left_ > 0) {
+    --gap_left_;
+    in.valid = false;
+    return true;
+  }
+  in.valid = true;
+  ++sent_;
+  return true;
+}
+
+std::string SpecMismatch::describe(const SpecUnitParams& p) const {
+  auto out = [](const SpecOut& o) {
+    return fmt::format("valid={} spec={:#x} rgb=({}, {}, {})", o.valid ? 1 : 0, o.spec, o.rgb[0], o.rgb[1], o.rgb[2]);
+  };
+  const std::string in = input.valid
+      ? fmt::format("shin={} cos={:#x} ({:.9f}) light=({}, {}, {})", input.shin, input.cos,
+                    std::ldexp(static_cast<double>(input.cos), -p.CosFracBits), input.light[0], input.light[1],
+                    input.light[2])
+      : std::string("no valid input (a control mismatch)");
+  return fmt::format("cycle {}: input {}\n  model: {}\n  rtl:   {}", cycle, in, out(expected), out(got));
+}
+
+void verifyLoadedProm(SpecDut& dut, const std::vector<PromWord>& expected, const std::string& prom_path,
+                      const SpecUnitParams& p) {
+  const std::vector<PromWord> got = dut.romWords();
+  if (got.size() != expected.size())
+    throw std::runtime_error(fmt::format("PROM depth {} in the RTL, {} expected", got.size(), expected.size()));
+  for (size_t i = 0; i < got.size(); ++i)
+    if (got[i] != expected[i])
+      throw std::runtime_error(fmt::format(
+          "the simulator loaded PROM word {} = 0x{} from {}, the table holds 0x{}: the PROM file is missing, "
+          "short, corrupt or made for another fit",
+          i, hexWord(got[i], p.promWordBits()), prom_path, hexWord(expected[i], p.promWordBits())));
+}
+
+void writeSpecVectors(const std::string& path, const std::string& config, const SpecUnitParams& p,
+                      const std::string& prom_path, const std::vector<SpecIn>& inputs,
+                      const std::vector<SpecOut>& expected) {
+  std::string text = fmt::format(
+      "# shadesim spec-unit vectors, one line per clock cycle after reset\n"
+      "# config {} {}\n# latency {}\n# prom {}\n"
+      "# columns (hex): valid shin cos light_r light_g light_b exp_valid exp_spec exp_r exp_g exp_b\n",
+      config, p.toJson().dump(), p.latency(), prom_path);
+  for (size_t i = 0; i < inputs.size(); ++i) {
+    const SpecIn& in = inputs[i];
+    const SpecOut& e = expected[i];
+    text += fmt::format("{:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x}\n", in.valid ? 1 : 0, in.shin, in.cos,
+                        in.light[0], in.light[1], in.light[2], e.valid ? 1 : 0, e.spec, e.rgb[0], e.rgb[1], e.rgb[2]);
+  }
+  writeFileAtomic(path, text);
+}
+
+SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, SpecStimulus& stim,
+                             const SpecCosimOptions& opts) {
+  const SpecUnitParams& p = model.params();
+  SpecCosimResult res;
+  res.config = config;
+  // The file first (strict parse: clear messages for missing, short or corrupt files), then
+  // what the simulator made of it.
+  const std::vector<PromWord> file_words = readPromHex(opts.prom_path, p.promWordBits(), p.promDepth());
+  for (size_t i = 0; i < file_words.size(); ++i)
+    if (file_words[i] != model.prom()[i])
+      throw std::runtime_error(fmt::format("PROM file {} holds word {} = 0x{}, the model's table 0x{}: the file is "
+                                           "corrupt or made for another fit or format",
+                                           opts.prom_path, i, hexWord(file_words[i], p.promWordBits()),
+                                           hexWord(model.prom()[i], p.promWordBits())));
+  auto dut = makeSpecDut(config, SpecDutOptions{opts.prom_path, ""});
+  verifyLoadedProm(*dut, model.prom(), opts.prom_path, p);
+
+  const size_t window = static_cast<size_t>(p.latency()) + 8;
+  std::deque<SpecIn> history;  // inputs of the last `window` cycles
+  std::vector<SpecIn> fail_window;
+  dut->reset();
+  model.reset();
+  const auto t0 = std::chrono::steady_clock::now();
+  SpecIn in;
+  bool more = true;
+  int drain = p.latency();
+  uint64_t next_progress = uint64_t{1} << 20;
+  while (more || drain > 0) {
+    if (more) more = stim.next(in);
+    if (!more) {
+      in = SpecIn{};
+      --drain;
+    }
+    if (in.valid) ++res.vectors;
+    const SpecOut got = dut->tick(in);
+    const SpecOut exp = model.tick(in);
+    if (history.size() == window) history.pop_front();
+    history.push_back(in);
+    if (got != exp) {
+      ++res.mismatches;
+      if (!res.first) {
+        SpecMismatch m;
+        m.cycle = model.cycle();
+        const size_t back = static_cast<size_t>(p.latency()) - 1;
+        if (history.size() > back) m.input = history[history.size() - 1 - back];
+        m.expected = exp;
+        m.got = got;
+        res.first = m;
+        fail_window.assign(history.begin(), history.end());
+      }
+      if (res.mismatches >= opts.max_mismatches) break;
+    }
+    if (opts.progress && res.vectors >= next_progress) {
+      opts.progress(res.vectors, stim.total());
+      next_progress += uint64_t{1} << 20;
+    }
+  }
+  res.cycles = model.cycle();
+  res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  dut->finish();
+
+  if (res.first) {
+    // Replay the failing window from reset into a traced instance, with the model's expected
+    // outputs for the same window, so the case reproduces alone.
+    res.fst_path = fmt::format("{}/spec_{}_fail.fst", opts.fail_dir, config);
+    res.vector_path = fmt::format("{}/spec_{}_fail.vec", opts.fail_dir, config);
+    auto traced = makeSpecDut(config, SpecDutOptions{opts.prom_path, res.fst_path});
+    SpecUnitModel replay(p, model.prom());
+    traced->reset();
+    std::vector<SpecOut> expected;
+    for (const SpecIn& w : fail_window) {
+      traced->tick(w);
+      expected.push_back(replay.tick(w));
+    }
+    traced->finish();
+    writeSpecVectors(res.vector_path, config, p, opts.prom_path, fail_window, expected);
+  }
+  return res;
+}
+
+}  // namespace shd

@@ -1,0 +1,106 @@
+// The scoreboard of the specular unit: a verilated configuration and its golden model run the
+// same input stream, and every output port is compared on every cycle (the outputs hold their
+// last valid result, so data is compared even on cycles without valid_o).
+//
+// Before the run the PROM the simulator loaded is read back and compared with the table the
+// model was built from: $readmemh only warns on a missing, short or corrupt file, so this is
+// where such a file fails loudly.
+//
+// On a mismatch the run records the first failing cycle with the input that produced it and
+// both outputs, keeps counting up to max_mismatches, then replays the last few cycles into a
+// traced instance to write an FST waveform and a vector file of the failing window.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "device/prom.h"
+#include "device/spec_unit.h"
+#include "spec_dut.h"
+
+namespace shd {
+
+// Produces the input of each cycle. Returns false when the stream ends.
+class SpecStimulus {
+ public:
+  virtual ~SpecStimulus() = default;
+  virtual bool next(SpecIn& in) = 0;
+  virtual uint64_t total() const = 0;  // valid vectors the stream will produce
+};
+
+// Every (shininess code, cos code) pair, cos codes 0 .. 2^(Wc+1)-1 (those above 1.0 test the
+// input saturation), valid on every cycle; light channels seeded random, one vector in eight
+// at full scale.
+class ExhaustiveSpecStimulus final : public SpecStimulus {
+ public:
+  ExhaustiveSpecStimulus(const SpecUnitParams& p, uint64_t seed);
+  bool next(SpecIn& in) override;
+  uint64_t total() const override;
+
+ private:
+  SpecUnitParams p_;
+  std::mt19937_64 rng_;
+  uint64_t index_ = 0;
+};
+
+// Seeded random vectors: shininess uniform over the PROM, cos uniform with one vector in four
+// in the last 1/64 of the range (the narrow lobes of large n) and one in 32 above 1.0; valid
+// dropped with probability gap_prob for 1..3 cycles at a time.
+class RandomSpecStimulus final : public SpecStimulus {
+ public:
+  RandomSpecStimulus(const SpecUnitParams& p, uint64_t seed, uint64_t vectors, double gap_prob);
+  bool next(SpecIn& in) override;
+  uint64_t total() const override { return vectors_; }
+
+ private:
+  SpecUnitParams p_;
+  std::mt19937_64 rng_;
+  uint64_t vectors_;
+  uint64_t sent_ = 0;
+  double gap_prob_;
+  int gap_left_ = 0;
+};
+
+struct SpecMismatch {
+  uint64_t cycle = 0;  // cycle after reset whose outputs differ
+  SpecIn input;        // the input applied latency - 1 cycles earlier (invalid if none)
+  SpecOut expected, got;
+  std::string describe(const SpecUnitParams& p) const;
+};
+
+struct SpecCosimOptions {
+  std::string prom_path;        // the $readmemh file the simulator loads
+  std::string fail_dir = ".";   // where the failing window's FST and vector file go
+  uint64_t max_mismatches = 16;
+  std::function<void(uint64_t done, uint64_t total)> progress;  // called about every 2^20 vectors
+};
+
+struct SpecCosimResult {
+  std::string config;
+  uint64_t vectors = 0;  // valid inputs driven
+  uint64_t cycles = 0;
+  uint64_t mismatches = 0;
+  double seconds = 0;
+  std::optional<SpecMismatch> first;
+  std::string fst_path, vector_path;  // written when mismatches > 0
+};
+
+// Compares the words the simulator loaded with `expected`; throws std::runtime_error naming the
+// first differing address, both words and the file.
+void verifyLoadedProm(SpecDut& dut, const std::vector<PromWord>& expected, const std::string& prom_path,
+                      const SpecUnitParams& p);
+
+SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, SpecStimulus& stim,
+                             const SpecCosimOptions& opts);
+
+// The vector file of a window: "#" comment lines, then per cycle, in hex,
+//   valid shin cos light_r light_g light_b  exp_valid exp_spec exp_r exp_g exp_b
+void writeSpecVectors(const std::string& path, const std::string& config, const SpecUnitParams& p,
+                      const std::string& prom_path, const std::vector<SpecIn>& inputs,
+                      const std::vector<SpecOut>& expected);
+
+}  // namespace shd
