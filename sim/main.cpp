@@ -1,0 +1,332 @@
+// shadesim: the command-line program.
+//   shadesim prom        coefficient PROM tables for simulators and FPGA tools
+//   shadesim cosim       verilated RTL against the golden model, cycle by cycle
+//   shadesim spec-error  approximation, datapath and total error of the specular unit
+// Every failure prints "shadesim <command>: error: ..." naming the argument and exits non-zero;
+// files are written atomically, so a failed run leaves no partial output.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "device/prom.h"
+#include "device/prom_io.h"
+#include "progress.h"
+#include "report/spec_error.h"
+#include "spec_cosim.h"
+
+namespace fs = std::filesystem;
+using namespace shd;
+
+namespace {
+
+// A usage error: the message names the argument.
+struct ArgError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// --config takes a checked-in configuration name or a JSON file.
+SpecUnitConfig resolveConfig(const std::string& arg) {
+  if (fs::is_regular_file(arg)) return SpecUnitConfig::load(arg);
+  for (const std::string& name : builtinConfigNames())
+    if (arg == name) return SpecUnitConfig::load(configPath(name));
+  throw ArgError(fmt::format("--config {}: neither a file nor one of the configurations {}", arg,
+                             fmt::join(builtinConfigNames(), ", ")));
+}
+
+// The options that choose a PROM's contents, shared by prom, cosim and spec-error.
+struct TableOptions {
+  std::string config = "default";
+  bool config_given = false;
+  std::string fit, n, n_list, coef_format;
+  std::optional<double> level;
+  int degree = 0;  // 0: the configuration's
+
+  void add(CLI::App& app, bool fit_required) {
+    app.add_option("--config", config, "configuration: default|narrow|wide|cubic or a JSON file")
+        ->default_val("default");
+    auto* fit_opt = app.add_option("--fit", fit, "inflection | level | shortcut | minimax (default: the configuration's)")
+                        ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax"}));
+    if (fit_required) fit_opt->required();
+    app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)");
+    app.add_option("--degree", degree, "2 (quadratic) or 3 (cubic)")->check(CLI::IsMember({2, 3}));
+    auto* n_opt = app.add_option("--n", n, "shininess range lo:hi[:step], each in [1, 1000]");
+    auto* list_opt = app.add_option("--n-list", n_list, "explicit shininess list, e.g. 8,32,200");
+    n_opt->excludes(list_opt);
+    app.add_option("--coef-format", coef_format, "coefficient format, e.g. uQ10.14 (degree 3: sQm.f)");
+  }
+
+  // The unit parameters and the table request after applying the overrides.
+  PromTable build(SpecUnitConfig& cfg_out) const {
+    SpecUnitConfig cfg = resolveConfig(config);
+    PromContent content = cfg.prom;
+    if (!fit.empty()) content.fit = fit;
+    if (level) {
+      if (!(*level > 0 && *level < 1)) throw ArgError(fmt::format("--level {}: must lie in (0, 1)", *level));
+      content.level = *level;
+    }
+    if (!n.empty()) content = PromContent{content.fit, content.level, n, false};
+    if (!n_list.empty()) content = PromContent{content.fit, content.level, n_list, true};
+    PromRequest req;
+    try {
+      req = PromRequest::fromContent(content);
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(fmt::format("{}: {}", !n_list.empty() ? "--n-list" : (!n.empty() ? "--n" : "--fit"), e.what()));
+    }
+    SpecUnitParams& p = cfg.rtl;
+    if (degree != 0) p.Degree = degree;
+    if (!coef_format.empty()) {
+      FixedFormat f;
+      try {
+        f = FixedFormat::parse(coef_format);
+      } catch (const std::invalid_argument& e) {
+        throw ArgError(fmt::format("--coef-format: {}", e.what()));
+      }
+      if (f.is_signed != (p.Degree == 3))
+        throw ArgError(fmt::format("--coef-format {}: degree {} coefficients are {}; use {}Qm.f", coef_format,
+                                   p.Degree, p.Degree == 3 ? "signed" : "unsigned (a >= 0)",
+                                   p.Degree == 3 ? 's' : 'u'));
+      p.CoefIntBits = f.int_bits;
+      p.CoefFracBits = f.frac_bits;
+    }
+    // A table made without a configuration is as deep as its n list needs.
+    if (!config_given) p.ShinBits = addressBitsFor(req.n.values.size());
+    try {
+      p.validate();
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(fmt::format("{}: {}", !coef_format.empty() ? "--coef-format " + coef_format : "--config " + config,
+                                 e.what()));
+    }
+    try {
+      PromTable t = buildPromTable(req, p);
+      cfg_out = cfg;
+      cfg_out.rtl = p;
+      cfg_out.prom = content;
+      return t;
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(fmt::format("{}: {}",
+                                 !coef_format.empty() ? "--coef-format " + coef_format
+                                                      : fmt::format("coefficient format {} of --config {} (choose one "
+                                                                    "with --coef-format)",
+                                                                    p.coefFormat().str(), config),
+                                 e.what()));
+    }
+  }
+};
+
+void writeOut(const std::string& path, const std::string& text) {
+  if (path.empty() || path == "-") {
+    std::fwrite(text.data(), 1, text.size(), stdout);
+    return;
+  }
+  writeFileAtomic(path, text);
+}
+
+// ---------------------------------------------------------------- prom
+struct PromCmd {
+  TableOptions table;
+  std::string format, output;
+
+  void add(CLI::App& app) {
+    table.add(app, true);
+    app.add_option("--format", format, "hex ($readmemh) | mem (Lattice) | coe (Xilinx) | mif (Intel) | csv")
+        ->required()
+        ->check(CLI::IsMember({"hex", "mem", "coe", "mif", "csv"}));
+    app.add_option("-o,--output", output, "output file (default stdout); with --n-list also <file>.map.csv, "
+                                          "with csv also <file>.json (provenance)");
+  }
+
+  int run(const CLI::App& app) {
+    table.config_given = app.count("--config") > 0;
+    SpecUnitConfig cfg;
+    const PromTable t = table.build(cfg);
+    const PromFormat f = parsePromFormat(format);
+    // Render everything first, then write: an error leaves no file behind.
+    const std::string body = renderProm(t, f);
+    const std::string map = t.request.n.is_list ? renderAddressMap(t) : "";
+    const std::string side = f == PromFormat::Csv ? renderProvenanceJson(t) : "";
+    writeOut(output, body);
+    if (!output.empty() && output != "-") {
+      if (!map.empty()) writeFileAtomic(output + ".map.csv", map);
+      if (!side.empty()) writeFileAtomic(output + ".json", side);
+      std::fprintf(stderr, "wrote %s: %zu codes, %d words of %d bits (%s)\n", output.c_str(), t.entries.size(),
+                   t.unit.promDepth(), t.unit.promWordBits(), t.request.describe().c_str());
+    }
+    return 0;
+  }
+};
+
+// ---------------------------------------------------------------- cosim
+struct CosimCmd {
+  TableOptions table;
+  std::string unit = "spec", prom, fail_dir = ".";
+  bool exhaustive = false, json = false, quiet = false;
+  uint64_t vectors = 1'000'000, seed = 1;
+  double gap = 0.2;
+
+  void add(CLI::App& app) {
+    app.add_option("--unit", unit, "unit under test")->check(CLI::IsMember({"spec"}))->default_val("spec");
+    table.add(app, false);
+    app.add_option("--prom", prom, "PROM hex file the RTL loads (default: the table written to a temporary file); "
+                                   "it must hold the table the options describe");
+    app.add_flag("--exhaustive", exhaustive, "every (shininess code, cos code) pair, valid on every cycle");
+    app.add_option("--vectors", vectors, "random vectors (without --exhaustive)")->check(CLI::PositiveNumber);
+    app.add_option("--seed", seed, "random seed");
+    app.add_option("--gap", gap, "probability of dropping valid_i for 1..3 cycles (random mode)")
+        ->check(CLI::Range(0.0, 0.9));
+    app.add_option("--fail-dir", fail_dir, "where a failing case's FST waveform and vector file go");
+    app.add_flag("--json", json, "print the result as one JSON object on stdout");
+    app.add_flag("--quiet", quiet, "no progress on stderr");
+  }
+
+  int run(const CLI::App& app) {
+    table.config_given = true;
+    SpecUnitConfig cfg;
+    const PromTable t = table.build(cfg);
+    if (!app.count("--config")) cfg.name = "default";
+    std::string prom_path = prom;
+    fs::path tmp_dir;
+    if (prom_path.empty()) {
+      tmp_dir = fs::temp_directory_path() / fmt::format("shadesim-{}", getpid());
+      fs::create_directories(tmp_dir);
+      prom_path = (tmp_dir / fmt::format("spec_{}.hex", cfg.name)).string();
+      writeFileAtomic(prom_path, renderProm(t, PromFormat::Hex));
+    }
+    prom_path = fs::absolute(prom_path).string();
+    fs::create_directories(fail_dir);
+    SpecUnitModel model(t.unit, t.words);
+    std::unique_ptr<SpecStimulus> stim;
+    if (exhaustive) stim = std::make_unique<ExhaustiveSpecStimulus>(t.unit, seed);
+    else stim = std::make_unique<RandomSpecStimulus>(t.unit, seed, vectors, gap);
+    Progress progress(fmt::format("cosim spec/{}", cfg.name), !quiet);
+    SpecCosimOptions o;
+    o.prom_path = prom_path;
+    o.fail_dir = fs::absolute(fail_dir).string();
+    o.progress = [&](uint64_t done, uint64_t total) { progress.update(done, total, "vectors"); };
+    SpecCosimResult r;
+    try {
+      r = runSpecCosim(cfg.name, model, *stim, o);
+    } catch (...) {
+      if (!tmp_dir.empty()) fs::remove_all(tmp_dir);
+      throw;
+    }
+    if (!tmp_dir.empty()) fs::remove_all(tmp_dir);
+    const double rate = r.seconds > 0 ? r.vectors / r.seconds : 0;
+    if (json) {
+      nlohmann::json j = {{"unit", "spec"},
+                          {"config", r.config},
+                          {"mode", exhaustive ? "exhaustive" : "random"},
+                          {"seed", seed},
+                          {"prom", prom.empty() ? std::string("(temporary)") : prom_path},
+                          {"table", t.request.describe()},
+                          {"vectors", r.vectors},
+                          {"cycles", r.cycles},
+                          {"mismatches", r.mismatches},
+                          {"seconds", r.seconds},
+                          {"vectors_per_second", rate}};
+      if (r.first) {
+        j["first_mismatch"] = {{"cycle", r.first->cycle},
+                               {"description", r.first->describe(t.unit)},
+                               {"fst", r.fst_path},
+                               {"vectors", r.vector_path}};
+      }
+      std::cout << j.dump(2) << "\n";
+    } else {
+      std::printf("cosim spec/%s %s seed %llu: %llu vectors, %llu cycles, %llu mismatches, %.2f s (%.1f M vectors/s)\n",
+                  r.config.c_str(), exhaustive ? "exhaustive" : "random", static_cast<unsigned long long>(seed),
+                  static_cast<unsigned long long>(r.vectors), static_cast<unsigned long long>(r.cycles),
+                  static_cast<unsigned long long>(r.mismatches), r.seconds, rate / 1e6);
+    }
+    if (r.first) {
+      std::fprintf(stderr, "MISMATCH (first of %llu) %s\nwaveform: %s\nvectors:  %s\n",
+                   static_cast<unsigned long long>(r.mismatches), r.first->describe(t.unit).c_str(),
+                   r.fst_path.c_str(), r.vector_path.c_str());
+      return 1;
+    }
+    return 0;
+  }
+};
+
+// ---------------------------------------------------------------- spec-error
+struct SpecErrorCmd {
+  TableOptions table;
+  std::string compare = "auto", json_out;
+  bool json = false, quiet = false;
+
+  void add(CLI::App& app) {
+    table.add(app, false);
+    app.add_option("--compare", compare, "second fit shown beside the first: auto (minimax, or inflection when the "
+                                         "first is minimax), none, or a fit name")
+        ->check(CLI::IsMember({"auto", "none", "inflection", "level", "shortcut", "minimax"}));
+    app.add_flag("--json", json, "print one JSON object on stdout instead of the table");
+    app.add_option("--json-out", json_out, "also write the JSON object to this file");
+    app.add_flag("--quiet", quiet, "no progress on stderr");
+  }
+
+  int run(const CLI::App& app) {
+    table.config_given = true;
+    SpecUnitConfig cfg;
+    const PromTable t = table.build(cfg);
+    if (!app.count("--config")) cfg.name = "default";
+    Progress progress(fmt::format("spec-error {}", toString(t.request.fit)), !quiet);
+    auto prog = [&](size_t done, size_t total) { progress.update(static_cast<double>(done), static_cast<double>(total), "n"); };
+    const SpecErrorReport primary = computeSpecError(cfg.name, t, prog);
+    std::optional<SpecErrorReport> second;
+    std::string cmp = compare;
+    if (cmp == "auto") cmp = t.request.fit == FitKind::Minimax ? "inflection" : "minimax";
+    if (cmp != "none" && cmp != toString(t.request.fit)) {
+      PromRequest req2 = t.request;
+      req2.fit = parseFitKind(cmp);
+      Progress p2(fmt::format("spec-error {}", cmp), !quiet);
+      try {
+        second = computeSpecError(cfg.name, buildPromTable(req2, t.unit),
+                                  [&](size_t d, size_t n) { p2.update(static_cast<double>(d), static_cast<double>(n), "n"); });
+      } catch (const std::invalid_argument& e) {
+        throw ArgError(fmt::format("--compare {}: {}", cmp, e.what()));
+      }
+    }
+    nlohmann::json j = toJson(primary);
+    if (second) j["compare"] = toJson(*second);
+    if (!json_out.empty()) writeFileAtomic(json_out, j.dump(2) + "\n");
+    if (json) std::cout << j.dump(2) << "\n";
+    else std::cout << renderSpecErrorTable(primary, second ? &*second : nullptr, representativeN(t));
+    return 0;
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{fmt::format("shadesim {}: cycle-accurate models and RTL of the shading hardware", SHD_VERSION)};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("shadesim ") + SHD_VERSION);
+  PromCmd prom;
+  CosimCmd cosim;
+  SpecErrorCmd spec_error;
+  CLI::App* prom_app = app.add_subcommand("prom", "write the coefficient PROM of the specular unit");
+  CLI::App* cosim_app = app.add_subcommand("cosim", "run the verilated RTL against the golden model");
+  CLI::App* err_app = app.add_subcommand("spec-error", "error report of the specular unit");
+  prom.add(*prom_app);
+  cosim.add(*cosim_app);
+  spec_error.add(*err_app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  CLI::App* cmd = app.get_subcommands().front();
+  try {
+    if (cmd == prom_app) return prom.run(*prom_app);
+    if (cmd == cosim_app) return cosim.run(*cosim_app);
+    if (cmd == err_app) return spec_error.run(*err_app);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "shadesim %s: error: %s\n", cmd->get_name().c_str(), e.what());
+    return 2;
+  }
+  return 2;
+}
