@@ -47,12 +47,11 @@ struct TableOptions {
   std::optional<double> level;
   int degree = 0;  // 0: the configuration's
 
-  void add(CLI::App& app, bool fit_required) {
+  void add(CLI::App& app) {
     app.add_option("--config", config, "configuration: default|narrow|wide|cubic or a JSON file")
         ->default_val("default");
-    auto* fit_opt = app.add_option("--fit", fit, "inflection | level | shortcut | minimax (default: the configuration's)")
-                        ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax"}));
-    if (fit_required) fit_opt->required();
+    app.add_option("--fit", fit, "inflection | level | shortcut | minimax (default: the configuration's)")
+        ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax"}));
     app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)");
     app.add_option("--degree", degree, "2 (quadratic) or 3 (cubic)")->check(CLI::IsMember({2, 3}));
     auto* n_opt = app.add_option("--n", n, "shininess range lo:hi[:step], each in [1, 1000]");
@@ -133,7 +132,7 @@ struct PromCmd {
   std::string format, output;
 
   void add(CLI::App& app) {
-    table.add(app, true);
+    table.add(app);
     app.add_option("--format", format, "hex ($readmemh) | mem (Lattice) | coe (Xilinx) | mif (Intel) | csv")
         ->required()
         ->check(CLI::IsMember({"hex", "mem", "coe", "mif", "csv"}));
@@ -171,7 +170,7 @@ struct CosimCmd {
 
   void add(CLI::App& app) {
     app.add_option("--unit", unit, "unit under test")->check(CLI::IsMember({"spec"}))->default_val("spec");
-    table.add(app, false);
+    table.add(app);
     app.add_option("--prom", prom, "PROM hex file the RTL loads (default: the table written to a temporary file); "
                                    "it must hold the table the options describe");
     app.add_flag("--exhaustive", exhaustive, "every (shininess code, cos code) pair, valid on every cycle");
@@ -259,7 +258,7 @@ struct SpecErrorCmd {
   bool json = false, quiet = false;
 
   void add(CLI::App& app) {
-    table.add(app, false);
+    table.add(app);
     app.add_option("--compare", compare, "second fit shown beside the first: auto (minimax, or inflection when the "
                                          "first is minimax), none, or a fit name")
         ->check(CLI::IsMember({"auto", "none", "inflection", "level", "shortcut", "minimax"}));

@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Regenerates the checked-in files of vectors/ with shadesim, or (--check) regenerates them into
+# a temporary directory and fails if any differs from the checked-in copy (CI runs this).
+#   scripts/regen_vectors.sh [--check] [--shadesim build/sim/shadesim]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+shadesim="$root/build/sim/shadesim"
+check=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --check) check=1 ;;
+    --shadesim) shadesim="$2"; shift ;;
+    *) echo "regen_vectors.sh: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+[ -x "$shadesim" ] || { echo "regen_vectors.sh: $shadesim is not built" >&2; exit 2; }
+
+if [ "$check" = 1 ]; then
+  dest=$(mktemp -d)
+  trap 'rm -rf "$dest"' EXIT
+else
+  dest="$root/vectors"
+fi
+mkdir -p "$dest/prom"
+
+# The PROM of every unit configuration, as the simulators load it.
+for cfg in default narrow wide cubic; do
+  "$shadesim" prom --config "$root/vectors/config/spec_$cfg.json" --format hex -o "$dest/prom/spec_$cfg.hex" 2>/dev/null
+done
+# The default PROM in every FPGA vendor's format.
+for fmt in mem coe mif csv; do
+  "$shadesim" prom --config "$root/vectors/config/spec_default.json" --format "$fmt" \
+    -o "$dest/prom/spec_default.$fmt" 2>/dev/null
+done
+
+if [ "$check" = 1 ]; then
+  status=0
+  while IFS= read -r f; do
+    rel=${f#"$dest"/}
+    if ! cmp -s "$f" "$root/vectors/$rel"; then
+      echo "vectors/$rel differs from a fresh regeneration (run scripts/regen_vectors.sh and commit)" >&2
+      status=1
+    fi
+  done < <(find "$dest" -type f | sort)
+  # A checked-in generated file that the generator no longer makes is stale too.
+  while IFS= read -r f; do
+    rel=${f#"$root/vectors"/}
+    [ -e "$dest/$rel" ] || { echo "vectors/$rel is not produced by the generator any more" >&2; status=1; }
+  done < <(find "$root/vectors/prom" -type f | sort)
+  [ "$status" = 0 ] && echo "vectors/: $(find "$dest" -type f | wc -l) generated files equal a fresh regeneration"
+  exit "$status"
+fi
+echo "regenerated $(find "$dest/prom" -type f | wc -l) files under vectors/prom"

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# The test command: installs what is missing, builds, runs every test with ctest, then builds
+# the tests again with AddressSanitizer + UndefinedBehaviorSanitizer and runs the fast ones.
+#   scripts/test.sh [--no-sanitize] [ctest arguments...]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+sanitize=1
+if [ "${1:-}" = "--no-sanitize" ]; then sanitize=0; shift; fi
+start=$(date +%s)
+"$root/scripts/install_deps.sh"
+"$root/scripts/build.sh" "$root/build"
+ctest --test-dir "$root/build" --output-on-failure -j "$(nproc)" "$@"
+echo "test.sh: release tests passed after $(( $(date +%s) - start )) s"
+if [ "$sanitize" = 1 ]; then
+  "$root/scripts/build.sh" "$root/build-asan" -DSHD_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    ctest --test-dir "$root/build-asan" --output-on-failure -j "$(nproc)" -LE slow "$@"
+  echo "test.sh: sanitizer tests passed after $(( $(date +%s) - start )) s"
+fi

@@ -1,0 +1,169 @@
+// The shadesim command line as a user runs it: outputs, JSON keys, and bad input (a clear
+// error naming the argument, a non-zero exit, no output file left behind).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#ifndef SHADESIM_BIN
+#error "SHADESIM_BIN must name the shadesim executable"
+#endif
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CmdResult {
+  int code = -1;
+  std::string out, err;
+};
+
+CmdResult run(const std::string& args) {
+  const fs::path dir = fs::path(testing::TempDir()) / "cli";
+  fs::create_directories(dir);
+  const std::string err_file = (dir / "stderr.txt").string();
+  const std::string cmd = std::string(SHADESIM_BIN) + " " + args + " 2>" + err_file;
+  CmdResult r;
+  FILE* p = popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  std::array<char, 4096> buf{};
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err_file);
+  std::stringstream ss;
+  ss << e.rdbuf();
+  r.err = ss.str();
+  return r;
+}
+
+std::string tmp(const std::string& name) {
+  const fs::path dir = fs::path(testing::TempDir()) / "cli";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  fs::remove(p);
+  return p.string();
+}
+
+// A failing command: non-zero exit, `needle` in the message, `out` not created.
+void expectRejected(const std::string& args, const std::string& needle, const std::string& out) {
+  const CmdResult r = run(args + " -o " + out);
+  EXPECT_NE(r.code, 0) << args;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\nstderr: " << r.err;
+  EXPECT_FALSE(fs::exists(out)) << args << " left " << out;
+  // Nor a temporary beside it.
+  for (const auto& e : fs::directory_iterator(fs::path(out).parent_path()))
+    EXPECT_EQ(e.path().filename().string().find(fs::path(out).filename().string() + ".tmp"), std::string::npos)
+        << e.path();
+}
+
+}  // namespace
+
+TEST(CliProm, WritesHexWithProvenanceAndAddressMap) {
+  const std::string out = tmp("list.hex");
+  const CmdResult r = run("prom --fit minimax --n-list 8,32,200 --format hex -o " + out);
+  ASSERT_EQ(r.code, 0) << r.err;
+  std::ifstream f(out);
+  std::string first;
+  std::getline(f, first);
+  EXPECT_NE(first.find("shadesim"), std::string::npos) << first;
+  int words = 0;
+  for (std::string l; std::getline(f, l);)
+    if (!l.empty() && l[0] != '/') ++words;
+  EXPECT_EQ(words, 4);  // 3 codes in a 2-bit address space
+  std::ifstream map(out + ".map.csv");
+  std::string header, row;
+  std::getline(map, header);
+  EXPECT_EQ(header, "address,n");
+  std::getline(map, row);
+  EXPECT_EQ(row.rfind("0,8", 0), 0u) << row;
+}
+
+TEST(CliProm, StdoutWithoutOutputFile) {
+  const CmdResult r = run("prom --fit inflection --n 1:4 --format csv");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.out.rfind("n,address,a_real,a_code\n1,0,0,0\n2,1,1,16384\n", 0), 0u) << r.out;
+}
+
+TEST(CliProm, BadInputIsNamedAndLeavesNoFile) {
+  const std::string out = tmp("bad.hex");
+  expectRejected("prom --fit bogus --format hex", "--fit", out);
+  expectRejected("prom --fit level --n 0:1000 --format hex", "--n", out);
+  expectRejected("prom --fit level --n 1:1001 --format hex", "--n", out);
+  expectRejected("prom --fit level --n-list 8,x --format hex", "--n-list", out);
+  expectRejected("prom --fit level --n 1:10 --n-list 8 --format hex", "--n", out);
+  expectRejected("prom --fit level --coef-format uQ10.x --format hex", "--coef-format", out);
+  expectRejected("prom --fit level --coef-format uQ30.30 --format hex", "--coef-format", out);
+  expectRejected("prom --fit inflection --coef-format uQ9.14 --format hex", "uQ9.14", out);
+  expectRejected("prom --fit level --coef-format sQ10.14 --format hex", "--coef-format", out);
+  expectRejected("prom --fit shortcut --degree 3 --coef-format sQ16.12 --format hex", "shortcut", out);
+  expectRejected("prom --fit level --format bin", "--format", out);
+  expectRejected("prom --fit level --level 1.5 --format hex", "--level", out);
+  expectRejected("prom --fit level --config nosuch --format hex", "--config", out);
+  // An output directory that does not exist: an error, nothing created.
+  const CmdResult r = run("prom --fit level --format hex -o " + tmp("nodir") + "/x.hex");
+  EXPECT_NE(r.code, 0);
+  EXPECT_FALSE(fs::exists(tmp("nodir")));
+}
+
+TEST(CliCosim, JsonKeysAndZeroMismatches) {
+  const CmdResult r = run("cosim --unit spec --config narrow --vectors 20000 --seed 3 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* k : {"unit", "config", "vectors", "cycles", "mismatches", "seed", "vectors_per_second"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["vectors"], 20000);
+  EXPECT_EQ(j["mismatches"], 0);
+}
+
+TEST(CliCosim, BadInput) {
+  CmdResult r = run("cosim --unit spec --config nosuch --vectors 10");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--config"), std::string::npos) << r.err;
+  r = run("cosim --unit spec --config narrow --prom /nonexistent/p.hex --vectors 10 --quiet");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("cannot open"), std::string::npos) << r.err;
+  r = run("cosim --unit texture --vectors 10");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("--unit"), std::string::npos) << r.err;
+  // A PROM made for another fit: the table check names the word.
+  const std::string other = tmp("other.hex");
+  ASSERT_EQ(run("prom --config narrow --fit minimax --format hex -o " + other).code, 0);
+  r = run("cosim --unit spec --config narrow --prom " + other + " --vectors 10 --quiet");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("word"), std::string::npos) << r.err;
+}
+
+TEST(CliSpecError, JsonHoldsPerNAndSummary) {
+  const CmdResult r = run("spec-error --config narrow --n-list 1,8,32,1000 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["per_n"].size(), 4u);
+  for (const auto& row : j["per_n"])
+    for (const char* k : {"n", "approx_lobe_max_abs", "approx_peak_max_rel", "datapath_max_lsb", "total_max_lsb"})
+      EXPECT_TRUE(row.contains(k)) << k;
+  EXPECT_TRUE(j.contains("summary"));
+  EXPECT_TRUE(j.contains("compare"));  // the minimax fit beside the configuration's fit
+  EXPECT_EQ(j["compare"]["fit"], "minimax");
+  // n = 1 is exact: the only error is the final rounding, at most half an output LSB.
+  EXPECT_LE(j["per_n"][0]["total_max_lsb"].get<double>(), 0.5 + 1e-9);
+  // The minimax fit is no worse on the whole lobe than the configuration's fit, n by n.
+  for (size_t i = 0; i < 4; ++i)
+    EXPECT_LE(j["compare"]["per_n"][i]["approx_lobe_max_abs"].get<double>(),
+              j["per_n"][i]["approx_lobe_max_abs"].get<double>() + 1e-12);
+}
+
+TEST(CliSpecError, TableShowsBothFits) {
+  const CmdResult r = run("spec-error --config narrow --n-list 8,32 --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("fit level"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("fit minimax"), std::string::npos) << r.out;
+}
