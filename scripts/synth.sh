@@ -231,7 +231,7 @@ def multipliers():
     lb = p["LightBits"]
     m = [("MUL1 c*c", cw, cw, False, False, 2 * wc - 1)]
     if p["Degree"] == 2:
-        m.append(("MUL2 a*dt", kw + 1, dtw, True, True, kw + 1 + dtw))
+        m.append(("MUL2 a*dt", kw + 1, dtw, True, True, kw + dtw))
     else:
         m.append(("Horner u*c", kw, cw + 1, True, True, kw + wc))
         m.append(("MUL2 gt*dt", gtw, dtw, True, True, gtw + dtw))
@@ -328,7 +328,9 @@ for tgt, wall in walls.items():
     muls = multipliers()
     exp_dsps = sum(tiles(TECH[tgt], *m[1:]) for m in muls)
     exp = dict(dsps=exp_dsps,
-               dsps_per_multiplier={m[0]: tiles(TECH[tgt], *m[1:]) for m in muls})
+               dsps_per_multiplier={
+                   f"{m[0]} {m[1]}x{m[2]} {'signed' if m[3] else 'unsigned'}": tiles(TECH[tgt], *m[1:])
+                   for m in muls})
     if tgt == "ice40":
         exp["brams"] = ice40_brams(depth, varying)
         rom_ok = r["brams"] == exp["brams"]

@@ -1,7 +1,6 @@
 #include "spec_cosim.h"
 
 #include <chrono>
-#include <deque>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -120,7 +119,8 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
   verifyLoadedProm(*dut, model.prom(), opts.prom_path, p);
 
   const size_t window = static_cast<size_t>(p.latency()) + 8;
-  std::deque<SpecIn> history;  // inputs of the last `window` cycles
+  std::vector<SpecIn> history(window);  // ring: the inputs of the last `window` cycles
+  size_t filled = 0;                     // cycles recorded, at most window
   std::vector<SpecIn> fail_window;
   dut->reset();
   model.reset();
@@ -138,19 +138,20 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
     if (in.valid) ++res.vectors;
     const SpecOut got = dut->tick(in);
     const SpecOut exp = model.tick(in);
-    if (history.size() == window) history.pop_front();
-    history.push_back(in);
+    const uint64_t cyc = model.cycle();  // 1-based index of this cycle
+    history[cyc % window] = in;
+    filled = std::min(filled + 1, window);
     if (got != exp) {
       ++res.mismatches;
       if (!res.first) {
         SpecMismatch m;
-        m.cycle = model.cycle();
+        m.cycle = cyc;
         const size_t back = static_cast<size_t>(p.latency()) - 1;
-        if (history.size() > back) m.input = history[history.size() - 1 - back];
+        if (filled > back) m.input = history[(cyc - back) % window];
         m.expected = exp;
         m.got = got;
         res.first = m;
-        fail_window.assign(history.begin(), history.end());
+        for (uint64_t k = cyc + 1 - filled; k <= cyc; ++k) fail_window.push_back(history[k % window]);
       }
       if (res.mismatches >= opts.max_mismatches) break;
     }

@@ -89,6 +89,9 @@ TEST(SpecCosim, DetectsADatapathDifferenceAndDumpsTheWindow) {
   const SpecCosimResult r = runSpecCosim("narrow", model, stim, options(s));
   ASSERT_GT(r.mismatches, 0u);
   ASSERT_TRUE(r.first.has_value());
+  std::printf("as expected, MISMATCH (first of %llu) %s\nwaveform: %s\nvectors:  %s\n",
+              static_cast<unsigned long long>(r.mismatches), r.first->describe(s.table.unit).c_str(),
+              r.fst_path.c_str(), r.vector_path.c_str());
   EXPECT_TRUE(r.first->input.valid);
   EXPECT_TRUE(r.first->got.valid && r.first->expected.valid);
   EXPECT_NE(r.first->got.spec, r.first->expected.spec);

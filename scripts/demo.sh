@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The main job: installs what is missing, builds, then for the default configuration of the
+# specular unit generates the PROM (every format), runs the exhaustive co-simulation of the
+# verilated RTL against the golden model, prints the error table, and synthesises the unit.
+# Results go to out/.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+out="$root/out"
+"$root/scripts/install_deps.sh"
+"$root/scripts/build.sh" "$root/build"
+S="$root/build/sim/shadesim"
+mkdir -p "$out/prom"
+
+echo "== 1. PROM of the default configuration (out/prom/)"
+for fmt in hex mem coe mif csv; do
+  "$S" prom --config default --format "$fmt" -o "$out/prom/spec_default.$fmt"
+done
+
+echo "== 2. exhaustive co-simulation: verilated shd_spec_unit vs golden model"
+"$S" cosim --unit spec --config default --exhaustive --prom "$out/prom/spec_default.hex" \
+  --fail-dir "$out/fail" --json > "$out/cosim_spec_default.json.tmp"
+mv "$out/cosim_spec_default.json.tmp" "$out/cosim_spec_default.json"
+python3 - "$out/cosim_spec_default.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+print(f"   {j['vectors']:,} vectors, {j['cycles']:,} cycles, {j['mismatches']} mismatches, "
+      f"{j['seconds']:.2f} s ({j['vectors_per_second'] / 1e6:.1f} M vectors/s)")
+PY
+
+echo "== 3. error report: the paper's fit beside the minimax fit"
+"$S" spec-error --config default --json-out "$out/spec_error_default.json" > "$out/spec_error_default.txt.tmp"
+mv "$out/spec_error_default.txt.tmp" "$out/spec_error_default.txt"
+cat "$out/spec_error_default.txt"
+
+echo "== 4. synthesis with yosys (out/synth/default/)"
+"$root/scripts/synth.sh" --config "$root/vectors/config/spec_default.json" \
+  --prom "$out/prom/spec_default.hex" --out "$out/synth/default" --target both --check
+
+echo "== results in $out"
+ls -1 "$out"
