@@ -116,7 +116,7 @@ module shd_spec_unit #(
       localparam integer GSH = CoefFracBits + WC - HornerFracBits;
       wire signed [KW-1:0]  u_a = word_q1[KW-1:0];
       wire signed [KW-1:0]  v_a = word_q1[2*KW-1:KW];
-      wire signed [UCW-1:0] uc  = {{(CW+1){u_a[KW-1]}}, u_a} * {{KW{1'b0}}, 1'b0, c_q1};
+      wire signed [UCW-1:0] uc  = u_a * $signed({1'b0, c_q1});   // signed x signed: no wasted DSP tile
       // |u*c| <= 2^(KW-1+Wc): bits [GW-2:0] hold it.
       wire signed [GW-1:0]  g_full = {uc[GW-2], uc[GW-2:0]} + {v_a[KW-1], v_a, {WC{1'b0}}};
       wire signed [GW-1:0]  g_shift = g_full >>> GSH;    // Trunc to Hf bits

@@ -28,7 +28,7 @@ std::vector<FixedFormat> smallFormats() {
 
 // Exact reference: the value raw/2^f as a rational with denominator 2^D (D = 16 here).
 constexpr int kD = 16;
-int64_t scaled(int64_t raw, int frac) { return raw << (kD - frac); }
+int64_t scaled(int64_t raw, int frac) { return raw * (int64_t{1} << (kD - frac)); }
 
 // Reference rounding of the rational num/2^k to an integer, independent of requantize():
 // uses long division on non-negative magnitudes and sign handling.
@@ -124,7 +124,7 @@ TEST(Fixed, ArithmeticExhaustiveIsExact) {
           // Every result is exact: its value equals the rational result.
           ASSERT_EQ(scaled(s.raw(), s.format().frac_bits), va + vb) << a.str() << " + " << b.str();
           ASSERT_EQ(scaled(d.raw(), d.format().frac_bits), va - vb) << a.str() << " - " << b.str();
-          ASSERT_EQ(p.raw() << (2 * kD - p.format().frac_bits), va * vb) << a.str() << " * " << b.str();
+          ASSERT_EQ(p.raw() * (int64_t{1} << (2 * kD - p.format().frac_bits)), va * vb) << a.str() << " * " << b.str();
           // ...and fits the grown format (fromRaw would throw otherwise).
           ASSERT_TRUE(s.format().holds(s.raw()));
           ASSERT_TRUE(d.format().holds(d.raw()));

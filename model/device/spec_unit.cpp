@@ -109,7 +109,7 @@ SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<ui
     prod = k.u * dt;
     prod_frac = p_.CoefFracBits + p_.DiffFracBits;
   } else {
-    const int64_t g = k.u * c + (k.v << wc);                        // Horner, exact
+    const int64_t g = k.u * c + k.v * (int64_t{1} << wc);           // Horner, exact
     prod = (g >> (p_.CoefFracBits + wc - p_.HornerFracBits)) * dt;  // Trunc, MUL2
     prod_frac = p_.HornerFracBits + p_.DiffFracBits;
   }

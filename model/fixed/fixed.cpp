@@ -91,11 +91,14 @@ static __int128 floorShift(__int128 v, int k) {  // floor(v / 2^k), k >= 0
   return v >> k;  // arithmetic shift on a signed 128-bit value is floor division
 }
 
+// v * 2^k without shifting a negative value left (undefined before C++20).
+static __int128 scaleUp(__int128 v, int k) { return v * (static_cast<__int128>(1) << k); }
+
 __int128 requantize(__int128 raw, int from_frac, int to_frac, Quant q) {
   const int shift = from_frac - to_frac;
-  if (shift <= 0) return raw * (static_cast<__int128>(1) << -shift);
+  if (shift <= 0) return scaleUp(raw, -shift);
   const __int128 quot = floorShift(raw, shift);
-  const __int128 rem = raw - (quot << shift);  // in [0, 2^shift)
+  const __int128 rem = raw - scaleUp(quot, shift);  // in [0, 2^shift)
   const __int128 half = static_cast<__int128>(1) << (shift - 1);
   switch (q) {
     case Quant::Trunc: return quot;
@@ -129,7 +132,7 @@ Fixed Fixed::fromRaw(int64_t raw, FixedFormat fmt) {
 }
 
 Fixed Fixed::fromInt(int64_t v, FixedFormat fmt, Overflow o) {
-  const __int128 raw = static_cast<__int128>(v) << fmt.frac_bits;
+  const __int128 raw = scaleUp(v, fmt.frac_bits);
   return Fixed(fitRaw(raw, fmt, o), fmt);
 }
 
@@ -194,7 +197,7 @@ FixedFormat sumFormat(FixedFormat a, FixedFormat b, bool result_signed) {
 }
 
 __int128 aligned(Fixed x, int frac) {
-  return static_cast<__int128>(x.raw()) << (frac - x.format().frac_bits);
+  return scaleUp(x.raw(), frac - x.format().frac_bits);
 }
 
 }  // namespace
