@@ -197,7 +197,6 @@ struct CosimCmd {
       writeFileAtomic(prom_path, renderProm(t, PromFormat::Hex));
     }
     prom_path = fs::absolute(prom_path).string();
-    fs::create_directories(fail_dir);
     SpecUnitModel model(t.unit, t.words);
     std::unique_ptr<SpecStimulus> stim;
     if (exhaustive) stim = std::make_unique<ExhaustiveSpecStimulus>(t.unit, seed);

@@ -1,6 +1,7 @@
 #include "spec_cosim.h"
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 
 #include <fmt/format.h>
@@ -167,6 +168,7 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
   if (res.first) {
     // Replay the failing window from reset into a traced instance, with the model's expected
     // outputs for the same window, so the case reproduces alone.
+    std::filesystem::create_directories(opts.fail_dir);
     res.fst_path = fmt::format("{}/spec_{}_fail.fst", opts.fail_dir, config);
     res.vector_path = fmt::format("{}/spec_{}_fail.vec", opts.fail_dir, config);
     auto traced = makeSpecDut(config, SpecDutOptions{opts.prom_path, res.fst_path});
