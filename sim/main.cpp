@@ -4,6 +4,7 @@
 //   shadesim spec-error  approximation, datapath and total error of the specular unit
 // Every failure prints "shadesim <command>: error: ..." naming the argument and exits non-zero;
 // files are written atomically, so a failed run leaves no partial output.
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -42,7 +43,6 @@ SpecUnitConfig resolveConfig(const std::string& arg) {
 // The options that choose a PROM's contents, shared by prom, cosim and spec-error.
 struct TableOptions {
   std::string config = "default";
-  bool config_given = false;
   std::string fit, n, n_list, coef_format;
   std::optional<double> level;
   int degree = 0;  // 0: the configuration's
@@ -60,8 +60,10 @@ struct TableOptions {
     app.add_option("--coef-format", coef_format, "coefficient format, e.g. uQ10.14 (degree 3: sQm.f)");
   }
 
-  // The unit parameters and the table request after applying the overrides.
-  PromTable build(SpecUnitConfig& cfg_out) const {
+  // The unit parameters and the table request after applying the overrides. With size_to_n the
+  // PROM is as deep as the n list needs (a table made without naming a configuration);
+  // otherwise it keeps the configuration's ShinBits.
+  PromTable build(SpecUnitConfig& cfg_out, bool size_to_n) const {
     SpecUnitConfig cfg = resolveConfig(config);
     PromContent content = cfg.prom;
     if (!fit.empty()) content.fit = fit;
@@ -94,7 +96,7 @@ struct TableOptions {
       p.CoefFracBits = f.frac_bits;
     }
     // A table made without a configuration is as deep as its n list needs.
-    if (!config_given) p.ShinBits = addressBitsFor(req.n.values.size());
+    if (size_to_n) p.ShinBits = addressBitsFor(req.n.values.size());
     try {
       p.validate();
     } catch (const std::invalid_argument& e) {
@@ -141,9 +143,8 @@ struct PromCmd {
   }
 
   int run(const CLI::App& app) {
-    table.config_given = app.count("--config") > 0;
     SpecUnitConfig cfg;
-    const PromTable t = table.build(cfg);
+    const PromTable t = table.build(cfg, app.count("--config") == 0);
     const PromFormat f = parsePromFormat(format);
     // Render everything first, then write: an error leaves no file behind.
     const std::string body = renderProm(t, f);
@@ -183,11 +184,20 @@ struct CosimCmd {
     app.add_flag("--quiet", quiet, "no progress on stderr");
   }
 
-  int run(const CLI::App& app) {
-    table.config_given = true;
+  int run() {
     SpecUnitConfig cfg;
-    const PromTable t = table.build(cfg);
-    if (!app.count("--config")) cfg.name = "default";
+    const PromTable t = table.build(cfg, false);
+    // The RTL side is the configuration verilated into this binary: its parameters must be the
+    // ones the model is built with.
+    const std::vector<std::string> built = rtlSpecConfigs();
+    if (std::find(built.begin(), built.end(), cfg.name) == built.end())
+      throw ArgError(fmt::format("--config {}: no verilated unit named '{}' in this build (built: {}); add its JSON "
+                                 "to vectors/config and SHD_SPEC_CONFIGS",
+                                 table.config, cfg.name, fmt::join(built, ", ")));
+    if (SpecUnitConfig::load(configPath(cfg.name)).rtl.toJson() != t.unit.toJson())
+      throw ArgError(fmt::format("--config {}: its RTL parameters (after --degree/--coef-format) differ from the "
+                                 "verilated '{}' unit {}",
+                                 table.config, cfg.name, SpecUnitConfig::load(configPath(cfg.name)).rtl.toJson().dump()));
     std::string prom_path = prom;
     fs::path tmp_dir;
     if (prom_path.empty()) {
@@ -266,11 +276,9 @@ struct SpecErrorCmd {
     app.add_flag("--quiet", quiet, "no progress on stderr");
   }
 
-  int run(const CLI::App& app) {
-    table.config_given = true;
+  int run() {
     SpecUnitConfig cfg;
-    const PromTable t = table.build(cfg);
-    if (!app.count("--config")) cfg.name = "default";
+    const PromTable t = table.build(cfg, false);
     Progress progress(fmt::format("spec-error {}", toString(t.request.fit)), !quiet);
     auto prog = [&](size_t done, size_t total) { progress.update(static_cast<double>(done), static_cast<double>(total), "n"); };
     const SpecErrorReport primary = computeSpecError(cfg.name, t, prog);
@@ -320,8 +328,8 @@ int main(int argc, char** argv) {
   CLI::App* cmd = app.get_subcommands().front();
   try {
     if (cmd == prom_app) return prom.run(*prom_app);
-    if (cmd == cosim_app) return cosim.run(*cosim_app);
-    if (cmd == err_app) return spec_error.run(*err_app);
+    if (cmd == cosim_app) return cosim.run();
+    if (cmd == err_app) return spec_error.run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shadesim %s: error: %s\n", cmd->get_name().c_str(), e.what());
     return 2;

@@ -134,6 +134,10 @@ TEST(CliCosim, BadInput) {
   r = run("cosim --unit texture --vectors 10");
   EXPECT_NE(r.code, 0);
   EXPECT_NE(r.err.find("--unit"), std::string::npos) << r.err;
+  // Widths that differ from the verilated configuration cannot be co-simulated.
+  r = run("cosim --unit spec --config narrow --coef-format uQ10.8 --vectors 10 --quiet");
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.err.find("differ from the verilated"), std::string::npos) << r.err;
   // A PROM made for another fit: the table check names the word.
   const std::string other = tmp("other.hex");
   ASSERT_EQ(run("prom --config narrow --fit minimax --format hex -o " + other).code, 0);
