@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -25,10 +26,15 @@ struct CmdResult {
   std::string out, err;
 };
 
-CmdResult run(const std::string& args) {
-  const fs::path dir = fs::path(testing::TempDir()) / "cli";
+// ctest runs the tests of this file as parallel processes: each keeps its files apart.
+fs::path testDir() {
+  const fs::path dir = fs::path(testing::TempDir()) / ("cli_" + std::to_string(getpid()));
   fs::create_directories(dir);
-  const std::string err_file = (dir / "stderr.txt").string();
+  return dir;
+}
+
+CmdResult run(const std::string& args) {
+  const std::string err_file = (testDir() / "stderr.txt").string();
   const std::string cmd = std::string(SHADESIM_BIN) + " " + args + " 2>" + err_file;
   CmdResult r;
   FILE* p = popen(cmd.c_str(), "r");
@@ -46,9 +52,7 @@ CmdResult run(const std::string& args) {
 }
 
 std::string tmp(const std::string& name) {
-  const fs::path dir = fs::path(testing::TempDir()) / "cli";
-  fs::create_directories(dir);
-  const fs::path p = dir / name;
+  const fs::path p = testDir() / name;
   fs::remove(p);
   return p.string();
 }

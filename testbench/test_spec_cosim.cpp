@@ -22,11 +22,20 @@ struct CosimSetup {
 };
 
 // The configuration's table, written as the hex file the simulator loads.
+// ctest runs each test as its own process, in parallel: each test keeps its files apart.
+fs::path testDir() {
+  const testing::TestInfo* t = testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string(t->test_suite_name()) + "." + t->name();
+  for (char& ch : name)
+    if (ch == '/') ch = '_';
+  return fs::path(testing::TempDir()) / "spec_cosim" / name;
+}
+
 CosimSetup setup(const std::string& name) {
   CosimSetup s;
   s.cfg = SpecUnitConfig::load(configPath(name));
   s.table = buildPromTable(PromRequest::fromContent(s.cfg.prom), s.cfg.rtl);
-  const fs::path dir = fs::path(testing::TempDir()) / "spec_cosim";
+  const fs::path dir = testDir();
   fs::create_directories(dir);
   s.prom_path = (dir / fmt::format("spec_{}.hex", name)).string();
   writeFileAtomic(s.prom_path, renderProm(s.table, PromFormat::Hex));
@@ -36,7 +45,7 @@ CosimSetup setup(const std::string& name) {
 SpecCosimOptions options(const CosimSetup& s) {
   SpecCosimOptions o;
   o.prom_path = s.prom_path;
-  o.fail_dir = (fs::path(testing::TempDir()) / "spec_cosim").string();
+  o.fail_dir = testDir().string();
   return o;
 }
 
