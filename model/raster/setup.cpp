@@ -1,0 +1,371 @@
+#include "raster/setup.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "fixed/fixed.h"
+
+namespace shd {
+
+namespace {
+
+using i128 = __int128;
+
+int64_t floorDiv(i128 a, i128 b) {  // b > 0
+  i128 q = a / b;
+  if ((a % b) != 0 && a < 0) --q;
+  return static_cast<int64_t>(q);
+}
+int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
+
+// round-half-even(num / den), den > 0
+i128 roundDiv(i128 num, i128 den) {
+  i128 q = num / den, r = num % den;
+  if (r < 0) {
+    --q;
+    r += den;
+  }
+  const i128 twice = 2 * r;
+  if (twice > den || (twice == den && (q & 1) != 0)) ++q;
+  return q;
+}
+
+// A triangle in one frame: vertices in u units and its three biased edge functions in that
+// frame's pixel coordinates (edge s runs from vertex s to vertex s+1).
+struct Geom {
+  std::array<int64_t, 3> xu{}, yu{};
+  std::array<EdgeFunction, 3> e;
+};
+
+Geom screenGeom(const std::array<int64_t, 3>& xu, const std::array<int64_t, 3>& yu, int S) {
+  Geom g;
+  g.xu = xu;
+  g.yu = yu;
+  const int64_t half = int64_t{1} << S, step = int64_t{1} << (S + 1);
+  for (int s = 0; s < 3; ++s) {
+    const size_t p = static_cast<size_t>(s), q = static_cast<size_t>((s + 1) % 3);
+    const int64_t dx = xu[q] - xu[p], dy = yu[q] - yu[p];
+    EdgeFunction& e = g.e[p];
+    e.A = -dy * step;
+    e.B = dx * step;
+    e.C = dx * (half - yu[p]) - dy * (half - xu[p]);
+    e.topLeft = e.A > 0 || (e.A == 0 && e.B > 0);
+    if (!e.topLeft) e.C -= 1;
+  }
+  return g;
+}
+
+// The same triangle seen from a walker frame: lane pixel = walker pixel + (tx, ty).
+Geom translated(const Geom& g, int64_t tx, int64_t ty, int S) {
+  Geom w = g;
+  const int64_t step = int64_t{1} << (S + 1);
+  for (size_t i = 0; i < 3; ++i) {
+    w.xu[i] -= tx * step;
+    w.yu[i] -= ty * step;
+    w.e[i].C += w.e[i].A * tx + w.e[i].B * ty;
+  }
+  return w;
+}
+
+// Point-reflected: lane pixel = (ox - walker x, oy - walker y).
+Geom reflected(const Geom& g, int64_t ox, int64_t oy, int S) {
+  Geom w = g;
+  const int64_t step = int64_t{1} << (S + 1);
+  for (size_t i = 0; i < 3; ++i) {
+    w.xu[i] = (ox + 1) * step - g.xu[i];
+    w.yu[i] = (oy + 1) * step - g.yu[i];
+    w.e[i].C = g.e[i].C + g.e[i].A * ox + g.e[i].B * oy;
+    w.e[i].A = -g.e[i].A;
+    w.e[i].B = -g.e[i].B;
+  }
+  return w;
+}
+
+// Rows whose pixel centre (2w+1)*2^S lies in [lo, hi] (u units).
+std::pair<int64_t, int64_t> centreRows(int64_t lo, int64_t hi, int S) {
+  const int64_t half = int64_t{1} << S, step = int64_t{1} << (S + 1);
+  return {ceilDiv(lo - half, step), floorDiv(hi - half, step)};
+}
+
+void requireCoord(int64_t v, const SpanParams& p, const char* what) {
+  const int64_t lim = int64_t{1} << (p.CoordBits - 1);
+  if (v < -lim || v >= lim)
+    throw std::logic_error(fmt::format("setup: {} = {} does not fit CoordBits {}", what, v, p.CoordBits));
+}
+
+SpanLaneTri buildLaneTri(const Geom& g, bool flip, int64_t ox, int64_t oy, const RasterConfig& cfg) {
+  const int S = cfg.subpixel_bits;
+  const SpanParams& p = cfg.unit;
+  SpanLaneTri t;
+  t.flip = flip;
+  t.ox = static_cast<int32_t>(ox);
+  t.oy = static_cast<int32_t>(oy);
+  // Rows: pixel centres within the vertical extent, then the horizontal edge, then the viewport.
+  auto [r0, r1] = centreRows(*std::min_element(g.yu.begin(), g.yu.end()), *std::max_element(g.yu.begin(), g.yu.end()), S);
+  for (const EdgeFunction& e : g.e) {
+    if (e.A != 0) continue;
+    if (e.B > 0) r0 = std::max(r0, ceilDiv(-static_cast<i128>(e.C), e.B));
+    else r1 = std::min(r1, floorDiv(e.C, -e.B));
+  }
+  const int64_t W = cfg.width, H = cfg.height;
+  if (flip) {
+    r0 = std::max(r0, oy - (H - 1));
+    r1 = std::min(r1, oy);
+    t.clip_x0 = static_cast<int32_t>(ox - (W - 1));
+    t.clip_x1 = static_cast<int32_t>(ox);
+  } else {
+    r0 = std::max(r0, -oy);
+    r1 = std::min(r1, H - 1 - oy);
+    t.clip_x0 = static_cast<int32_t>(-ox);
+    t.clip_x1 = static_cast<int32_t>(W - 1 - ox);
+  }
+  if (r0 > r1) return t;  // no rows: row_first > row_last
+  requireCoord(r0, p, "lane-triangle first row");
+  requireCoord(r1, p, "lane-triangle last row");
+  t.row_first = static_cast<int32_t>(r0);
+  t.row_last = static_cast<int32_t>(r1);
+  int slot = 0;
+  for (int s = 0; s < 3; ++s) {
+    const EdgeFunction& e = g.e[static_cast<size_t>(s)];
+    if (e.A == 0) continue;
+    const size_t a = static_cast<size_t>(s), b = static_cast<size_t>((s + 1) % 3);
+    auto [ea, eb] = centreRows(std::min(g.yu[a], g.yu[b]), std::max(g.yu[a], g.yu[b]), S);
+    ea = std::max(ea, r0);
+    eb = std::min(eb, r1);
+    SpanEdge& d = t.edge[slot++];
+    if (ea > eb) continue;  // never active: stays an unused slot
+    d.row_first = static_cast<int32_t>(ea);
+    d.row_last = static_cast<int32_t>(eb);
+    d.right = e.A < 0;
+    const int64_t D = e.A < 0 ? -e.A : e.A;
+    const i128 N = -(static_cast<i128>(e.B) * ea + e.C);  // x >= N/D (left), x <= -N/D (right)
+    const int64_t q = ceilDiv(N, D);
+    d.q = static_cast<int32_t>(q);
+    d.r = static_cast<int64_t>(static_cast<i128>(q) * D - N);
+    d.div = D;
+    if (eb > ea) {  // the DDA steps: -B = k D + m
+      d.k = static_cast<int32_t>(floorDiv(-static_cast<i128>(e.B), D));
+      d.m = static_cast<int64_t>(-static_cast<i128>(e.B) - static_cast<i128>(d.k) * D);
+      requireCoord(floorDiv(-static_cast<i128>(e.B), D), p, "edge DDA step k");
+    }
+    // While active the bound lies within the edge's horizontal extent (+-1): it fits.
+    requireCoord(q, p, "edge DDA quotient");
+    if (D >= (int64_t{1} << p.RemBits))
+      throw std::logic_error(fmt::format("setup: edge divisor {} does not fit RemBits {}", D, p.RemBits));
+  }
+  return t;
+}
+
+}  // namespace
+
+int defaultAttrFracBits(int width, int height, int out_frac) {
+  int lg = 0;
+  while ((int64_t{1} << lg) < int64_t{1} + width + height) ++lg;
+  return out_frac + 1 + lg;
+}
+
+std::vector<int> defaultAttrFracBitsFor(int width, int height, int num_attr) {
+  std::vector<int> f;
+  for (int k = 0; k < num_attr; ++k) f.push_back(defaultAttrFracBits(width, height, k == 3 ? 24 : 0));
+  return f;
+}
+
+void RasterConfig::validate() const {
+  unit.validate();
+  const int64_t lim = int64_t{1} << unit.PixBits;
+  if (width < 1 || width > lim || height < 1 || height > lim)
+    throw std::invalid_argument(fmt::format("viewport {}x{} must fit PixBits {} (1..{})", width, height, unit.PixBits, lim));
+  if (int64_t{2} * std::max(width, height) > (int64_t{1} << (unit.CoordBits - 3)))
+    throw std::invalid_argument(fmt::format("viewport {}x{} too large for the guard band of CoordBits {}", width,
+                                            height, unit.CoordBits));
+  if (subpixel_bits < 1 || subpixel_bits > 8)
+    throw std::invalid_argument(fmt::format("subpixel_bits {} must be in 1..8", subpixel_bits));
+  if (!attr_frac_bits.empty() && static_cast<int>(attr_frac_bits.size()) != unit.NumAttr)
+    throw std::invalid_argument(fmt::format("attr_frac_bits has {} entries, NumAttr is {}", attr_frac_bits.size(), unit.NumAttr));
+  for (int k = 0; k < unit.NumAttr; ++k)
+    if (attrFracBits(k) < 0 || attrFracBits(k) > unit.AttrBits - 2)
+      throw std::invalid_argument(fmt::format("attribute {} fraction bits {} must be in 0..AttrBits-2", k, attrFracBits(k)));
+}
+
+int RasterConfig::attrFracBits(int k) const {
+  if (attr_frac_bits.empty()) return defaultAttrFracBitsFor(width, height, unit.NumAttr)[static_cast<size_t>(k)];
+  return attr_frac_bits[static_cast<size_t>(k)];
+}
+
+SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg) {
+  const SpanParams& p = cfg.unit;
+  const int S = cfg.subpixel_bits, K = p.NumAttr;
+  SetupResult res;
+  SnappedTriangle& t = res.tri;
+  // Snap to the subpixel grid; the guard band bounds every width downstream.
+  const double guard = std::ldexp(1.0, p.CoordBits - 3);
+  for (size_t i = 0; i < 3; ++i) {
+    if (!std::isfinite(v[i].x) || !std::isfinite(v[i].y))
+      throw std::invalid_argument(fmt::format("triangle {}: vertex {} has a non-finite coordinate ({}, {})", tag, i, v[i].x, v[i].y));
+    if (std::fabs(v[i].x) > guard || std::fabs(v[i].y) > guard)
+      throw std::invalid_argument(fmt::format("triangle {}: vertex {} at ({}, {}) lies outside the guard band +-{} px: "
+                                              "clip first",
+                                              tag, i, v[i].x, v[i].y, guard));
+    if (static_cast<int>(v[i].attr.size()) != K)
+      throw std::invalid_argument(fmt::format("triangle {}: vertex {} has {} attributes, the unit takes {}", tag, i, v[i].attr.size(), K));
+    t.X[i] = Fixed::fromDouble(v[i].x, FixedFormat::s(p.CoordBits, S), Quant::RoundHalfEven, Overflow::Error).raw();
+    t.Y[i] = Fixed::fromDouble(v[i].y, FixedFormat::s(p.CoordBits, S), Quant::RoundHalfEven, Overflow::Error).raw();
+  }
+  t.a.assign(static_cast<size_t>(K), {});
+  const int64_t err_bound = (1 + int64_t{cfg.width} + cfg.height) / 2 + 2;  // codes, see header
+  const int64_t lim = (int64_t{1} << (p.AttrBits - 1)) - 1 - err_bound;
+  for (int k = 0; k < K; ++k)
+    for (size_t i = 0; i < 3; ++i) {
+      const double val = v[i].attr[static_cast<size_t>(k)];
+      const int F = cfg.attrFracBits(k);
+      if (!std::isfinite(val) || std::fabs(std::ldexp(val, F)) > static_cast<double>(lim))
+        throw std::invalid_argument(fmt::format(
+            "triangle {}: attribute {} = {} at vertex {} does not fit AttrBits {} with {} fraction bits", tag, k, val, i,
+            p.AttrBits, F));
+      t.a[static_cast<size_t>(k)][i] = Fixed::fromDouble(val, FixedFormat::s(p.AttrBits - F, F), Quant::RoundHalfEven, Overflow::Error).raw();
+    }
+  t.det = (t.X[1] - t.X[0]) * (t.Y[2] - t.Y[0]) - (t.X[2] - t.X[0]) * (t.Y[1] - t.Y[0]);
+  if (t.det == 0) {
+    res.dropped = "zero area";
+    return res;
+  }
+  if (t.det < 0) {  // one orientation downstream: inside is E >= 0
+    std::swap(t.X[1], t.X[2]);
+    std::swap(t.Y[1], t.Y[2]);
+    for (auto& a : t.a) std::swap(a[1], a[2]);
+    t.swapped = true;
+    t.det = -t.det;
+  }
+  const std::array<int64_t, 3> xu = {2 * t.X[0], 2 * t.X[1], 2 * t.X[2]}, yu = {2 * t.Y[0], 2 * t.Y[1], 2 * t.Y[2]};
+  const Geom whole = screenGeom(xu, yu, S);
+  res.edges = whole.e;
+
+  // The attribute plane in screen pixels, referenced inside the viewport (see the error bound).
+  AttributePlane& pl = res.plane;
+  const int64_t px_min = floorDiv(*std::min_element(t.X.begin(), t.X.end()), int64_t{1} << S);
+  const int64_t py_min = floorDiv(*std::min_element(t.Y.begin(), t.Y.end()), int64_t{1} << S);
+  pl.xref = std::clamp<int64_t>(px_min, 0, cfg.width - 1);
+  pl.yref = std::clamp<int64_t>(py_min, 0, cfg.height - 1);
+  const i128 det = t.det;
+  for (int k = 0; k < K; ++k) {
+    const auto& a = t.a[static_cast<size_t>(k)];
+    const i128 nx = static_cast<i128>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) - static_cast<i128>(a[2] - a[0]) * (t.Y[1] - t.Y[0]);
+    const i128 ny = static_cast<i128>(t.X[1] - t.X[0]) * (a[2] - a[0]) - static_cast<i128>(t.X[2] - t.X[0]) * (a[1] - a[0]);
+    // per pixel = per subpixel * 2^S
+    pl.didx.push_back(static_cast<int64_t>(roundDiv(nx * (i128{1} << S), det)));
+    pl.didy.push_back(static_cast<int64_t>(roundDiv(ny * (i128{1} << S), det)));
+    // exact plane at the reference pixel centre, in u units: I = a0 + (nx (cx - U0) + ny (cy - V0)) / (2 det)
+    const i128 cx = (2 * static_cast<i128>(pl.xref) + 1) << S, cy = (2 * static_cast<i128>(pl.yref) + 1) << S;
+    pl.iref.push_back(static_cast<int64_t>(roundDiv(2 * det * a[0] + nx * (cx - xu[0]) + ny * (cy - yu[0]), 2 * det)));
+  }
+
+  // Lane-triangles in the walker frame.
+  std::vector<SpanLaneTri> lanes;
+  const SpanMode mode = p.mode();
+  if (mode != SpanMode::Sierpinski) {
+    lanes.push_back(buildLaneTri(whole, false, 0, 0, cfg));
+  } else {
+    // Split at the edge midpoints (exact in u units): T0 = (V0, M01, M20) is the walker frame,
+    // T1 = (M01, V1, M12) and T2 = (M20, M12, V2) are its translates by (V1-V0)/2 and
+    // (V2-V0)/2, T3 = (M12, M20, M01) its point reflection through (M01 + M20)/2.
+    const std::array<int64_t, 3> mx = {t.X[0] + t.X[1], t.X[1] + t.X[2], t.X[2] + t.X[0]};  // M01, M12, M20
+    const std::array<int64_t, 3> my = {t.Y[0] + t.Y[1], t.Y[1] + t.Y[2], t.Y[2] + t.Y[0]};
+    const Geom g0 = screenGeom({xu[0], mx[0], mx[2]}, {yu[0], my[0], my[2]}, S);
+    const Geom g1 = screenGeom({mx[0], xu[1], mx[1]}, {my[0], yu[1], my[1]}, S);
+    const Geom g2 = screenGeom({mx[2], mx[1], xu[2]}, {my[2], my[1], yu[2]}, S);
+    const Geom g3 = screenGeom({mx[1], mx[2], mx[0]}, {my[1], my[2], my[0]}, S);
+    const int64_t step = int64_t{1} << (S + 1);
+    // Integer pixel offsets, rounded: a half-pixel remainder is a "cut point", absorbed by the
+    // lane's own exact edges.
+    const int64_t t1x = static_cast<int64_t>(roundDiv(t.X[1] - t.X[0], step)), t1y = static_cast<int64_t>(roundDiv(t.Y[1] - t.Y[0], step));
+    const int64_t t2x = static_cast<int64_t>(roundDiv(t.X[2] - t.X[0], step)), t2y = static_cast<int64_t>(roundDiv(t.Y[2] - t.Y[0], step));
+    const int64_t ox = static_cast<int64_t>(roundDiv(mx[0] + mx[2], step)) - 1, oy = static_cast<int64_t>(roundDiv(my[0] + my[2], step)) - 1;
+    lanes.push_back(buildLaneTri(g0, false, 0, 0, cfg));
+    lanes.push_back(buildLaneTri(translated(g1, t1x, t1y, S), false, t1x, t1y, cfg));
+    lanes.push_back(buildLaneTri(translated(g2, t2x, t2y, S), false, t2x, t2y, cfg));
+    lanes.push_back(buildLaneTri(reflected(g3, ox, oy, S), true, ox, oy, cfg));
+  }
+  int64_t row_first = 0, row_last = -1;
+  bool any = false;
+  for (const SpanLaneTri& l : lanes) {
+    if (l.row_first > l.row_last) continue;
+    row_first = any ? std::min<int64_t>(row_first, l.row_first) : l.row_first;
+    row_last = any ? std::max<int64_t>(row_last, l.row_last) : l.row_last;
+    any = true;
+  }
+  if (!any) {
+    res.dropped = "outside the viewport";
+    return res;
+  }
+  SpanDesc d;
+  d.tag = tag;
+  d.row_first = static_cast<int32_t>(row_first);
+  d.row_last = static_cast<int32_t>(row_last);
+  d.xref = static_cast<int32_t>(pl.xref);
+  const int64_t amask = (int64_t{1} << p.AttrBits) - 1;
+  auto wrap = [&](i128 x) {
+    int64_t low = static_cast<int64_t>(static_cast<uint64_t>(x) & static_cast<uint64_t>(amask));
+    if (low >> (p.AttrBits - 1)) low -= int64_t{1} << p.AttrBits;
+    return low;
+  };
+  for (int k = 0; k < K; ++k) {
+    d.iref.push_back(wrap(pl.at(k, d.xref, d.row_first)));
+    d.didx.push_back(wrap(pl.didx[static_cast<size_t>(k)]));
+    d.didy.push_back(wrap(pl.didy[static_cast<size_t>(k)]));
+  }
+  for (SpanLaneTri& l : lanes) {
+    // Lane attribute = I_w + aoff, or aoff - I_w when flipped, with I_w the walker (screen) plane.
+    for (int k = 0; k < K; ++k) {
+      const i128 dx = pl.didx[static_cast<size_t>(k)], dy = pl.didy[static_cast<size_t>(k)];
+      l.aoff.push_back(l.flip ? wrap(static_cast<i128>(pl.at(k, 0, 0)) + pl.at(k, l.ox, l.oy))
+                              : wrap(dx * l.ox + dy * l.oy));
+    }
+  }
+  d.tri = std::move(lanes);
+  res.desc = std::move(d);
+  return res;
+}
+
+std::vector<SpanFragment> rasterizeReference(const SetupResult& s, const RasterConfig& cfg) {
+  std::vector<SpanFragment> out;
+  if (s.tri.det == 0) return out;
+  const int S = cfg.subpixel_bits;
+  const int64_t one = int64_t{1} << S;
+  const int64_t x0 = std::max<int64_t>(0, floorDiv(*std::min_element(s.tri.X.begin(), s.tri.X.end()), one) - 1);
+  const int64_t x1 = std::min<int64_t>(cfg.width - 1, floorDiv(*std::max_element(s.tri.X.begin(), s.tri.X.end()), one) + 1);
+  const int64_t y0 = std::max<int64_t>(0, floorDiv(*std::min_element(s.tri.Y.begin(), s.tri.Y.end()), one) - 1);
+  const int64_t y1 = std::min<int64_t>(cfg.height - 1, floorDiv(*std::max_element(s.tri.Y.begin(), s.tri.Y.end()), one) + 1);
+  const uint32_t tag = s.desc ? s.desc->tag : 0;
+  for (int64_t py = y0; py <= y1; ++py)
+    for (int64_t px = x0; px <= x1; ++px) {
+      bool in = true;
+      for (const EdgeFunction& e : s.edges) in = in && e.eval(px, py) >= 0;
+      if (!in) continue;
+      SpanFragment f;
+      f.tag = tag;
+      f.x = static_cast<int32_t>(px);
+      f.y = static_cast<int32_t>(py);
+      for (int k = 0; k < cfg.unit.NumAttr; ++k) f.attr.push_back(s.plane.at(k, px, py));
+      out.push_back(std::move(f));
+    }
+  return out;
+}
+
+double exactPlane(const SetupResult& s, const RasterConfig& cfg, int k, int64_t px, int64_t py) {
+  const SnappedTriangle& t = s.tri;
+  const auto& a = t.a[static_cast<size_t>(k)];
+  // In subpixel units: I = a0 + gx (cx - X0) + gy (cy - Y0), pixel centre c = (p + 0.5) 2^S.
+  const long double det = static_cast<long double>(t.det);
+  const long double gx = (static_cast<long double>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) -
+                          static_cast<long double>(a[2] - a[0]) * (t.Y[1] - t.Y[0])) / det;
+  const long double gy = (static_cast<long double>(t.X[1] - t.X[0]) * (a[2] - a[0]) -
+                          static_cast<long double>(t.X[2] - t.X[0]) * (a[1] - a[0])) / det;
+  const long double one = std::ldexp(1.0L, cfg.subpixel_bits);
+  const long double cx = (px + 0.5L) * one, cy = (py + 0.5L) * one;
+  return static_cast<double>(a[0] + gx * (cx - t.X[0]) + gy * (cy - t.Y[0]));
+}
+
+}  // namespace shd

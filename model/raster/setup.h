@@ -1,0 +1,121 @@
+// Triangle setup: screen-space vertices in, a span-unit descriptor (raster/span_unit.h) out.
+//
+// Fixed point and the pixel grid
+//   Vertices snap to S = subpixel_bits fraction bits (round-half-even): X = round(x * 2^S).
+//   Pixel (px, py) covers [px, px+1) x [py, py+1) and is sampled at its centre (px+0.5, py+0.5).
+//   Internally positions are in units u = 2^-(S+1) pixel (a vertex is U = 2X, a pixel centre
+//   (2px+1)*2^S), so that the edge midpoints of the 4-way split are exact integers too.
+//   Vertices must lie in the guard band |x|, |y| <= 2^(CoordBits-3) pixels (8192 for the default
+//   CoordBits 16): clip larger triangles first. NaN or infinite coordinates are rejected.
+//
+// Edge functions and the fill rule
+//   With det = (X1-X0)(Y2-Y0) - (X2-X0)(Y1-Y0) > 0 (setup swaps two vertices otherwise) the
+//   edge P->Q has E(px, py) = A px + B py + C with A = -(Qy-Py) 2^(S+1), B = (Qx-Px) 2^(S+1),
+//   C = E at pixel (0, 0), all integers (u^2 units), and the inside is E >= 0. Top-left rule
+//   (y down): an edge is "left" if A > 0 and "top" if A == 0 and B > 0; a pixel centre exactly on
+//   an edge belongs to the triangle only for top and left edges. Setup folds this into a bias:
+//   C' = C - 1 for the other edges, so the per-pixel test is the sign bit of A px + B py + C'.
+//   A pixel shared by two triangles of a mesh (a shared edge is the same line with opposite
+//   direction, so exactly one of the two is top/left) is drawn exactly once.
+//
+// Degenerate triangles (the stated rule): det == 0 (zero area: repeated or collinear vertices)
+//   covers no pixel and is dropped at setup without a division; so is a triangle with no pixel
+//   centre inside the viewport. setupTriangle() then returns no descriptor and says why.
+//
+// Attribute planes (errata 4.1: the plane gradient with det as denominator)
+//   Vertex attribute k is quantised to a code a_i = round(value * 2^F_k) (F_k = attr_frac_bits).
+//   The gradients per pixel are the exact rationals
+//     dI/dx = 2^S ((a1-a0)(Y2-Y0) - (a2-a0)(Y1-Y0)) / det,
+//     dI/dy = 2^S ((X1-X0)(a2-a0) - (X2-X0)(a1-a0)) / det,
+//   rounded half-even to integer codes didx, didy, and iref is the exact plane at the reference
+//   pixel (xref, yref) rounded the same way. The plane every mode uses is then
+//     I(px, py) = iref + didx (px - xref) + didy (py - yref)      (exact integer arithmetic)
+//   so stepping by didx along a span, by didy down rows, or jumping by a multiple (the lanes,
+//   the segments, the 4-way split) gives, at every pixel, exactly the value of evaluating this
+//   plane there: bit-identical, no drift, whatever the span width or triangle height.
+//   Against the exact plane of the vertex values the error at a pixel is at most
+//     0.5 * (1 + |px - xref| + |py - yref|) codes <= 0.5 * (1 + W + H) * 2^-F_k
+//   in the attribute's own units (each of the three rounded quantities errs by <= half a code).
+//   For it to stay below a quarter of an output LSB 2^-O_k anywhere in a W x H viewport:
+//     F_k >= O_k + 1 + ceil(log2(1 + W + H)).
+//   512 x 512, colour out as integer codes (O = 0): F = 12 (bound 0.125 LSB); depth out with
+//   24 fraction bits: F = 36. defaultAttrFracBits() applies this rule.
+//   Only the values at covered pixels must fit AttrBits: the unit computes modulo 2^AttrBits,
+//   so wrapped gradients and intermediate sums still give the exact value where it fits.
+//   Setup checks the covered values' bound and reports an attribute that cannot fit.
+#pragma once
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "raster/span_unit.h"
+
+namespace shd {
+
+struct RasterConfig {
+  int width = 512, height = 512;
+  int subpixel_bits = 4;
+  std::vector<int> attr_frac_bits;  // per attribute; empty: defaultAttrFracBits
+  SpanParams unit;
+
+  void validate() const;  // std::invalid_argument naming the field
+  int attrFracBits(int k) const;
+};
+
+// F_k for output fraction bits out_frac (see the header comment).
+int defaultAttrFracBits(int width, int height, int out_frac);
+// Colour channels (attributes 0..2, integer output codes) and depth (attribute 3, 24 output
+// fraction bits); further attributes as colour.
+std::vector<int> defaultAttrFracBitsFor(int width, int height, int num_attr);
+
+struct SetupVertex {
+  double x = 0, y = 0;        // pixels, y down
+  std::vector<double> attr;   // NumAttr values in the attribute's units
+};
+
+// The fixed-point triangle after snapping: kept for references and diagnostics.
+struct SnappedTriangle {
+  std::array<int64_t, 3> X{}, Y{};                 // subpixel units, det > 0 order
+  std::vector<std::array<int64_t, 3>> a;           // attribute codes per attribute
+  bool swapped = false;                            // vertices 1 and 2 were swapped
+  int64_t det = 0;
+};
+
+struct EdgeFunction {
+  int64_t A = 0, B = 0, C = 0;  // C includes the top-left bias; inside iff A px + B py + C >= 0
+  bool topLeft = false;
+  int64_t eval(int64_t px, int64_t py) const { return A * px + B * py + C; }
+};
+
+struct AttributePlane {
+  int64_t xref = 0, yref = 0;
+  std::vector<int64_t> iref, didx, didy;  // codes (not wrapped)
+  int64_t at(int k, int64_t px, int64_t py) const {
+    const size_t i = static_cast<size_t>(k);
+    return iref[i] + didx[i] * (px - xref) + didy[i] * (py - yref);
+  }
+};
+
+struct SetupResult {
+  std::optional<SpanDesc> desc;  // empty: nothing to draw, see `dropped`
+  std::string dropped;           // "zero area", "outside the viewport"
+  SnappedTriangle tri;
+  std::array<EdgeFunction, 3> edges;  // of the whole triangle, screen pixel coordinates
+  AttributePlane plane;               // screen pixel coordinates
+};
+
+// std::invalid_argument (a clear message naming the vertex or attribute) for NaN/infinite
+// coordinates, vertices outside the guard band, or attributes that cannot fit AttrBits.
+SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg);
+
+// The reference the span unit is tested against: every pixel of the viewport whose centre
+// passes the three biased edge functions (direct evaluation, no DDA), with the plane's value,
+// in row-major order.
+std::vector<SpanFragment> rasterizeReference(const SetupResult& s, const RasterConfig& cfg);
+
+// The exact (rational) plane of the snapped vertex codes at a pixel centre, in codes.
+double exactPlane(const SetupResult& s, const RasterConfig& cfg, int k, int64_t px, int64_t py);
+
+}  // namespace shd

@@ -1,0 +1,206 @@
+// The span unit (paper 4.1-4.2): fragments of a triangle along raster lines, with the constant
+// attribute increment dI/dx, in lanes. SpanUnitModel is the bit-exact, cycle-accurate twin of
+// rtl/shd_span_unit.v; SpanDesc is the triangle descriptor that triangle setup
+// (raster/setup.h) produces and both consume.
+//
+// ---------------------------------------------------------------------------------------------
+// Frames and lanes
+//   The unit walks a *walker frame*: rows w (integers) and columns x (integers), signed.
+//   It holds NumTri *lane-triangles*, each a triangle given in the walker frame by up to three
+//   edges in solved (DDA) form, with its own row range and clip box, and an output map from the
+//   walker frame to screen pixels. Each lane-triangle drives LanesPerTri lanes.
+//     serial      NumTri 1, LanesPerTri 1
+//     evenodd     NumTri 1, LanesPerTri 2, AlignLanes 1: lane i takes the pixels x = i (mod 2),
+//                 as a framebuffer interleaved in two banks by x parity would
+//     seg2/4/8    NumTri 1, LanesPerTri 2^k, AlignLanes 0: lane i takes x = xs + i + t*2^k of a
+//                 span starting at xs (segments of the span, the last one masked)
+//     sierpinski  NumTri 4, LanesPerTri 1: the triangle split at its edge midpoints; the walker
+//                 frame is the corner sub-triangle at vertex 0; sub-triangles 1 and 2 are
+//                 translated copies (integer pixel offset, rounded), sub-triangle 3 (the middle
+//                 one) is point-reflected, so its pixels are walked in the opposite direction.
+//                 Each lane-triangle carries its own exact edges, so when an edge delta is odd
+//                 (the paper's "cut points") every lane still covers exactly its own pixels.
+//   Every lane reads the same walker attribute plane: I_w(x, w) = iref + didx*(x - xref)
+//   + didy*(w - row_first), exact integer (two's complement) arithmetic on attribute codes. A
+//   lane's fragment at walker (x, w) has
+//       flip = 0:  pixel (x + ox, w + oy),  attribute I_w(x, w) + aoff
+//       flip = 1:  pixel (ox - x, oy - w),  attribute aoff - I_w(x, w)
+//   Because all of it is exact integer arithmetic on one plane, every mode produces, pixel by
+//   pixel, the code the plane equation gives there: bit-identical across modes by construction
+//   (and test_span_unit checks it).
+//
+// Edges in solved form (one DDA per edge)
+//   A lane-triangle's edge is a linear function E = A x + B w + C' (C' includes the top-left
+//   bias, raster/setup.h) and the pixel (x, w) is inside the edge iff E >= 0. With D = |A| > 0
+//   and N = -(B w + C'):
+//     left edge  (A > 0):  x >= N/D,   i.e. x >= ceil(N/D)
+//     right edge (A < 0):  x <= -N/D,  i.e. x <= floor(-N/D) = -ceil(N/D)
+//   so every edge keeps q = ceil(N/D) and r = q*D - N in [0, D), and the bound is q (left) or
+//   -q (right). From row w to w+1, N grows by -B = k*D + m with 0 <= m < D:
+//       r' = r - m;  if r' < 0 { r' += D; q' = q + k + 1 } else { q' = q + k }
+//   exactly (no division per row). An edge bounds the span only in its active rows
+//   [row_first, row_last] (the rows whose pixel centre lies within the edge's vertical extent);
+//   a lane-triangle's horizontal edge has no DDA: setup folds it into the lane-triangle's row
+//   range. Unused edge slots have row_first > row_last.
+//
+// ---------------------------------------------------------------------------------------------
+// Cycle behaviour (identical in the RTL). One clock; synchronous state, reset to IDLE.
+//   Outputs are functions of the registers only (valid/ready without combinational paths from
+//   inputs to outputs):
+//     desc_ready = (state == IDLE)
+//     in SPAN, for lane-triangle j and lane i (lane index j*LanesPerTri + i), at x = xg + i:
+//       lane_valid = ne_j && lo_j <= x && x <= hi_j
+//       fragment: pixel and attribute by the map above, attribute = map(icur + i*didx)
+//     out_valid = OR of lane_valid (0 outside SPAN); tag = the descriptor's tag
+//   At the rising edge:
+//     IDLE: if desc_valid: latch the descriptor; w <- row_first; every edge (q, r) <- (q0, r0);
+//           irow <- iref; state <- ROW.
+//     ROW:  for each lane-triangle j:
+//             in_j = row_first_j <= w <= row_last_j
+//             lo_j = max(clip_x0_j, q_e of the left edges e active at w)
+//             hi_j = min(clip_x1_j, -q_e of the right edges e active at w)
+//             ne_j = in_j && lo_j <= hi_j                       (latched with lo_j, hi_j)
+//           if some ne_j:  xs = min of lo_j, xe = max of hi_j over the ne_j (xe latched);
+//                          xg <- AlignLanes ? xs - (xs mod LanesPerTri) : xs;
+//                          icur <- irow + didx*(xg - xref);  wspan <- w;  state <- SPAN
+//           else:          state <- (w == row_last) ? IDLE : ROW
+//           in both cases: every edge active at w with w < its row_last steps its DDA;
+//                          irow <- irow + didy;  w <- w + 1
+//     SPAN: if !out_valid || out_ready:
+//             if xg + LanesPerTri > xe: state <- (wspan == row_last) ? IDLE : ROW
+//             else:                     xg <- xg + LanesPerTri; icur <- icur + LanesPerTri*didx
+//   Cycles per triangle without stalls: 1 (IDLE, accepting) + sum over walker rows of
+//   (1 + the SPAN cycles of the row), SPAN cycles = floor((xe - xg0)/LanesPerTri) + 1.
+//   Register widths: w, q, xg, xe, lo, hi: CoordBits signed; r, D, m: RemBits unsigned;
+//   attributes: AttrBits signed, wrapping (two's complement) like the RTL. Setup guarantees that
+//   every value a valid lane shows fits, so wrapping only ever touches masked lanes.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace shd {
+
+enum class SpanMode { Serial, EvenOdd, Seg2, Seg4, Seg8, Sierpinski };
+const char* toString(SpanMode m);        // "serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"
+SpanMode parseSpanMode(const std::string& s);  // std::invalid_argument naming the choices
+std::vector<SpanMode> allSpanModes();
+
+// Parameters of shd_span_unit, named as in the Verilog.
+struct SpanParams {
+  int NumTri = 1;       // lane-triangles: 1, or 4 (sierpinski)
+  int LanesPerTri = 1;  // 1, 2, 4 or 8
+  int AlignLanes = 0;   // 1: lane i takes x = i (mod LanesPerTri)
+  int NumAttr = 4;      // attributes per fragment
+  int AttrBits = 40;    // signed attribute codes
+  int CoordBits = 16;   // signed walker-frame coordinates (rows, columns, DDA quotients, k)
+  int RemBits = 27;     // unsigned DDA divisor, remainder and m
+  int PixBits = 12;     // unsigned screen pixel coordinates on the fragment ports
+  int TagBits = 32;     // triangle tag carried to the fragments
+
+  static SpanParams forMode(SpanMode m);  // the defaults above with the mode's lane layout
+  SpanMode mode() const;                  // std::invalid_argument for a layout no mode has
+  int lanes() const { return NumTri * LanesPerTri; }
+  void validate() const;  // std::invalid_argument naming the parameter
+};
+
+struct SpanEdge {
+  int32_t row_first = 1, row_last = 0;  // active walker rows; row_first > row_last: unused slot
+  bool right = false;                   // bound is -q (right) or q (left)
+  int32_t q = 0;                        // at row_first
+  int64_t r = 0;                        // at row_first, 0 <= r < div
+  int64_t div = 1;                      // D = |A| > 0
+  int32_t k = 0;                        // per row: -B = k*D + m
+  int64_t m = 0;                        // 0 <= m < D
+};
+
+struct SpanLaneTri {
+  int32_t row_first = 1, row_last = 0;  // walker rows (scissored); empty if first > last
+  int32_t clip_x0 = 0, clip_x1 = -1;    // walker columns whose pixels lie in the viewport
+  SpanEdge edge[3];
+  bool flip = false;
+  int32_t ox = 0, oy = 0;
+  std::vector<int64_t> aoff;  // NumAttr
+};
+
+struct SpanDesc {
+  uint32_t tag = 0;
+  int32_t row_first = 0, row_last = -1;  // walker rows: the union of the lane-triangles' rows
+  int32_t xref = 0;                      // iref is the plane at (xref, row_first)
+  std::vector<int64_t> iref, didx, didy;  // NumAttr each
+  std::vector<SpanLaneTri> tri;           // NumTri
+};
+
+struct SpanFragment {
+  uint32_t tag = 0;
+  int32_t x = 0, y = 0;
+  std::vector<int64_t> attr;
+};
+
+struct SpanLaneOut {
+  bool valid = false;
+  int32_t x = 0, y = 0;
+  std::vector<int64_t> attr;
+};
+
+struct SpanIn {
+  bool desc_valid = false;
+  const SpanDesc* desc = nullptr;  // read when desc_valid
+  bool out_ready = true;
+};
+
+struct SpanOut {
+  bool desc_ready = false;
+  bool out_valid = false;
+  uint32_t tag = 0;
+  std::vector<SpanLaneOut> lane;  // lanes(); data meaningful where valid
+};
+
+class SpanUnitModel {
+ public:
+  explicit SpanUnitModel(SpanParams p);
+  const SpanParams& params() const { return p_; }
+
+  void reset();
+  // The outputs during this cycle (functions of the registers), then the rising edge with
+  // the inputs `in`. Returns the outputs seen before the edge.
+  SpanOut tick(const SpanIn& in);
+  uint64_t cycle() const { return cycle_; }
+  bool idle() const { return state_ == State::Idle; }
+  // Cycles spent in ROW and in SPAN since reset (for utilisation figures).
+  uint64_t rowCycles() const { return row_cycles_; }
+  uint64_t spanCycles() const { return span_cycles_; }
+
+ private:
+  enum class State { Idle, Row, Span };
+  struct EdgeState {
+    int64_t q = 0, r = 0;
+  };
+  SpanOut outputs() const;
+  int64_t wrapAttr(__int128 v) const;
+  int64_t wrapCoord(int64_t v) const;
+
+  SpanParams p_;
+  State state_ = State::Idle;
+  SpanDesc d_;
+  int64_t w_ = 0, wspan_ = 0, xg_ = 0, xe_ = 0;
+  std::vector<EdgeState> e_;         // NumTri*3
+  std::vector<int64_t> irow_, icur_;  // NumAttr
+  std::vector<int64_t> lo_, hi_;      // NumTri
+  std::vector<bool> ne_;
+  uint64_t cycle_ = 0, row_cycles_ = 0, span_cycles_ = 0;
+};
+
+// Runs one descriptor through the model with out_ready always 1, from IDLE to IDLE: the
+// fragments in output order and the cycles spent (including the accepting IDLE cycle).
+struct SpanRun {
+  std::vector<SpanFragment> fragments;
+  uint64_t cycles = 0;
+  uint64_t valid_lanes = 0;  // sum over SPAN cycles of the valid lanes (= fragments)
+  uint64_t span_cycles = 0;  // SPAN cycles
+  uint64_t row_cycles = 0;   // ROW cycles
+};
+SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d);
+
+}  // namespace shd
