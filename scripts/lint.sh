@@ -3,9 +3,12 @@
 # compile under Icarus `iverilog -g2012`). Checks, one output line each:
 #   verilator  <file>    every rtl/*.v on its own, top = the file's name, default parameters
 #                        (submodules are found with -y rtl)
-#   verilator  <config>  shd_spec_unit with the "rtl" parameters of vectors/config/spec_<config>.json
-#                        (-G<Name>=<value>)
-#   iverilog   <config>  iverilog -g2012 -Wall compile of the same (-Pshd_spec_unit.<Name>=<value>)
+#   verilator  <top> [<config>]
+#                        the unit with the "rtl" parameters of a configuration (-G<Name>=<value>):
+#                        shd_spec_unit for every vectors/config/spec_<config>.json,
+#                        shd_span_unit for every vectors/config/span_<config>.json
+#   iverilog   <top> [<config>]
+#                        iverilog -g2012 -Wall compile of the same (-P<top>.<Name>=<value>)
 # Any warning or error fails the check: Icarus exits 0 on warnings (an unknown -P parameter, an
 # out-of-range part select), so any output at all counts as a failure. Lint waivers, if the
 # project adds them, are Verilator configuration files rtl/*.vlt and are passed to every
@@ -17,7 +20,6 @@ set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 RTL=$ROOT/rtl
-TOP=shd_spec_unit
 verbose=0
 case ${1:-} in
   -v) verbose=1 ;;
@@ -32,10 +34,16 @@ done
 shopt -s nullglob
 rtl_files=("$RTL"/*.v)
 waivers=("$RTL"/*.vlt)
-configs=("$ROOT"/vectors/config/spec_*.json)
+spec_configs=("$ROOT"/vectors/config/spec_*.json)
+span_configs=("$ROOT"/vectors/config/span_*.json)
 shopt -u nullglob
 ((${#rtl_files[@]} > 0)) || { echo "lint.sh: error: no rtl/*.v" >&2; exit 2; }
-((${#configs[@]} > 0)) || { echo "lint.sh: error: no vectors/config/spec_*.json" >&2; exit 2; }
+((${#spec_configs[@]} > 0)) || { echo "lint.sh: error: no vectors/config/spec_*.json" >&2; exit 2; }
+((${#span_configs[@]} > 0)) || { echo "lint.sh: error: no vectors/config/span_*.json" >&2; exit 2; }
+# "<top> <config file>" per configuration: the file name's prefix names the unit.
+configs=()
+for cfg in "${spec_configs[@]}"; do configs+=("shd_spec_unit $cfg"); done
+for cfg in "${span_configs[@]}"; do configs+=("shd_span_unit $cfg"); done
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -65,9 +73,11 @@ for f in "${rtl_files[@]}"; do
   run_check "verilator  $m.v" verilator_lint --top-module "$m" "$f"
 done
 
-for cfg in "${configs[@]}"; do
+for entry in "${configs[@]}"; do
+  top=${entry%% *}
+  cfg=${entry#* }
   name=$(basename "$cfg" .json)
-  name=${name#spec_}
+  name=${name#*_}
   # One "Name=Value" per line from the configuration's "rtl" object, integers only.
   if ! params=$(python3 - "$cfg" 2>"$tmp/out" <<'EOF'
 import json, re, sys
@@ -83,7 +93,7 @@ for k, v in rtl.items():
     print(f"{k}={v}")
 EOF
   ); then
-    printf 'FAIL  config     %s\n' "$name"
+    printf 'FAIL  config     %s\n' "$top [$name]"
     sed 's/^/      /' "$tmp/out"
     failures=$((failures + 1))
     continue
@@ -92,11 +102,11 @@ EOF
   pargs=()
   while IFS= read -r kv; do
     gargs+=("-G$kv")
-    pargs+=("-P$TOP.$kv")
+    pargs+=("-P$top.$kv")
   done <<<"$params"
-  run_check "verilator  $TOP [$name]" verilator_lint --top-module "$TOP" "${gargs[@]}" "$RTL/$TOP.v"
-  run_check "iverilog   $TOP [$name]" \
-    iverilog -g2012 -Wall -s "$TOP" "${pargs[@]}" -o "$tmp/$name.vvp" "${rtl_files[@]}"
+  run_check "verilator  $top [$name]" verilator_lint --top-module "$top" "${gargs[@]}" "$RTL/$top.v"
+  run_check "iverilog   $top [$name]" \
+    iverilog -g2012 -Wall -s "$top" "${pargs[@]}" -o "$tmp/$top.$name.vvp" "${rtl_files[@]}"
 done
 
 if ((failures > 0)); then

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# synth.sh: synthesise one specular-unit configuration with yosys for iCE40 and/or Xilinx 7-series
-# and report its area.
+# synth.sh: synthesise one specular-unit (or span-unit) configuration with yosys for iCE40 and/or
+# Xilinx 7-series and report its area.
 #
-# Usage: scripts/synth.sh [--config vectors/config/spec_default.json]
-#                         [--prom vectors/prom/spec_default.hex]
-#                         [--out out/synth/default] [--target ice40|xc7|both] [--check]
+# Usage: scripts/synth.sh [--top shd_spec_unit|shd_span_unit]
+#          [--config vectors/config/spec_default.json] [--prom vectors/prom/spec_default.hex]
+#          [--out out/synth/default] [--target ice40|xc7|both] [--check]
 #
-# --prom and --out default to vectors/prom/<config file name>.hex and out/synth/<name>.
+# --top defaults to shd_spec_unit; everything below is about it except where "--top shd_span_unit"
+# says otherwise. --prom and --out default to vectors/prom/<config file name>.hex and
+# out/synth/<name> (<name>: the file name without "spec_": out/synth/span_serial for a span unit).
 # The "rtl" object of the configuration becomes one `chparam -set Name Value ... shd_spec_unit`
 # (one command: separate chparams elaborate the module once per parameter, with old and new values
 # mixed, and yosys warns about out-of-range selects in those intermediate modules); the PROM
@@ -58,12 +60,23 @@
 #   warnings  yosys printed no warning except the known harmless ones in KNOWN_WARNINGS below
 #             (multiple drivers, a memory turned into registers, a bad $readmemh are caught).
 #
+# --top shd_span_unit: the span unit (rtl/shd_span_unit.v) with the "rtl" object of a
+# vectors/config/span_<mode>.json (--config defaults to span_serial.json); no PROM (--prom is an
+# error), summary.json has no "prom_file"/"prom". Its --check has these checks instead of rom_bram:
+#   dsps      The only multiplier is the row start icur = irow + didx*(xg - xref), one per
+#             attribute: AttrBits x (CoordBits+1) signed, of which the low AttrBits are used
+#             (the plane wraps at AttrBits). The DSP count equals NumAttr times its mul2dsp.v
+#             tiling as above. Fails when the lanes' i*didx (constant multiples, built from
+#             shifts and adds) or the LanesPerTri*didx step turn into multipliers, or the row
+#             multiply stays in LUTs.
+#   latches   proc_dlatch inferred no latch (the comb blocks assign every output on every path).
+#   no_mem    no $mem cell, block RAM or distributed RAM: the unit is registers and logic only.
+#   warnings  as above.
+#
 # Exit status: 0 success, 1 a failed check, 2 a usage or input error, 3 yosys failed.
 set -euo pipefail
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-RTL_FILES=("$ROOT/rtl/shd_spec_unit.v" "$ROOT/rtl/shd_coef_rom.v" "$ROOT/rtl/shd_pipe_reg.v")
-TOP=shd_spec_unit
 
 usage() {
   sed -n '5,7p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
@@ -77,13 +90,15 @@ plain_path() {
   [[ $2 =~ ^[^[:space:]\"\\\;]+$ ]] || die "$1 path '$2' must not contain whitespace, quotes, backslashes or ';'"
 }
 
-config=$ROOT/vectors/config/spec_default.json
+TOP=shd_spec_unit
+config=""
 prom=""
 out=""
 target=both
 check=0
 while (($# > 0)); do
   case $1 in
+    --top) (($# >= 2)) || die "$1 needs a value"; TOP=$2; shift 2 ;;
     --config) (($# >= 2)) || die "$1 needs a value"; config=$2; shift 2 ;;
     --prom) (($# >= 2)) || die "$1 needs a value"; prom=$2; shift 2 ;;
     --out) (($# >= 2)) || die "$1 needs a value"; out=$2; shift 2 ;;
@@ -101,17 +116,32 @@ case $target in
   *) die "--target must be ice40, xc7 or both, not '$target'" ;;
 esac
 
+case $TOP in
+  shd_spec_unit)
+    RTL_FILES=("$ROOT/rtl/shd_spec_unit.v" "$ROOT/rtl/shd_coef_rom.v" "$ROOT/rtl/shd_pipe_reg.v")
+    [[ -n $config ]] || config=$ROOT/vectors/config/spec_default.json
+    ;;
+  shd_span_unit)
+    RTL_FILES=("$ROOT/rtl/shd_span_unit.v")
+    [[ -n $config ]] || config=$ROOT/vectors/config/span_serial.json
+    [[ -z $prom ]] || die "--prom applies to shd_spec_unit only"
+    ;;
+  *) die "--top must be shd_spec_unit or shd_span_unit, not '$TOP'" ;;
+esac
+
 [[ -f $config ]] || die "configuration file '$config' not found"
 config=$(realpath "$config")
 cfg_base=$(basename "$config" .json)
-[[ -n $prom ]] || prom=$ROOT/vectors/prom/$cfg_base.hex
 [[ -n $out ]] || out=$ROOT/out/synth/${cfg_base#spec_}
-[[ -f $prom ]] || die "PROM file '$prom' not found (make it with 'shadesim prom', or pass --prom)"
-prom=$(realpath "$prom")
+if [[ $TOP == shd_spec_unit ]]; then
+  [[ -n $prom ]] || prom=$ROOT/vectors/prom/$cfg_base.hex
+  [[ -f $prom ]] || die "PROM file '$prom' not found (make it with 'shadesim prom', or pass --prom)"
+  prom=$(realpath "$prom")
+  plain_path PROM "$prom"
+fi
 command -v yosys >/dev/null || die "yosys not found (apt-get install yosys)"
 mkdir -p "$out"
 out=$(realpath "$out")
-plain_path PROM "$prom"
 plain_path output "$out"
 plain_path RTL "$ROOT"
 
@@ -124,7 +154,7 @@ def fail(msg):
     print(f"synth.sh: error: {msg}", file=sys.stderr)
     sys.exit(2)
 
-def load_config(path):
+def load_config(path, top):
     try:
         with open(path) as f:
             cfg = json.load(f)
@@ -136,8 +166,13 @@ def load_config(path):
     for name, value in rtl.items():
         if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or type(value) is not int:
             fail(f"{path}: rtl.{name} = {value!r} is not an integer parameter")
-    for name in ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
-                 "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"]:
+    required = {
+        "shd_spec_unit": ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
+                          "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"],
+        "shd_span_unit": ["NumTri", "LanesPerTri", "AlignLanes", "NumAttr", "AttrBits",
+                          "CoordBits", "RemBits", "PixBits", "TagBits"],
+    }[top]
+    for name in required:
         if name not in rtl:
             fail(f"{path}: rtl.{name} is missing")
     return cfg.get("name", os.path.basename(path)), rtl
@@ -170,20 +205,23 @@ def prom_geometry(path, p):
     varying = sum(1 for b in range(word_bits) if len({(v >> b) & 1 for v in vals}) > 1)
     return depth, word_bits, varying
 
-mode = sys.argv[1]
+mode, top = sys.argv[1], sys.argv[2]
 if mode == "params":
-    name, p = load_config(sys.argv[2])
-    prom_geometry(sys.argv[3], p)
+    name, p = load_config(sys.argv[3], top)
+    if top == "shd_spec_unit":
+        prom_geometry(sys.argv[4], p)
     print(name)
     print(" ".join(f"-set {k} {v}" for k, v in p.items()))
     sys.exit(0)
 
 # ---------------------------------------------------------------- mode "summary"
-config_file, prom_file, out, check, yosys_version = sys.argv[2:7]
+config_file, prom_file, out, check, yosys_version = sys.argv[3:8]
 check = check == "1"
-walls = dict(w.split("=", 1) for w in sys.argv[7:])
-name, p = load_config(config_file)
-depth, word_bits, varying = prom_geometry(prom_file, p)
+walls = dict(w.split("=", 1) for w in sys.argv[8:])
+name, p = load_config(config_file, top)
+span = top == "shd_span_unit"
+if not span:
+    depth, word_bits, varying = prom_geometry(prom_file, p)
 
 # Warnings seen in clean runs and known to be harmless.
 KNOWN_WARNINGS = [
@@ -226,6 +264,10 @@ def tiles(t, aw, bw, asg, bsg, yw, cell="$mul"):
 
 def multipliers():
     """(name, a bits, b bits, a signed, b signed, product bits used) per multiplier."""
+    if span:
+        # icur = irow + didx*(xg - xref): AttrBits x (CoordBits+1) signed, low AttrBits used.
+        return [(f"row start didx{a}*(xg-xref)", p["AttrBits"], p["CoordBits"] + 1, True, True,
+                 p["AttrBits"]) for a in range(p["NumAttr"])]
     wc = p["CosFracBits"]; cw = wc + 1
     kw = p["CoefIntBits"] + p["CoefFracBits"]
     dtw = p["DiffFracBits"] - 1
@@ -275,9 +317,13 @@ def classify(tgt, cells):
     r["cells_total"] = sum(cells.values())
     return r
 
-summary = dict(config=name, config_file=config_file, prom_file=prom_file, yosys=yosys_version,
-               rtl=p, prom=dict(depth=depth, word_bits=word_bits, varying_bits=varying),
-               targets={})
+if span:
+    summary = dict(config=name, config_file=config_file, top=top, yosys=yosys_version, rtl=p,
+                   targets={})
+else:
+    summary = dict(config=name, config_file=config_file, prom_file=prom_file, yosys=yosys_version,
+                   rtl=p, prom=dict(depth=depth, word_bits=word_bits, varying_bits=varying),
+                   targets={})
 failed = []
 for tgt, wall in walls.items():
     with open(os.path.join(out, f"{tgt}_stat.json")) as f:
@@ -289,32 +335,48 @@ for tgt, wall in walls.items():
     per_mul = {f"{m[0]} {m[1]}x{m[2]} {'signed' if m[3] else 'unsigned'}": tiles(TECH[tgt], *m[1:])
                for m in multipliers()}
     exp = dict(dsps=sum(per_mul.values()), dsps_per_multiplier=per_mul)
-    if tgt == "ice40":
-        exp["brams"] = ice40_brams(depth, varying)
-        rom_ok = r["brams"] == exp["brams"]
-    else:
-        exp["bram_kbits"] = xc7_bram_kbits(depth, varying)
-        rom_ok = r["bram_kbits"] == exp["bram_kbits"]
     leftover_mem = count(cells, r"\$mem\w*")
-    rom_ok = rom_ok and leftover_mem == 0 and r["distributed_ram"] == 0
-
     with open(os.path.join(out, f"{tgt}.log")) as f:
         log = f.read().splitlines()
     warns = [l for l in log if re.search(r"warning", l, re.I) and not l.startswith("Warnings:")
              and not any(re.search(k, l) for k in KNOWN_WARNINGS)]
-    checks = dict(rom_bram=rom_ok, dsps=r["dsps"] == exp["dsps"], warnings=not warns)
-    r.update(expected=exp, checks=checks, unexpected_warnings=warns[:20])
-    summary["targets"][tgt] = r
 
-    bram = f"{r['brams']} ({r['bram_kbits']} kbit)"
-    print(f"  {name:8s} {tgt:5s} {r['wall_s']:5.1f} s  LUT {r['luts']:5d}  FF {r['ffs']:5d}  "
-          f"carry {r['carries']:4d}  DSP {r['dsps']:2d}  BRAM {bram:13s} cells {r['cells_total']:5d}"
-          f"  ROM in BRAM: {'yes' if rom_ok else 'NO'}")
-    if not checks["rom_bram"]:
-        want = f"{exp['brams']} SB_RAM40_4K" if tgt == "ice40" else f"{exp['bram_kbits']} kbit"
-        failed.append(f"{name}/{tgt} rom_bram: PROM {depth}x{varying} (of {word_bits} bits; "
-                      f"constant columns dropped) should take {want}; got {bram}, "
-                      f"{leftover_mem} $mem, {r['distributed_ram']} distributed RAM/ROM cells")
+    if span:
+        latches = [l for l in log if l.startswith("Latch inferred for signal")]
+        mem_ok = leftover_mem == 0 and r["brams"] == 0 and r["distributed_ram"] == 0
+        checks = dict(dsps=r["dsps"] == exp["dsps"], latches=not latches, no_mem=mem_ok,
+                      warnings=not warns)
+        r.update(expected=exp, checks=checks, unexpected_warnings=warns[:20])
+        summary["targets"][tgt] = r
+        print(f"  {name:10s} {tgt:5s} {r['wall_s']:5.1f} s  LUT {r['luts']:5d}  FF {r['ffs']:5d}  "
+              f"carry {r['carries']:4d}  DSP {r['dsps']:2d}  cells {r['cells_total']:5d}  "
+              f"latches {len(latches)}")
+        if not checks["latches"]:
+            failed.append(f"{name}/{tgt} latches: " + "; ".join(latches[:5]))
+        if not checks["no_mem"]:
+            failed.append(f"{name}/{tgt} no_mem: {leftover_mem} $mem, {r['brams']} block RAM, "
+                          f"{r['distributed_ram']} distributed RAM/ROM cells (expected none)")
+    else:
+        if tgt == "ice40":
+            exp["brams"] = ice40_brams(depth, varying)
+            rom_ok = r["brams"] == exp["brams"]
+        else:
+            exp["bram_kbits"] = xc7_bram_kbits(depth, varying)
+            rom_ok = r["bram_kbits"] == exp["bram_kbits"]
+        rom_ok = rom_ok and leftover_mem == 0 and r["distributed_ram"] == 0
+        checks = dict(rom_bram=rom_ok, dsps=r["dsps"] == exp["dsps"], warnings=not warns)
+        r.update(expected=exp, checks=checks, unexpected_warnings=warns[:20])
+        summary["targets"][tgt] = r
+
+        bram = f"{r['brams']} ({r['bram_kbits']} kbit)"
+        print(f"  {name:8s} {tgt:5s} {r['wall_s']:5.1f} s  LUT {r['luts']:5d}  FF {r['ffs']:5d}  "
+              f"carry {r['carries']:4d}  DSP {r['dsps']:2d}  BRAM {bram:13s} "
+              f"cells {r['cells_total']:5d}  ROM in BRAM: {'yes' if rom_ok else 'NO'}")
+        if not checks["rom_bram"]:
+            want = f"{exp['brams']} SB_RAM40_4K" if tgt == "ice40" else f"{exp['bram_kbits']} kbit"
+            failed.append(f"{name}/{tgt} rom_bram: PROM {depth}x{varying} (of {word_bits} bits; "
+                          f"constant columns dropped) should take {want}; got {bram}, "
+                          f"{leftover_mem} $mem, {r['distributed_ram']} distributed RAM/ROM cells")
     if not checks["dsps"]:
         failed.append(f"{name}/{tgt} dsps: {r['dsps']} DSPs, expected {exp['dsps']} = {per_mul}")
     if not checks["warnings"]:
@@ -333,10 +395,15 @@ for msg in failed:
 if check:
     if failed:
         sys.exit(1)
-    print("  checks passed: ROM in least block RAM, DSPs = multiplier tiling, no unexpected warnings")
+    if span:
+        print("  checks passed: DSPs = row-start multiplier tiling, no latches, no memories, "
+              "no unexpected warnings")
+    else:
+        print("  checks passed: ROM in least block RAM, DSPs = multiplier tiling, "
+              "no unexpected warnings")
 EOF
 
-params=$(python3 -c "$PY" params "$config" "$prom") || exit 2
+params=$(python3 -c "$PY" params "$TOP" "$config" "$prom") || exit 2
 cfg_name=$(head -n 1 <<<"$params")
 chparams=$(tail -n 1 <<<"$params")
 yosys_version=$(yosys -V)
@@ -351,8 +418,10 @@ run_yosys() {
   log=$out/$tgt.log
   stat=$out/${tgt}_stat.json
   err=$out/.$tgt.stderr
+  local rom=""
+  [[ $TOP != shd_spec_unit ]] || rom="-set RomFile \"$prom\""
   script="read_verilog -defer ${RTL_FILES[*]}
-chparam $chparams -set RomFile \"$prom\" $TOP
+chparam $chparams $rom $TOP
 hierarchy -check -top $TOP
 $synth
 tee -q -o $stat.tmp stat -json"
@@ -381,4 +450,4 @@ for tgt in "${targets[@]}"; do
   walls+=("$tgt=$wall_s")
 done
 
-python3 -c "$PY" summary "$config" "$prom" "$out" "$check" "$yosys_version" "${walls[@]}"
+python3 -c "$PY" summary "$TOP" "$config" "$prom" "$out" "$check" "$yosys_version" "${walls[@]}"

@@ -19,6 +19,10 @@
 #include "device/prom_io.h"
 #include "progress.h"
 #include "report/spec_error.h"
+#include "raster/desc_stream.h"
+#include "report/span_cycles.h"
+#include "scene/sphere.h"
+#include "span_cosim.h"
 #include "spec_cosim.h"
 
 namespace fs = std::filesystem;
@@ -164,13 +168,23 @@ struct PromCmd {
 // ---------------------------------------------------------------- cosim
 struct CosimCmd {
   TableOptions table;
-  std::string unit = "spec", prom, fail_dir = ".";
+  std::string unit = "spec", prom, fail_dir = ".", mode = "serial";
+  uint64_t triangles = 100000;
+  double ready_prob = 0.8;
   bool exhaustive = false, json = false, quiet = false;
   uint64_t vectors = 1'000'000, seed = 1;
   double gap = 0.2;
 
   void add(CLI::App& app) {
-    app.add_option("--unit", unit, "unit under test")->check(CLI::IsMember({"spec"}))->default_val("spec");
+    app.add_option("--unit", unit, "unit under test: spec (specular unit) or span (span unit)")
+        ->check(CLI::IsMember({"spec", "span"}))
+        ->default_val("spec");
+    app.add_option("--mode", mode, "span unit: serial | evenodd | seg2 | seg4 | seg8 | sierpinski")
+        ->check(CLI::IsMember({"serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"}));
+    app.add_option("--triangles", triangles, "span unit: seeded random triangles (raster/trigen.h classes)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--ready", ready_prob, "span unit: probability that the consumer is ready on a cycle")
+        ->check(CLI::Range(0.05, 1.0));
     table.add(app);
     app.add_option("--prom", prom, "PROM hex file the RTL loads (default: the table written to a temporary file); "
                                    "it must hold the table the options describe");
@@ -184,7 +198,55 @@ struct CosimCmd {
     app.add_flag("--quiet", quiet, "no progress on stderr");
   }
 
-  int run() {
+  int run() { return unit == "span" ? runSpan() : runSpec(); }
+
+  int runSpan() {
+    const SpanMode m = parseSpanMode(mode);
+    RasterConfig rc;
+    rc.unit = SpanParams::forMode(m);
+    DescriptorStream descs(seed, triangles, rc);
+    auto next = [&](SpanDesc& d) { return descs.next(d); };
+    Progress progress(fmt::format("cosim span/{}", mode), !quiet);
+    SpanCosimOptions o;
+    o.seed = seed;
+    o.ready_prob = ready_prob;
+    o.fail_dir = fs::absolute(fail_dir).string();
+    o.progress = [&](uint64_t) { progress.update(static_cast<double>(descs.generated()), static_cast<double>(triangles), "triangles"); };
+    const SpanCosimResult r = runSpanCosim(mode, next, o);
+    if (json) {
+      nlohmann::json j = {{"unit", "span"},
+                          {"mode", mode},
+                          {"seed", seed},
+                          {"triangles", r.triangles},
+                          {"generated", descs.generated()},
+                          {"dropped_at_setup", descs.dropped()},
+                          {"fragments", r.fragments},
+                          {"cycles", r.cycles},
+                          {"mismatches", r.mismatches},
+                          {"seconds", r.seconds},
+                          {"fragments_per_second", r.seconds > 0 ? r.fragments / r.seconds : 0.0}};
+      if (r.first)
+        j["first_mismatch"] = {{"cycle", r.first->cycle}, {"triangle", r.first->tag}, {"what", r.first->what},
+                               {"fst", r.fst_path}, {"case", r.case_path}};
+      std::cout << j.dump(2) << "\n";
+    } else {
+      std::printf("cosim span/%s seed %llu: %llu triangles drawn (%llu generated, %llu dropped by setup), %llu fragments, "
+                  "%llu cycles, %llu mismatches, %.2f s (%.1f M fragments/s)\n",
+                  mode.c_str(), static_cast<unsigned long long>(seed), static_cast<unsigned long long>(r.triangles),
+                  static_cast<unsigned long long>(descs.generated()), static_cast<unsigned long long>(descs.dropped()),
+                  static_cast<unsigned long long>(r.fragments), static_cast<unsigned long long>(r.cycles),
+                  static_cast<unsigned long long>(r.mismatches), r.seconds, r.seconds > 0 ? r.fragments / r.seconds / 1e6 : 0.0);
+    }
+    if (r.first) {
+      std::fprintf(stderr, "MISMATCH (first of %llu) cycle %llu, triangle %u: %s\nwaveform: %s\ncase:     %s\n",
+                   static_cast<unsigned long long>(r.mismatches), static_cast<unsigned long long>(r.first->cycle),
+                   r.first->tag, r.first->what.c_str(), r.fst_path.c_str(), r.case_path.c_str());
+      return 1;
+    }
+    return 0;
+  }
+
+  int runSpec() {
     SpecUnitConfig cfg;
     const PromTable t = table.build(cfg, false);
     // The RTL side is the configuration verilated into this binary: its parameters must be the
@@ -305,6 +367,64 @@ struct SpecErrorCmd {
   }
 };
 
+// ---------------------------------------------------------------- span-cycles
+struct SpanCyclesCmd {
+  uint64_t triangles = 20000, seed = 1;
+  std::vector<int> divider_latency{1, 4, 8, 16, 32};
+  int soft_repeats = 5;
+  bool json = false;
+  std::string json_out;
+
+  void add(CLI::App& app) {
+    app.add_option("--triangles", triangles, "triangles per size class (and for the mixed stream)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--seed", seed, "generator seed");
+    app.add_option("--divider-latency", divider_latency, "divider latencies (cycles) of the classical unit")
+        ->delimiter(',')
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--soft-repeats", soft_repeats, "repeats of the software timing (median)")->check(CLI::Range(1, 1000));
+    app.add_flag("--json", json, "print one JSON object instead of the tables");
+    app.add_option("--json-out", json_out, "also write the JSON object to this file");
+  }
+
+  int run() {
+    RasterConfig rc;
+    std::vector<TriangleSetCycles> sets;
+    auto classStream = [&](const char* name, int cls) {
+      TriGenOptions g;
+      if (cls >= 0) {
+        g.size_weight = {0, 0, 0, 0, 0};
+        g.size_weight[static_cast<size_t>(cls)] = 1;
+      }
+      TriangleGenerator gen(seed, g);
+      TriangleList list;
+      for (uint64_t i = 0; i < triangles; ++i) list.push_back(toSetupVertices(gen.next(), rc.unit.NumAttr));
+      std::fprintf(stderr, "span-cycles: %s (%zu triangles)\n", name, list.size());
+      sets.push_back(measureSpanCycles(name, list, rc, divider_latency, soft_repeats));
+    };
+    const char* names[] = {"pixel1", "small", "mesh 10-100px", "large", "screen"};
+    for (int cls = 0; cls < kNumSizeClasses; ++cls) classStream(names[cls], cls);
+    classStream("mixed", -1);
+    // The built-in sphere (DESIGN.md): idx3d SPHERE(1, 64) seen from (0, 0, -3), front faces;
+    // attributes: the normal mapped to colour, and depth.
+    TriangleList sphere;
+    for (const ScreenTriangle& t : projectFrontFaces(idx3dSphere(1, 64), Camera{})) {
+      std::array<SetupVertex, 3> v;
+      for (size_t i = 0; i < 3; ++i)
+        v[i] = {t.v[i].x, t.v[i].y, {127.5 * (t.v[i].n.x + 1), 127.5 * (t.v[i].n.y + 1), 127.5 * (t.v[i].n.z + 1), t.v[i].z / 4}};
+      sphere.push_back(v);
+    }
+    std::fprintf(stderr, "span-cycles: builtin:sphere (%zu front faces)\n", sphere.size());
+    sets.push_back(measureSpanCycles("builtin:sphere", sphere, rc, divider_latency, soft_repeats));
+    nlohmann::json j = {{"seed", seed}, {"triangles_per_class", triangles}, {"sets", nlohmann::json::array()}};
+    for (const auto& s : sets) j["sets"].push_back(toJson(s));
+    if (!json_out.empty()) writeFileAtomic(json_out, j.dump(2) + "\n");
+    if (json) std::cout << j.dump(2) << "\n";
+    else std::cout << renderSpanCyclesTable(sets);
+    return 0;
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -317,6 +437,9 @@ int main(int argc, char** argv) {
   CLI::App* prom_app = app.add_subcommand("prom", "write the coefficient PROM of the specular unit");
   CLI::App* cosim_app = app.add_subcommand("cosim", "run the verilated RTL against the golden model");
   CLI::App* err_app = app.add_subcommand("spec-error", "error report of the specular unit");
+  SpanCyclesCmd span_cycles;
+  CLI::App* cyc_app = app.add_subcommand("span-cycles", "cycles of the span unit per mode, and the paper's speed-up claims");
+  span_cycles.add(*cyc_app);
   prom.add(*prom_app);
   cosim.add(*cosim_app);
   spec_error.add(*err_app);
@@ -330,6 +453,7 @@ int main(int argc, char** argv) {
     if (cmd == prom_app) return prom.run(*prom_app);
     if (cmd == cosim_app) return cosim.run();
     if (cmd == err_app) return spec_error.run();
+    if (cmd == cyc_app) return span_cycles.run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shadesim %s: error: %s\n", cmd->get_name().c_str(), e.what());
     return 2;

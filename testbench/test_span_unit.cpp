@@ -3,7 +3,7 @@
 // bound, the cycle formula, and stalls.
 #include "raster/setup.h"
 #include "raster/span_unit.h"
-#include "raster/trigen.h"
+#include "raster/desc_stream.h"
 
 #include <gtest/gtest.h>
 
@@ -71,16 +71,6 @@ std::array<SetupVertex, 3> randomTriangle(std::mt19937_64& rng, int w, int h) {
   return v;
 }
 
-std::array<SetupVertex, 3> fromGen(const GenTriangle& t, int num_attr) {
-  std::array<SetupVertex, 3> v;
-  for (size_t i = 0; i < 3; ++i) {
-    v[i].x = t.v[i].x;
-    v[i].y = t.v[i].y;
-    v[i].attr.assign(t.v[i].attr.begin(), t.v[i].attr.begin() + num_attr);
-  }
-  return v;
-}
-
 std::string describe(const GenTriangle& t) {
   return fmt::format("triangle {} ({}) ({}, {}) ({}, {}) ({}, {})", t.id, t.kind(), t.v[0].x, t.v[0].y, t.v[1].x,
                      t.v[1].y, t.v[2].x, t.v[2].y);
@@ -101,7 +91,7 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
   long frags = 0;
   for (long n = 0; n < count; ++n) {
     const GenTriangle t = gen.next();
-    const auto v = fromGen(t, c.unit.NumAttr);
+    const auto v = toSetupVertices(t, c.unit.NumAttr);
     std::vector<SpanFragment> serial;
     for (size_t mi = 0; mi < units.size(); ++mi) {
       const SetupResult s = setupTriangle(v, t.id, cfgs[mi]);
@@ -283,7 +273,7 @@ TEST(SpanUnitModel, SerialEqualsDirectEvaluationOnGeneratorClasses) {
   std::map<std::string, long> seen;
   for (int n = 0; n < 100000; ++n) {
     const GenTriangle t = gen.next();
-    const SetupResult s = setupTriangle(fromGen(t, c.unit.NumAttr), t.id, c);
+    const SetupResult s = setupTriangle(toSetupVertices(t, c.unit.NumAttr), t.id, c);
     const auto ref = rasterizeReference(s, c);
     const auto got = s.desc ? sorted(runSpanUnit(unit, *s.desc).fragments) : std::vector<SpanFragment>{};
     ASSERT_EQ(got.size(), ref.size()) << describe(t);
@@ -324,7 +314,7 @@ TEST(SpanUnitModel, SharedEdgesOfMeshesDrawnExactlyOnce) {
                                                 : makeSharedEdgeMesh(rng, opt, 13 + trial, 9 + trial, mo);
       std::vector<int> hits(static_cast<size_t>(c.width) * c.height, 0);
       for (const GenTriangle& t : mesh) {
-        const SetupResult s = setupTriangle(fromGen(t, c.unit.NumAttr), t.id, c);
+        const SetupResult s = setupTriangle(toSetupVertices(t, c.unit.NumAttr), t.id, c);
         if (!s.desc) continue;
         for (const SpanFragment& f : runSpanUnit(unit, *s.desc).fragments)
           ++hits[static_cast<size_t>(f.y) * c.width + f.x];

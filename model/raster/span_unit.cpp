@@ -71,12 +71,14 @@ void SpanParams::validate() const {
 
 namespace {
 
-int64_t wrapTo(__int128 v, int bits) {
-  const unsigned __int128 mask = (static_cast<unsigned __int128>(1) << bits) - 1;
-  __int128 low = static_cast<__int128>(static_cast<unsigned __int128>(v) & mask);
-  if ((low >> (bits - 1)) != 0) low -= static_cast<__int128>(1) << bits;
-  return static_cast<int64_t>(low);
+// Two's complement wrap to `bits` (< 64) bits: the value mod 2^bits, sign-extended. The
+// callers form sums and products in uint64_t, which is exact mod 2^64 and so mod 2^bits.
+int64_t wrapTo(uint64_t v, int bits) {
+  const int sh = 64 - bits;
+  return static_cast<int64_t>(v << sh) >> sh;  // arithmetic shift: defined on GCC/Clang, C++20
 }
+
+uint64_t u(int64_t v) { return static_cast<uint64_t>(v); }
 
 }  // namespace
 
@@ -85,8 +87,8 @@ SpanUnitModel::SpanUnitModel(SpanParams p) : p_(p) {
   reset();
 }
 
-int64_t SpanUnitModel::wrapAttr(__int128 v) const { return wrapTo(v, p_.AttrBits); }
-int64_t SpanUnitModel::wrapCoord(int64_t v) const { return wrapTo(v, p_.CoordBits); }
+int64_t SpanUnitModel::wrapAttr(uint64_t v) const { return wrapTo(v, p_.AttrBits); }
+int64_t SpanUnitModel::wrapCoord(int64_t v) const { return wrapTo(u(v), p_.CoordBits); }
 
 void SpanUnitModel::reset() {
   state_ = State::Idle;
@@ -99,11 +101,13 @@ void SpanUnitModel::reset() {
   cycle_ = row_cycles_ = span_cycles_ = 0;
 }
 
-SpanOut SpanUnitModel::outputs() const {
-  SpanOut o;
+void SpanUnitModel::outputs(SpanOut& o) const {
   o.desc_ready = state_ == State::Idle;
+  o.out_valid = false;
+  o.tag = 0;
   o.lane.resize(static_cast<size_t>(p_.lanes()));
-  if (state_ != State::Span) return o;
+  for (SpanLaneOut& l : o.lane) l.valid = false;
+  if (state_ != State::Span) return;
   o.tag = d_.tag;
   const int L = p_.LanesPerTri;
   for (int j = 0; j < p_.NumTri; ++j) {
@@ -120,18 +124,22 @@ SpanOut SpanUnitModel::outputs() const {
       lane.attr.resize(static_cast<size_t>(p_.NumAttr));
       for (int a = 0; a < p_.NumAttr; ++a) {
         const size_t ai = static_cast<size_t>(a);
-        const int64_t v = wrapAttr(static_cast<__int128>(icur_[ai]) + static_cast<__int128>(i) * d_.didx[ai]);
-        lane.attr[ai] = t.flip ? wrapAttr(static_cast<__int128>(t.aoff[ai]) - v)
-                               : wrapAttr(static_cast<__int128>(v) + t.aoff[ai]);
+        const uint64_t v = u(icur_[ai]) + static_cast<uint64_t>(i) * u(d_.didx[ai]);
+        lane.attr[ai] = wrapAttr(t.flip ? u(t.aoff[ai]) - v : v + u(t.aoff[ai]));
       }
       o.out_valid = true;
     }
   }
-  return o;
 }
 
 SpanOut SpanUnitModel::tick(const SpanIn& in) {
-  const SpanOut out = outputs();
+  SpanOut out;
+  tick(in, out);
+  return out;
+}
+
+void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
+  outputs(out);
   const int L = p_.LanesPerTri;
   if (state_ == State::Row) ++row_cycles_;
   if (state_ == State::Span) ++span_cycles_;
@@ -141,6 +149,8 @@ SpanOut SpanUnitModel::tick(const SpanIn& in) {
         if (in.desc == nullptr || static_cast<int>(in.desc->tri.size()) != p_.NumTri ||
             static_cast<int>(in.desc->iref.size()) != p_.NumAttr)
           throw std::invalid_argument("span descriptor does not match the unit's NumTri/NumAttr");
+        if (in.desc->row_first > in.desc->row_last)  // the RTL would walk until w wraps
+          throw std::invalid_argument("span descriptor without rows: setup drops such triangles");
         d_ = *in.desc;
         w_ = d_.row_first;
         for (int j = 0; j < p_.NumTri; ++j)
@@ -181,7 +191,7 @@ SpanOut SpanUnitModel::tick(const SpanIn& in) {
         xg_ = p_.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
         for (int a = 0; a < p_.NumAttr; ++a) {
           const size_t ai = static_cast<size_t>(a);
-          icur_[ai] = wrapAttr(static_cast<__int128>(irow_[ai]) + static_cast<__int128>(d_.didx[ai]) * (xg_ - d_.xref));
+          icur_[ai] = wrapAttr(u(irow_[ai]) + u(d_.didx[ai]) * u(xg_ - d_.xref));
         }
         wspan_ = w_;
         state_ = State::Span;
@@ -205,7 +215,7 @@ SpanOut SpanUnitModel::tick(const SpanIn& in) {
         }
       for (int a = 0; a < p_.NumAttr; ++a) {
         const size_t ai = static_cast<size_t>(a);
-        irow_[ai] = wrapAttr(static_cast<__int128>(irow_[ai]) + d_.didy[ai]);
+        irow_[ai] = wrapAttr(u(irow_[ai]) + u(d_.didy[ai]));
       }
       w_ = wrapCoord(w_ + 1);
       break;
@@ -218,14 +228,13 @@ SpanOut SpanUnitModel::tick(const SpanIn& in) {
           xg_ += L;
           for (int a = 0; a < p_.NumAttr; ++a) {
             const size_t ai = static_cast<size_t>(a);
-            icur_[ai] = wrapAttr(static_cast<__int128>(icur_[ai]) + static_cast<__int128>(L) * d_.didx[ai]);
+            icur_[ai] = wrapAttr(u(icur_[ai]) + static_cast<uint64_t>(L) * u(d_.didx[ai]));
           }
         }
       }
       break;
   }
   ++cycle_;
-  return out;
 }
 
 SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d) {

@@ -126,7 +126,10 @@ struct SpanLaneTri {
 
 struct SpanDesc {
   uint32_t tag = 0;
-  int32_t row_first = 0, row_last = -1;  // walker rows: the union of the lane-triangles' rows
+  // Walker rows: the union of the lane-triangles' rows; never empty (row_first <= row_last):
+  // setup drops a triangle without rows, and the unit, which stops at w == row_last, would
+  // otherwise walk until w wraps.
+  int32_t row_first = 0, row_last = -1;
   int32_t xref = 0;                      // iref is the plane at (xref, row_first)
   std::vector<int64_t> iref, didx, didy;  // NumAttr each
   std::vector<SpanLaneTri> tri;           // NumTri
@@ -164,8 +167,10 @@ class SpanUnitModel {
 
   void reset();
   // The outputs during this cycle (functions of the registers), then the rising edge with
-  // the inputs `in`. Returns the outputs seen before the edge.
+  // the inputs `in`. Returns the outputs seen before the edge. The second form reuses `out`'s
+  // storage (the co-simulation's hot path).
   SpanOut tick(const SpanIn& in);
+  void tick(const SpanIn& in, SpanOut& out);
   uint64_t cycle() const { return cycle_; }
   bool idle() const { return state_ == State::Idle; }
   // Cycles spent in ROW and in SPAN since reset (for utilisation figures).
@@ -177,8 +182,8 @@ class SpanUnitModel {
   struct EdgeState {
     int64_t q = 0, r = 0;
   };
-  SpanOut outputs() const;
-  int64_t wrapAttr(__int128 v) const;
+  void outputs(SpanOut& o) const;
+  int64_t wrapAttr(uint64_t v) const;
   int64_t wrapCoord(int64_t v) const;
 
   SpanParams p_;

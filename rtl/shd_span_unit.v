@@ -1,0 +1,457 @@
+// shd_span_unit: fragments of a triangle along raster lines with the constant step dI/dx, in
+// lanes (paper 4.1-4.2; modes serial, even/odd, segments of 2^k lanes, 4-way Sierpinski split).
+// What:     walks the walker rows w of one descriptor. Per row each of NumTri lane-triangles j
+//           bounds it by its clip box and its active edges in solved (DDA) form (left edge
+//           x >= q, right edge x <= -q): [lo_j, hi_j], ne_j; the union [xs, xe] of the non-empty
+//           ones is then shown LanesPerTri columns per cycle. Lane l = j*LanesPerTri + i shows
+//           column x = xg + i, valid iff ne_j && lo_j <= x <= hi_j, its pixel and attribute
+//           mapped by j's (flip, ox, oy, aoff).
+// Why:      all lanes read one walker plane I = irow + didx*(x - xref): one multiply per
+//           attribute at a row start, then steps of LanesPerTri*didx, and lane i adds i*didx
+//           (shifts and adds, i < 8), so every mode gives at each pixel exactly the plane's value.
+//           Each edge is a DDA (q, r): no division and no multiply per row.
+// Latency:  IDLE -> ROW -> (SPAN ...) -> ROW ... -> IDLE. 1 cycle accepting a descriptor
+//           (desc_ready_o = IDLE), 1 ROW cycle per walker row, floor((xe - xg0)/LanesPerTri) + 1
+//           SPAN cycles per row with pixels, more only while out_ready_i stalls a valid output.
+//           Outputs are functions of registers only (no path from desc_valid_i, out_ready_i).
+// Formats:  w, q, k, xg, xe, lo, hi, clip, ox, oy, xref, row ranges: CoordBits signed.
+//           r, div, m: RemBits unsigned. Attributes: AttrBits signed, two's complement, wrapping.
+//           out_x_o, out_y_o: the low PixBits of the screen pixel.
+// Widths:   x = xg + i and xg + LanesPerTri: CoordBits+1 bits, no wrap, for the comparisons.
+//           The right-edge bound -q: CoordBits+1 bits, exact (-(-2^(C-1)) = 2^(C-1)); then
+//           hi = min(clip_x1, -q ...) lies in [min(clip_x1, -(2^(C-1)-1)), clip_x1] and lo =
+//           max(clip_x0, q ...) is one of its CoordBits operands: both fit CoordBits, the dropped
+//           MSBs are sign copies. xg - xref: CoordBits+1 bits signed, exact. icur <- irow +
+//           didx*(xg - xref): the low AttrBits of the exact product sum (signed AttrBits x
+//           (CoordBits+1) multiply). r - m: RemBits+1 bits signed, exact for r, m < 2^RemBits;
+//           when negative div is added back, and 0 <= r' < div < 2^RemBits drops a 0 MSB (setup
+//           guarantees 0 <= r, m < div). q + k (+ 1) and w + 1 wrap at CoordBits. In SPAN
+//           xg + LanesPerTri is only stored when <= xe, so it fits. Pixels: exact sums of
+//           max(CoordBits+2, PixBits+1) bits, the low PixBits kept.
+// Rounding: none: integer arithmetic, modulo 2^AttrBits for the attributes.
+// Choices where model/raster/span_unit.h leaves room (the model must make the same ones):
+//           - lo_q, hi_q, ne_q load in every ROW cycle; xg_q, xe_q, icur_q, wspan_q only in a
+//             ROW cycle that goes to SPAN (xg_q and icur_q also when SPAN advances in a row).
+//           - The descriptor registers (tag, row_last, xref, didx, didy, lane-triangles, edges)
+//             load only on accepting; out_tag_o shows that register in every state.
+//           - out_lane_valid_o and out_valid_o are 0 outside SPAN. out_x_o, out_y_o, out_attr_o
+//             are driven from the registers in every state and mean something only on a valid
+//             lane (data registers have no reset): compare them there only. Likewise out_tag_o
+//             only while out_valid_o.
+//           - An edge is active at w iff row_first_e <= w <= row_last_e (signed); it steps in a
+//             ROW cycle iff row_first_e <= w < row_last_e. Every slot's (q, r) loads from e_q_i,
+//             e_r_i on accepting, used or not.
+//           - The row loop ends only on w == row_last (a ROW cycle without pixels) or wspan ==
+//             row_last (the end of a span): a descriptor with row_first > row_last walks until w
+//             wraps around to row_last (up to 2^CoordBits rows). Setup must not send one.
+//           - Parameters are not checked: LanesPerTri must be 1, 2, 4 or 8 (lane i adds i*didx
+//             as at most three shifted copies of didx, i < 8).
+// Model:    model/raster/span_unit.h SpanUnitModel, bit-exact and cycle-accurate.
+module shd_span_unit #(
+  parameter integer NumTri      = 1,
+  parameter integer LanesPerTri = 1,
+  parameter integer AlignLanes  = 0,
+  parameter integer NumAttr     = 4,
+  parameter integer AttrBits    = 40,
+  parameter integer CoordBits   = 16,
+  parameter integer RemBits     = 27,
+  parameter integer PixBits     = 12,
+  parameter integer TagBits     = 32
+) (
+  input  wire                                  clk_i,
+  input  wire                                  rst_ni,
+
+  input  wire                                  desc_valid_i,
+  output wire                                  desc_ready_o,
+  input  wire [TagBits-1:0]                    desc_tag_i,
+  input  wire [CoordBits-1:0]                  desc_row_first_i,
+  input  wire [CoordBits-1:0]                  desc_row_last_i,
+  input  wire [CoordBits-1:0]                  desc_xref_i,
+  input  wire [NumAttr*AttrBits-1:0]           desc_iref_i,
+  input  wire [NumAttr*AttrBits-1:0]           desc_didx_i,
+  input  wire [NumAttr*AttrBits-1:0]           desc_didy_i,
+  input  wire [NumTri*CoordBits-1:0]           lt_row_first_i,
+  input  wire [NumTri*CoordBits-1:0]           lt_row_last_i,
+  input  wire [NumTri*CoordBits-1:0]           lt_clip_x0_i,
+  input  wire [NumTri*CoordBits-1:0]           lt_clip_x1_i,
+  input  wire [NumTri*CoordBits-1:0]           lt_ox_i,
+  input  wire [NumTri*CoordBits-1:0]           lt_oy_i,
+  input  wire [NumTri-1:0]                     lt_flip_i,
+  input  wire [NumTri*NumAttr*AttrBits-1:0]    lt_aoff_i,
+  input  wire [NumTri*3-1:0]                   e_right_i,
+  input  wire [NumTri*3*CoordBits-1:0]         e_row_first_i,
+  input  wire [NumTri*3*CoordBits-1:0]         e_row_last_i,
+  input  wire [NumTri*3*CoordBits-1:0]         e_q_i,
+  input  wire [NumTri*3*CoordBits-1:0]         e_k_i,
+  input  wire [NumTri*3*RemBits-1:0]           e_r_i,
+  input  wire [NumTri*3*RemBits-1:0]           e_div_i,
+  input  wire [NumTri*3*RemBits-1:0]           e_m_i,
+
+  output wire                                  out_valid_o,
+  input  wire                                  out_ready_i,
+  output wire [TagBits-1:0]                    out_tag_o,
+  output wire [NumTri*LanesPerTri-1:0]         out_lane_valid_o,
+  output wire [NumTri*LanesPerTri*PixBits-1:0] out_x_o,
+  output wire [NumTri*LanesPerTri*PixBits-1:0] out_y_o,
+  output wire [NumTri*LanesPerTri*NumAttr*AttrBits-1:0] out_attr_o
+);
+
+  localparam integer C     = CoordBits;
+  localparam integer R     = RemBits;
+  localparam integer A     = AttrBits;
+  localparam integer L     = LanesPerTri;
+  localparam integer NE    = NumTri * 3;                 // edge slots, e = j*3 + s
+  localparam integer AV    = NumAttr * AttrBits;         // one attribute vector
+  localparam integer LOG2L = (L >= 8) ? 3 : (L >= 4) ? 2 : (L >= 2) ? 1 : 0;
+  // Pixel sums, exact: C+2 bits, and at least one bit above the PixBits kept.
+  localparam integer PXW   = (PixBits >= C + 2) ? PixBits + 1 : C + 2;
+  localparam integer MW    = A + C + 1;                  // didx*(xg - xref), natural width
+
+  localparam [1:0] ST_IDLE = 2'd0;
+  localparam [1:0] ST_ROW  = 2'd1;
+  localparam [1:0] ST_SPAN = 2'd2;
+
+  // The most negative / positive C+1-bit and C-bit values: empty min/max reductions give them.
+  localparam [C:0]   EXT_MIN    = {1'b1, {C{1'b0}}};
+  localparam [C:0]   EXT_MAX    = {1'b0, {C{1'b1}}};
+  localparam [C-1:0] COORD_MIN  = {1'b1, {(C-1){1'b0}}};
+  localparam [C-1:0] COORD_MAX  = {1'b0, {(C-1){1'b1}}};
+  localparam [C-1:0] ALIGN_MASK = {C{1'b1}} << ((AlignLanes != 0) ? LOG2L : 0);
+
+  // ---------------------------------------------------------------- registers
+  reg  [1:0]             state_q;
+  reg  [1:0]             state_d;
+
+  // Descriptor: loaded when a descriptor is accepted.
+  reg  [TagBits-1:0]     tag_q;
+  reg  [C-1:0]           row_last_q;
+  reg  [C-1:0]           xref_q;
+  reg  [AV-1:0]          didx_q;
+  reg  [AV-1:0]          didy_q;
+  reg  [NumTri*C-1:0]    lt_row_first_q;
+  reg  [NumTri*C-1:0]    lt_row_last_q;
+  reg  [NumTri*C-1:0]    lt_clip_x0_q;
+  reg  [NumTri*C-1:0]    lt_clip_x1_q;
+  reg  [NumTri*C-1:0]    lt_ox_q;
+  reg  [NumTri*C-1:0]    lt_oy_q;
+  reg  [NumTri-1:0]      lt_flip_q;
+  reg  [NumTri*AV-1:0]   lt_aoff_q;
+  reg  [NE-1:0]          e_right_q;
+  reg  [NE*C-1:0]        e_row_first_q;
+  reg  [NE*C-1:0]        e_row_last_q;
+  reg  [NE*C-1:0]        e_k_q;
+  reg  [NE*R-1:0]        e_div_q;
+  reg  [NE*R-1:0]        e_m_q;
+
+  // Walker: the row, the plane at (xref, w), every edge's DDA state (q, r).
+  reg  [C-1:0]           w_q;
+  reg  [AV-1:0]          irow_q;
+  reg  [NE*C-1:0]        quo_q;
+  reg  [NE*R-1:0]        rem_q;
+  wire [C-1:0]           w_d;
+  wire [AV-1:0]          irow_d;
+  wire [NE*C-1:0]        quo_d;
+  wire [NE*R-1:0]        rem_d;
+
+  // Row results: each lane-triangle's bounds in the row being spanned.
+  reg  [NumTri*C-1:0]    lo_q;
+  reg  [NumTri*C-1:0]    hi_q;
+  reg  [NumTri-1:0]      ne_q;
+  wire [NumTri*C-1:0]    lo_d;
+  wire [NumTri*C-1:0]    hi_d;
+  wire [NumTri-1:0]      ne_d;
+
+  // Span: the lane group's first column, the span end, its row and the plane at (xg, wspan).
+  reg  [C-1:0]           xg_q;
+  reg  [C-1:0]           xe_q;
+  reg  [C-1:0]           wspan_q;
+  reg  [AV-1:0]          icur_q;
+  reg  [C-1:0]           xg_d;
+  reg  [C-1:0]           xe_d;
+  reg  [AV-1:0]          icur_d;
+
+  // ---------------------------------------------------------------- control
+  wire in_idle  = (state_q == ST_IDLE);
+  wire in_row   = (state_q == ST_ROW);
+  wire in_span  = (state_q == ST_SPAN);
+  wire accept   = in_idle && desc_valid_i;
+
+  wire span_adv;    // SPAN: the lane group is taken (or shows nothing)
+  wire span_done;   // SPAN: the lane group is the row's last
+  wire any_ne;      // ROW: some lane-triangle has pixels in row w
+  wire span_load  = in_row && any_ne;
+  wire span_step  = in_span && span_adv && !span_done;
+  wire walk_en    = accept || in_row;
+
+  always @* begin
+    state_d = state_q;
+    case (state_q)
+      ST_IDLE: if (desc_valid_i) state_d = ST_ROW;
+      ST_ROW: begin
+        if (any_ne)                 state_d = ST_SPAN;
+        else if (w_q == row_last_q) state_d = ST_IDLE;
+      end
+      ST_SPAN: begin
+        if (span_adv && span_done) state_d = (wspan_q == row_last_q) ? ST_IDLE : ST_ROW;
+      end
+      default: state_d = ST_IDLE;
+    endcase
+  end
+
+  always @(posedge clk_i or negedge rst_ni) begin
+    if (!rst_ni) state_q <= ST_IDLE;
+    else         state_q <= state_d;
+  end
+
+  always @(posedge clk_i) begin
+    if (accept) begin
+      tag_q          <= desc_tag_i;
+      row_last_q     <= desc_row_last_i;
+      xref_q         <= desc_xref_i;
+      didx_q         <= desc_didx_i;
+      didy_q         <= desc_didy_i;
+      lt_row_first_q <= lt_row_first_i;
+      lt_row_last_q  <= lt_row_last_i;
+      lt_clip_x0_q   <= lt_clip_x0_i;
+      lt_clip_x1_q   <= lt_clip_x1_i;
+      lt_ox_q        <= lt_ox_i;
+      lt_oy_q        <= lt_oy_i;
+      lt_flip_q      <= lt_flip_i;
+      lt_aoff_q      <= lt_aoff_i;
+      e_right_q      <= e_right_i;
+      e_row_first_q  <= e_row_first_i;
+      e_row_last_q   <= e_row_last_i;
+      e_k_q          <= e_k_i;
+      e_div_q        <= e_div_i;
+      e_m_q          <= e_m_i;
+    end
+  end
+
+  // ---------------------------------------------------------------- ROW: walker and edges
+  // IDLE (accepting) loads row_first, iref and every edge's (q0, r0); ROW steps them.
+  assign w_d = accept ? desc_row_first_i : w_q + {{(C-1){1'b0}}, 1'b1};  // wraps at CoordBits
+
+  wire [NE-1:0]       e_act;     // edge bounds the span at w
+  wire [NE*(C+1)-1:0] e_bound;   // q (left) or -q (right), CoordBits+1 bits
+
+  genvar e;
+  generate
+    for (e = 0; e < NE; e = e + 1) begin : g_edge
+      wire signed [C-1:0] rf_e  = e_row_first_q[e*C +: C];
+      wire signed [C-1:0] rl_e  = e_row_last_q[e*C +: C];
+      wire signed [C-1:0] w_e   = w_q;
+      wire [C-1:0]        q_e   = quo_q[e*C +: C];
+      wire [C-1:0]        k_e   = e_k_q[e*C +: C];
+      wire [R-1:0]        r_e   = rem_q[e*R +: R];
+      wire [R-1:0]        m_e   = e_m_q[e*R +: R];
+      wire [R-1:0]        div_e = e_div_q[e*R +: R];
+      wire [C:0]          q_x   = {q_e[C-1], q_e};
+
+      assign e_act[e] = (rf_e <= w_e) && (w_e <= rl_e);
+      wire step_e = (rf_e <= w_e) && (w_e < rl_e);      // active at w and w < row_last
+      assign e_bound[e*(C+1) +: C+1] = e_right_q[e] ? (~q_x + {{C{1'b0}}, 1'b1}) : q_x;
+
+      // DDA: r' = r - m; if r' < 0 { r' += D; q' = q + k + 1 } else { q' = q + k }.
+      wire [R:0]   r_sub  = {1'b0, r_e} - {1'b0, m_e};      // exact: |r - m| < 2^R
+      wire         borrow = r_sub[R];
+      wire [R:0]   r_fix  = r_sub + (borrow ? {1'b0, div_e} : {(R+1){1'b0}});
+      // 0 <= r_fix < div < 2^R when 0 <= r, m < div: r_fix[R] is 0.
+      wire         unused_r_fix = r_fix[R];
+      wire [C-1:0] q_next = q_e + k_e + {{(C-1){1'b0}}, borrow};  // wraps at CoordBits
+
+      assign quo_d[e*C +: C] = accept ? e_q_i[e*C +: C] : (step_e ? q_next : q_e);
+      assign rem_d[e*R +: R] = accept ? e_r_i[e*R +: R] : (step_e ? r_fix[R-1:0] : r_e);
+    end
+  endgenerate
+
+  always @(posedge clk_i) begin
+    if (walk_en) begin
+      w_q    <= w_d;
+      irow_q <= irow_d;
+      quo_q  <= quo_d;
+      rem_q  <= rem_d;
+    end
+  end
+
+  // ---------------------------------------------------------------- ROW: lane-triangle bounds
+  // lo_j = max(clip_x0_j, q of the active left edges), hi_j = min(clip_x1_j, -q of the active
+  // right edges), compared with CoordBits+1 bits; ne_j = in_j && lo_j <= hi_j.
+  genvar j;
+  generate
+    for (j = 0; j < NumTri; j = j + 1) begin : g_tri
+      wire signed [C-1:0] rf_j = lt_row_first_q[j*C +: C];
+      wire signed [C-1:0] rl_j = lt_row_last_q[j*C +: C];
+      wire signed [C-1:0] w_j  = w_q;
+      wire [C-1:0]        x0_j = lt_clip_x0_q[j*C +: C];
+      wire [C-1:0]        x1_j = lt_clip_x1_q[j*C +: C];
+      wire signed [C:0]   cl_0, cl_1, cl_2, cr_0, cr_1, cr_2;   // candidates per edge slot
+      wire signed [C:0]   b_0 = e_bound[(j*3+0)*(C+1) +: C+1];
+      wire signed [C:0]   b_1 = e_bound[(j*3+1)*(C+1) +: C+1];
+      wire signed [C:0]   b_2 = e_bound[(j*3+2)*(C+1) +: C+1];
+      wire [2:0]          act_j   = e_act[j*3 +: 3];
+      wire [2:0]          right_j = e_right_q[j*3 +: 3];
+      assign cl_0 = (act_j[0] && !right_j[0]) ? b_0 : EXT_MIN;
+      assign cl_1 = (act_j[1] && !right_j[1]) ? b_1 : EXT_MIN;
+      assign cl_2 = (act_j[2] && !right_j[2]) ? b_2 : EXT_MIN;
+      assign cr_0 = (act_j[0] && right_j[0]) ? b_0 : EXT_MAX;
+      assign cr_1 = (act_j[1] && right_j[1]) ? b_1 : EXT_MAX;
+      assign cr_2 = (act_j[2] && right_j[2]) ? b_2 : EXT_MAX;
+      wire signed [C:0] lo_x0 = {x0_j[C-1], x0_j};
+      wire signed [C:0] hi_x1 = {x1_j[C-1], x1_j};
+      wire signed [C:0] lo_a  = (cl_0 > lo_x0) ? cl_0 : lo_x0;
+      wire signed [C:0] lo_b  = (cl_2 > cl_1) ? cl_2 : cl_1;
+      wire signed [C:0] lo_j  = (lo_b > lo_a) ? lo_b : lo_a;
+      wire signed [C:0] hi_a  = (cr_0 < hi_x1) ? cr_0 : hi_x1;
+      wire signed [C:0] hi_b  = (cr_2 < cr_1) ? cr_2 : cr_1;
+      wire signed [C:0] hi_j  = (hi_b < hi_a) ? hi_b : hi_a;
+      // lo_j is a CoordBits value (clip_x0 or some q); hi_j <= clip_x1 and hi_j >= -(2^(C-1)-1)
+      // unless it is clip_x1 (see header): both fit CoordBits, the MSBs are sign copies.
+      wire unused_lohi_msb = lo_j[C] ^ hi_j[C];
+
+      assign ne_d[j] = (rf_j <= w_j) && (w_j <= rl_j) && (lo_j <= hi_j);
+      assign lo_d[j*C +: C] = lo_j[C-1:0];
+      assign hi_d[j*C +: C] = hi_j[C-1:0];
+    end
+  endgenerate
+
+  always @(posedge clk_i) begin
+    if (in_row) begin
+      lo_q <= lo_d;
+      hi_q <= hi_d;
+      ne_q <= ne_d;
+    end
+  end
+
+  // xs = min lo_j, xe = max hi_j over the lane-triangles with ne_j (NumTri <= 4 terms).
+  reg signed [C-1:0] xs_r;
+  reg signed [C-1:0] xe_r;
+  integer t;
+  always @* begin
+    xs_r = COORD_MAX;
+    xe_r = COORD_MIN;
+    for (t = 0; t < NumTri; t = t + 1) begin
+      if (ne_d[t]) begin
+        if ($signed(lo_d[t*C +: C]) < xs_r) xs_r = lo_d[t*C +: C];
+        if ($signed(hi_d[t*C +: C]) > xe_r) xe_r = hi_d[t*C +: C];
+      end
+    end
+  end
+  assign any_ne = |ne_d;
+
+  // AlignLanes: xg = xs - (xs mod LanesPerTri), floor modulo (two's complement AND).
+  wire [C-1:0] xg_row = xs_r & ALIGN_MASK;
+  wire [C:0]   dx_row = {xg_row[C-1], xg_row} - {xref_q[C-1], xref_q};  // exact, C+1 signed
+
+  // ---------------------------------------------------------------- SPAN: lane group
+  // Done when xg + LanesPerTri > xe (CoordBits+1 bits: xg + L may pass the largest coordinate).
+  // Otherwise xg + L <= xe fits CoordBits.
+  wire signed [C:0] xg_next = $signed({xg_q[C-1], xg_q}) + $signed(L[C:0]);
+  assign span_done = xg_next > $signed({xe_q[C-1], xe_q});
+  wire unused_xg_next_msb = xg_next[C];
+
+  // ---------------------------------------------------------------- attributes (per a)
+  wire [AV-1:0] icur_row;    // irow + didx*(xg - xref)
+  wire [AV-1:0] icur_step;   // icur + LanesPerTri*didx
+  genvar a;
+  generate
+    for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
+      wire signed [A-1:0]  didx_a = didx_q[a*A +: A];
+      wire signed [MW-1:0] didx_x = {{(C+1){didx_a[A-1]}}, didx_a};
+      wire signed [MW-1:0] dx_x   = {{A{dx_row[C]}}, dx_row};
+      // Signed A x (C+1) product (the sign copies are removed by synthesis); only its low
+      // AttrBits are needed: the plane is computed modulo 2^AttrBits.
+      wire signed [MW-1:0] prod_a = didx_x * dx_x;
+      wire unused_prod_msbs = ^prod_a[MW-1:A];
+      assign icur_row[a*A +: A]  = irow_q[a*A +: A] + prod_a[A-1:0];
+      assign icur_step[a*A +: A] = icur_q[a*A +: A] + (didx_q[a*A +: A] << LOG2L);
+      assign irow_d[a*A +: A]    = accept ? desc_iref_i[a*A +: A]
+                                          : irow_q[a*A +: A] + didy_q[a*A +: A];
+    end
+  endgenerate
+
+  always @* begin
+    xg_d   = xg_q;
+    xe_d   = xe_q;
+    icur_d = icur_q;
+    if (span_load) begin
+      xg_d   = xg_row;
+      xe_d   = xe_r;
+      icur_d = icur_row;
+    end else if (span_step) begin
+      xg_d   = xg_next[C-1:0];
+      icur_d = icur_step;
+    end
+  end
+
+  always @(posedge clk_i) begin
+    if (span_load || span_step) begin
+      xg_q   <= xg_d;
+      icur_q <= icur_d;
+    end
+  end
+
+  always @(posedge clk_i) begin
+    if (span_load) begin
+      xe_q    <= xe_d;
+      wspan_q <= w_q;
+    end
+  end
+
+  // ---------------------------------------------------------------- lanes
+  // Lane i of every lane-triangle shows column x = xg + i and the plane value icur + i*didx
+  // (i*didx as at most three shifted copies, i < 8); lane-triangle j maps them to its pixel and
+  // attribute.
+  wire [NumTri*L-1:0] lane_valid;
+  genvar i;
+  generate
+    for (i = 0; i < L; i = i + 1) begin : g_lane
+      localparam [C:0] LANE_OFF = i;
+      wire signed [C:0] x_i = $signed({xg_q[C-1], xg_q}) + $signed(LANE_OFF);
+      wire [AV-1:0]     v_i;
+      for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
+        wire [A-1:0] d_a  = didx_q[a*A +: A];
+        wire [A-1:0] s0_a = ((i & 1) != 0) ? d_a        : {A{1'b0}};
+        wire [A-1:0] s1_a = ((i & 2) != 0) ? (d_a << 1) : {A{1'b0}};
+        wire [A-1:0] s2_a = ((i & 4) != 0) ? (d_a << 2) : {A{1'b0}};
+        assign v_i[a*A +: A] = icur_q[a*A +: A] + s0_a + s1_a + s2_a;   // wraps at AttrBits
+      end
+
+      for (j = 0; j < NumTri; j = j + 1) begin : g_tri
+        localparam integer LN = j * L + i;
+        wire signed [C-1:0] lo_l = lo_q[j*C +: C];
+        wire signed [C-1:0] hi_l = hi_q[j*C +: C];
+        wire [C-1:0]        ox_l = lt_ox_q[j*C +: C];
+        wire [C-1:0]        oy_l = lt_oy_q[j*C +: C];
+        wire                flip = lt_flip_q[j];
+        assign lane_valid[LN] = in_span && ne_q[j]
+                                && ($signed({lo_l[C-1], lo_l}) <= x_i)
+                                && (x_i <= $signed({hi_l[C-1], hi_l}));
+
+        // flip: (ox - x, oy - wspan); else (x + ox, wspan + oy); exact, low PixBits kept.
+        wire [PXW-1:0] x_p  = {{(PXW-C-1){x_i[C]}}, x_i};
+        wire [PXW-1:0] ox_p = {{(PXW-C){ox_l[C-1]}}, ox_l};
+        wire [PXW-1:0] oy_p = {{(PXW-C){oy_l[C-1]}}, oy_l};
+        wire [PXW-1:0] w_p  = {{(PXW-C){wspan_q[C-1]}}, wspan_q};
+        wire [PXW-1:0] px   = flip ? ox_p - x_p : x_p + ox_p;
+        wire [PXW-1:0] py   = flip ? oy_p - w_p : w_p + oy_p;
+        assign out_x_o[LN*PixBits +: PixBits] = px[PixBits-1:0];
+        assign out_y_o[LN*PixBits +: PixBits] = py[PixBits-1:0];
+        wire unused_pix_msbs = ^{px[PXW-1:PixBits], py[PXW-1:PixBits]};
+
+        for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
+          wire [A-1:0] v_a    = v_i[a*A +: A];
+          wire [A-1:0] aoff_a = lt_aoff_q[(j*NumAttr+a)*A +: A];
+          assign out_attr_o[(LN*NumAttr+a)*A +: A] = flip ? aoff_a - v_a : v_a + aoff_a;
+        end
+      end
+    end
+  endgenerate
+
+  // ---------------------------------------------------------------- outputs
+  assign span_adv         = !out_valid_o || out_ready_i;
+  assign desc_ready_o     = in_idle;
+  assign out_valid_o      = |lane_valid;
+  assign out_tag_o        = tag_q;
+  assign out_lane_valid_o = lane_valid;
+
+endmodule

@@ -1,0 +1,58 @@
+// The scoreboard of the span unit: the verilated configuration and SpanUnitModel take the same
+// descriptor stream with the same random back-pressure (out_ready) and descriptor gaps, and
+// every output is compared on every cycle: desc_ready, out_valid, the tag, each lane's valid
+// bit, and each valid lane's pixel and attributes.
+//
+// On the first mismatch the failing triangle is replayed alone from reset, with the same
+// out_ready pattern, into a traced instance (an FST waveform), and its descriptor and pattern
+// are written as JSON so that the case reproduces by itself.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "raster/span_unit.h"
+#include "span_dut.h"
+
+namespace shd {
+
+struct SpanCosimOptions {
+  uint64_t seed = 1;             // the back-pressure and gap pattern
+  double ready_prob = 0.8;       // out_ready high on a cycle with this probability
+  double desc_gap_prob = 0.1;    // a descriptor waits 1..3 cycles before being offered
+  std::string fail_dir = ".";
+  uint64_t max_mismatches = 16;
+  std::function<void(uint64_t done)> progress;  // called every 4096 triangles
+  // Fault injection for the checker's own tests: run the model with other parameters than
+  // the verilated unit (e.g. another lane layout) so that the comparison must fail.
+  std::optional<SpanParams> model_params;
+};
+
+struct SpanMismatch {
+  uint64_t cycle = 0;
+  uint32_t tag = 0;  // the triangle being processed
+  std::string what;  // which output differs, with both values
+};
+
+struct SpanCosimResult {
+  std::string mode;
+  uint64_t triangles = 0;  // descriptors accepted
+  uint64_t fragments = 0;  // lane fragments handed over (valid lane, out_valid and out_ready)
+  uint64_t cycles = 0;
+  uint64_t mismatches = 0;
+  double seconds = 0;
+  std::optional<SpanMismatch> first;
+  std::string fst_path, case_path;
+};
+
+// next(d) fills the next descriptor and returns false at the end of the stream.
+SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(SpanDesc&)>& next,
+                             const SpanCosimOptions& opts);
+
+nlohmann::json toJson(const SpanDesc& d);
+
+}  // namespace shd

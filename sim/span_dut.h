@@ -1,0 +1,35 @@
+// SpanDut: one verilated configuration (mode) of rtl/shd_span_unit.v behind a small interface.
+// tick() drives the inputs, reads the outputs (functions of the registers, so they are the
+// values of this cycle) and then clocks a rising edge: the contract of SpanUnitModel::tick().
+// Valid/ready rule: a descriptor offered with desc_valid must not change until it is accepted.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "raster/span_unit.h"
+
+namespace shd {
+
+class SpanDut {
+ public:
+  virtual ~SpanDut() = default;
+  virtual const std::string& configName() const = 0;
+  virtual const SpanParams& params() const = 0;
+  virtual void reset() = 0;  // rst_ni low for two cycles, inputs idle
+  virtual void tick(const SpanIn& in, SpanOut& out) = 0;  // reuses out's storage
+  SpanOut tick(const SpanIn& in) {
+    SpanOut out;
+    tick(in, out);
+    return out;
+  }
+  virtual uint64_t cycle() const = 0;
+  virtual void finish() = 0;
+};
+
+std::vector<std::string> rtlSpanConfigs();
+// config: a span mode name (serial, evenodd, seg2, seg4, seg8, sierpinski). fst_path "": no trace.
+std::unique_ptr<SpanDut> makeSpanDut(const std::string& config, const std::string& fst_path);
+
+}  // namespace shd

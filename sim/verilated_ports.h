@@ -1,0 +1,62 @@
+// Bit fields of verilated ports: a port of up to 64 bits is an integer member, a wider one a
+// VlWide of 32-bit words. put()/get() address a field by its LSB and width either way, so a
+// harness packs flattened Verilog vectors ([n*W +: W]) without caring which.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <type_traits>
+
+#include <verilated.h>
+
+namespace shd::ports {
+
+template <class T>
+std::enable_if_t<std::is_integral_v<T>> put(T& port, int lsb, int width, uint64_t v) {
+  const uint64_t mask = width >= 64 ? ~uint64_t{0} : (uint64_t{1} << width) - 1;
+  uint64_t p = static_cast<uint64_t>(port);
+  p = (p & ~(mask << lsb)) | ((v & mask) << lsb);
+  port = static_cast<T>(p);
+}
+
+template <std::size_t N>
+void put(VlWide<N>& port, int lsb, int width, uint64_t v) {
+  // Word by word: the field covers bits [lsb, lsb + width) of the 32-bit words.
+  while (width > 0) {
+    const std::size_t w = static_cast<std::size_t>(lsb / 32);
+    const int off = lsb % 32, n = std::min(width, 32 - off);
+    const uint32_t mask = (n == 32 ? ~uint32_t{0} : ((uint32_t{1} << n) - 1)) << off;
+    port[w] = (port[w] & ~mask) | ((static_cast<uint32_t>(v) << off) & mask);
+    v >>= n;
+    lsb += n;
+    width -= n;
+  }
+}
+
+template <class T>
+std::enable_if_t<std::is_integral_v<T>, uint64_t> get(const T& port, int lsb, int width) {
+  const uint64_t mask = width >= 64 ? ~uint64_t{0} : (uint64_t{1} << width) - 1;
+  return (static_cast<uint64_t>(port) >> lsb) & mask;
+}
+
+template <std::size_t N>
+uint64_t get(const VlWide<N>& port, int lsb, int width) {
+  uint64_t v = 0;
+  int done = 0;
+  while (done < width) {
+    const std::size_t w = static_cast<std::size_t>(lsb / 32);
+    const int off = lsb % 32, n = std::min(width - done, 32 - off);
+    const uint64_t bits = (port[w] >> off) & (n == 32 ? ~uint32_t{0} : ((uint32_t{1} << n) - 1));
+    v |= bits << done;
+    done += n;
+    lsb += n;
+  }
+  return v;
+}
+
+inline int64_t signExtend(uint64_t v, int width) {
+  const uint64_t sign = uint64_t{1} << (width - 1);
+  return static_cast<int64_t>((v ^ sign) - sign);
+}
+
+}  // namespace shd::ports
