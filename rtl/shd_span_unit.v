@@ -181,7 +181,6 @@ module shd_span_unit #(
   wire any_ne;      // ROW: some lane-triangle has pixels in row w
   wire span_load  = in_row && any_ne;
   wire span_step  = in_span && span_adv && !span_done;
-  wire walk_en    = accept || in_row;
 
   always @* begin
     state_d = state_q;
@@ -229,7 +228,7 @@ module shd_span_unit #(
 
   // ---------------------------------------------------------------- ROW: walker and edges
   // IDLE (accepting) loads row_first, iref and every edge's (q0, r0); ROW steps them.
-  assign w_d = accept ? desc_row_first_i : w_q + {{(C-1){1'b0}}, 1'b1};  // wraps at CoordBits
+  assign w_d = w_q + {{(C-1){1'b0}}, 1'b1};  // ROW: next row, wraps at CoordBits
 
   wire [NE-1:0]       e_act;     // edge bounds the span at w
   wire [NE*(C+1)-1:0] e_bound;   // q (left) or -q (right), CoordBits+1 bits
@@ -259,13 +258,22 @@ module shd_span_unit #(
       wire         unused_r_fix = r_fix[R];
       wire [C-1:0] q_next = q_e + k_e + {{(C-1){1'b0}}, borrow};  // wraps at CoordBits
 
-      assign quo_d[e*C +: C] = accept ? e_q_i[e*C +: C] : (step_e ? q_next : q_e);
-      assign rem_d[e*R +: R] = accept ? e_r_i[e*R +: R] : (step_e ? r_fix[R-1:0] : r_e);
+      assign quo_d[e*C +: C] = step_e ? q_next : q_e;
+      assign rem_d[e*R +: R] = step_e ? r_fix[R-1:0] : r_e;
     end
   endgenerate
 
+  // The walker registers load the descriptor on accept and step in ROW. The descriptor mux
+  // sits in the clocked block (not in the _d logic) so that a simulator re-evaluates the
+  // register-only ROW logic once per clock, not on every input change (Verilator's input
+  // logic runs on every eval); the hardware is the same two-input mux.
   always @(posedge clk_i) begin
-    if (walk_en) begin
+    if (accept) begin
+      w_q    <= desc_row_first_i;
+      irow_q <= desc_iref_i;
+      quo_q  <= e_q_i;
+      rem_q  <= e_r_i;
+    end else if (in_row) begin
       w_q    <= w_d;
       irow_q <= irow_d;
       quo_q  <= quo_d;
@@ -364,8 +372,7 @@ module shd_span_unit #(
       wire unused_prod_msbs = ^prod_a[MW-1:A];
       assign icur_row[a*A +: A]  = irow_q[a*A +: A] + prod_a[A-1:0];
       assign icur_step[a*A +: A] = icur_q[a*A +: A] + (didx_q[a*A +: A] << LOG2L);
-      assign irow_d[a*A +: A]    = accept ? desc_iref_i[a*A +: A]
-                                          : irow_q[a*A +: A] + didy_q[a*A +: A];
+      assign irow_d[a*A +: A]    = irow_q[a*A +: A] + didy_q[a*A +: A];
     end
   endgenerate
 

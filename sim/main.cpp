@@ -376,7 +376,9 @@ struct SpanCyclesCmd {
   std::string json_out;
 
   void add(CLI::App& app) {
-    app.add_option("--triangles", triangles, "triangles per size class (and for the mixed stream)")
+    app.add_option("--triangles", triangles,
+                   "triangles per size class and for the mixed stream; large: 1/20 of it, screen-filling: 1/2000 "
+                   "(at least 5), so that every set costs about the same")
         ->check(CLI::PositiveNumber);
     app.add_option("--seed", seed, "generator seed");
     app.add_option("--divider-latency", divider_latency, "divider latencies (cycles) of the classical unit")
@@ -391,6 +393,9 @@ struct SpanCyclesCmd {
     RasterConfig rc;
     std::vector<TriangleSetCycles> sets;
     auto classStream = [&](const char* name, int cls) {
+      uint64_t count = triangles;
+      if (cls == static_cast<int>(SizeClass::Large)) count = std::max<uint64_t>(5, triangles / 20);
+      if (cls == static_cast<int>(SizeClass::Screen)) count = std::max<uint64_t>(5, triangles / 2000);
       TriGenOptions g;
       if (cls >= 0) {
         g.size_weight = {0, 0, 0, 0, 0};
@@ -398,7 +403,7 @@ struct SpanCyclesCmd {
       }
       TriangleGenerator gen(seed, g);
       TriangleList list;
-      for (uint64_t i = 0; i < triangles; ++i) list.push_back(toSetupVertices(gen.next(), rc.unit.NumAttr));
+      for (uint64_t i = 0; i < count; ++i) list.push_back(toSetupVertices(gen.next(), rc.unit.NumAttr));
       std::fprintf(stderr, "span-cycles: %s (%zu triangles)\n", name, list.size());
       sets.push_back(measureSpanCycles(name, list, rc, divider_latency, soft_repeats));
     };

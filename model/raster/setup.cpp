@@ -169,7 +169,7 @@ int defaultAttrFracBits(int width, int height, int out_frac) {
 
 std::vector<int> defaultAttrFracBitsFor(int width, int height, int num_attr) {
   std::vector<int> f;
-  for (int k = 0; k < num_attr; ++k) f.push_back(defaultAttrFracBits(width, height, k == 3 ? 24 : 0));
+  for (int k = 0; k < num_attr; ++k) f.push_back(defaultAttrFracBits(width, height, k == 3 ? 16 : 0));
   return f;
 }
 

@@ -39,7 +39,8 @@
 //   For it to stay below a quarter of an output LSB 2^-O_k anywhere in a W x H viewport:
 //     F_k >= O_k + 1 + ceil(log2(1 + W + H)).
 //   512 x 512, colour out as integer codes (O = 0): F = 12 (bound 0.125 LSB); depth out with
-//   24 fraction bits: F = 36. defaultAttrFracBits() applies this rule.
+//   16 fraction bits: F = 28 (codes up to 2^28, so AttrBits 32 holds them with sign and margin).
+//   defaultAttrFracBits() applies this rule.
 //   Only the values at covered pixels must fit AttrBits: the unit computes modulo 2^AttrBits,
 //   so wrapped gradients and intermediate sums still give the exact value where it fits.
 //   Setup checks the covered values' bound and reports an attribute that cannot fit.
@@ -66,7 +67,7 @@ struct RasterConfig {
 
 // F_k for output fraction bits out_frac (see the header comment).
 int defaultAttrFracBits(int width, int height, int out_frac);
-// Colour channels (attributes 0..2, integer output codes) and depth (attribute 3, 24 output
+// Colour channels (attributes 0..2, integer output codes) and depth (attribute 3, 16 output
 // fraction bits); further attributes as colour.
 std::vector<int> defaultAttrFracBitsFor(int width, int height, int num_attr);
 

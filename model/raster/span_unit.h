@@ -93,7 +93,7 @@ struct SpanParams {
   int LanesPerTri = 1;  // 1, 2, 4 or 8
   int AlignLanes = 0;   // 1: lane i takes x = i (mod LanesPerTri)
   int NumAttr = 4;      // attributes per fragment
-  int AttrBits = 40;    // signed attribute codes
+  int AttrBits = 32;    // signed attribute codes
   int CoordBits = 16;   // signed walker-frame coordinates (rows, columns, DDA quotients, k)
   int RemBits = 27;     // unsigned DDA divisor, remainder and m
   int PixBits = 12;     // unsigned screen pixel coordinates on the fragment ports
