@@ -372,7 +372,7 @@ struct SpanCyclesCmd {
   uint64_t triangles = 20000, seed = 1;
   std::vector<int> divider_latency{1, 4, 8, 16, 32};
   int soft_repeats = 5;
-  bool json = false;
+  bool json = false, rtl = false;
   std::string json_out;
 
   void add(CLI::App& app) {
@@ -387,10 +387,12 @@ struct SpanCyclesCmd {
     app.add_option("--soft-repeats", soft_repeats, "repeats of the software timing (median)")->check(CLI::Range(1, 1000));
     app.add_flag("--json", json, "print one JSON object instead of the tables");
     app.add_option("--json-out", json_out, "also write the JSON object to this file");
+    app.add_flag("--rtl", rtl, "also run every set through the verilated unit of every mode and check its cycles");
   }
 
   int run() {
     RasterConfig rc;
+    std::vector<std::pair<std::string, TriangleList>> lists;
     std::vector<TriangleSetCycles> sets;
     auto classStream = [&](const char* name, int cls) {
       uint64_t count = triangles;
@@ -404,8 +406,7 @@ struct SpanCyclesCmd {
       TriangleGenerator gen(seed, g);
       TriangleList list;
       for (uint64_t i = 0; i < count; ++i) list.push_back(toSetupVertices(gen.next(), rc.unit.NumAttr));
-      std::fprintf(stderr, "span-cycles: %s (%zu triangles)\n", name, list.size());
-      sets.push_back(measureSpanCycles(name, list, rc, divider_latency, soft_repeats));
+      lists.emplace_back(name, std::move(list));
     };
     const char* names[] = {"pixel1", "small", "mesh 10-100px", "large", "screen"};
     for (int cls = 0; cls < kNumSizeClasses; ++cls) classStream(names[cls], cls);
@@ -419,14 +420,49 @@ struct SpanCyclesCmd {
         v[i] = {t.v[i].x, t.v[i].y, {127.5 * (t.v[i].n.x + 1), 127.5 * (t.v[i].n.y + 1), 127.5 * (t.v[i].n.z + 1), t.v[i].z / 4}};
       sphere.push_back(v);
     }
-    std::fprintf(stderr, "span-cycles: builtin:sphere (%zu front faces)\n", sphere.size());
-    sets.push_back(measureSpanCycles("builtin:sphere", sphere, rc, divider_latency, soft_repeats));
+    lists.emplace_back("builtin:sphere", std::move(sphere));
+    for (const auto& [name, list] : lists) {
+      std::fprintf(stderr, "span-cycles: %s (%zu triangles)\n", name.c_str(), list.size());
+      sets.push_back(measureSpanCycles(name, list, rc, divider_latency, soft_repeats));
+    }
     nlohmann::json j = {{"seed", seed}, {"triangles_per_class", triangles}, {"sets", nlohmann::json::array()}};
     for (const auto& s : sets) j["sets"].push_back(toJson(s));
+    // The cycle counts checked against the RTL: the same triangles through the verilated unit
+    // of each mode, consumer always ready, compared cycle by cycle with the model.
+    bool rtl_ok = true;
+    std::string rtl_lines;
+    for (size_t si = 0; rtl && si < lists.size(); ++si)
+      for (size_t mi = 0; mi < sets[si].modes.size(); ++mi) {
+        const SpanMode m = sets[si].modes[mi].mode;
+        RasterConfig c = rc;
+        c.unit = SpanParams::forMode(m);
+        size_t next_tri = 0;
+        const TriangleList& list = lists[si].second;
+        SpanCosimOptions o;
+        o.ready_prob = 1.0;
+        o.desc_gap_prob = 0.0;
+        const SpanCosimResult r = runSpanCosim(toString(m), [&](SpanDesc& d) {
+          while (next_tri < list.size()) {
+            SetupResult s = setupTriangle(list[next_tri], static_cast<uint32_t>(next_tri), c);
+            ++next_tri;
+            if (s.desc) {
+              d = std::move(*s.desc);
+              return true;
+            }
+          }
+          return false;
+        }, o);
+        const bool ok = r.mismatches == 0 && r.cycles == sets[si].modes[mi].cycles;
+        rtl_ok = rtl_ok && ok;
+        j["sets"][si]["modes"][mi]["rtl_cycles"] = r.cycles;
+        j["sets"][si]["modes"][mi]["rtl_mismatches"] = r.mismatches;
+        rtl_lines += fmt::format("{:<16} {:<11} model {:>10} rtl {:>10} cycles, {} mismatches{}\n", lists[si].first,
+                                 toString(m), sets[si].modes[mi].cycles, r.cycles, r.mismatches, ok ? "" : "  <-- FAIL");
+      }
     if (!json_out.empty()) writeFileAtomic(json_out, j.dump(2) + "\n");
     if (json) std::cout << j.dump(2) << "\n";
-    else std::cout << renderSpanCyclesTable(sets);
-    return 0;
+    else std::cout << renderSpanCyclesTable(sets) << (rtl ? "\nChecked against the RTL (verilated, cycle by cycle):\n" + rtl_lines : "");
+    return rtl_ok ? 0 : 1;
   }
 };
 

@@ -7,9 +7,9 @@
 #include <string>
 
 #include <verilated.h>
-#include <verilated_fst_c.h>
 
 #include "spec_dut.h"
+#include "verilated_harness.h"
 
 namespace shd {
 
@@ -34,93 +34,47 @@ std::vector<PromWord> romWordsOf(const VlUnpacked<T, Depth>& rom) {
 template <class V>
 class SpecDutImpl final : public SpecDut {
  public:
-  SpecDutImpl(std::string name, const SpecDutOptions& opts) : name_(std::move(name)) {
-    // Several models with their own contexts live in one process (a traced replay beside the
-    // main run): Verilator 5.006 resolves plusargs, $fatal and even ~VerilatedScope through the
-    // thread's current context, so each harness makes its own context current before it
-    // evaluates or destroys its model (verilator issue #8265).
-    ctx_ = std::make_unique<VerilatedContext>();
-    Verilated::threadContextp(ctx_.get());
-    const std::string plusarg = "+prom=" + opts.prom_path;
-    const char* argv[] = {"shadesim", plusarg.c_str()};
-    ctx_->commandArgs(2, argv);
-    if (!opts.fst_path.empty()) ctx_->traceEverOn(true);  // before the model (TOOLCHAIN 4)
-    dut_ = std::make_unique<V>(ctx_.get(), "dut");
-    if (!opts.fst_path.empty()) {
-      fst_ = std::make_unique<VerilatedFstC>();
-      dut_->trace(fst_.get(), 99);
-      fst_->open(opts.fst_path.c_str());
-    }
-    dut_->clk_i = 0;
-    dut_->rst_ni = 1;
-    dut_->valid_i = 0;
-    dut_->eval();
-    dump();
-  }
-  ~SpecDutImpl() override {
-    finish();
-    Verilated::threadContextp(ctx_.get());
-    fst_.reset();
-    dut_.reset();
+  SpecDutImpl(std::string name, const SpecDutOptions& opts)
+      : name_(std::move(name)), h_({"+prom=" + opts.prom_path}, opts.fst_path) {
+    h_.dut().valid_i = 0;
+    h_.settle();
   }
 
   const std::string& configName() const override { return name_; }
 
   void reset() override {
-    dut_->rst_ni = 0;
+    h_.dut().rst_ni = 0;
     SpecIn idle;
     tick(idle);
     tick(idle);
-    dut_->rst_ni = 1;
+    h_.dut().rst_ni = 1;
   }
 
   SpecOut tick(const SpecIn& in) override {
-    Verilated::threadContextp(ctx_.get());
-    dut_->valid_i = in.valid;
-    dut_->shin_i = in.shin;
-    dut_->cos_i = in.cos;
-    dut_->light_r_i = in.light[0];
-    dut_->light_g_i = in.light[1];
-    dut_->light_b_i = in.light[2];
-    dut_->clk_i = 0;
-    dut_->eval();
-    ctx_->timeInc(5);
-    dump();
-    dut_->clk_i = 1;
-    dut_->eval();
-    ctx_->timeInc(5);
-    dump();
-    ++cycle_;
+    V& d = h_.dut();
+    d.valid_i = in.valid;
+    d.shin_i = in.shin;
+    d.cos_i = in.cos;
+    d.light_r_i = in.light[0];
+    d.light_g_i = in.light[1];
+    d.light_b_i = in.light[2];
+    h_.fallingEdge();
+    h_.risingEdge();
     SpecOut out;
-    out.valid = dut_->valid_o;
-    out.spec = dut_->spec_o;
-    out.rgb = {dut_->spec_r_o, dut_->spec_g_o, dut_->spec_b_o};
+    out.valid = d.valid_o;
+    out.spec = d.spec_o;
+    out.rgb = {d.spec_r_o, d.spec_g_o, d.spec_b_o};
     return out;
   }
 
-  std::vector<PromWord> romWords() override { return romWordsOf(dut_->rootp->shd_spec_unit__DOT__u_rom__DOT__rom); }
+  std::vector<PromWord> romWords() override { return romWordsOf(h_.dut().rootp->shd_spec_unit__DOT__u_rom__DOT__rom); }
 
-  uint64_t cycle() const override { return cycle_; }
-
-  void finish() override {
-    if (finished_) return;
-    finished_ = true;
-    Verilated::threadContextp(ctx_.get());
-    dut_->final();
-    if (fst_) fst_->close();
-  }
+  uint64_t cycle() const override { return h_.cycle(); }
+  void finish() override { h_.finish(); }
 
  private:
-  void dump() {
-    if (fst_) fst_->dump(ctx_->time());
-  }
-
   std::string name_;
-  std::unique_ptr<VerilatedContext> ctx_;
-  std::unique_ptr<V> dut_;
-  std::unique_ptr<VerilatedFstC> fst_;
-  uint64_t cycle_ = 0;
-  bool finished_ = false;
+  VerilatedHarness<V> h_;
 };
 
 }  // namespace shd

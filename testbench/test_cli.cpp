@@ -175,3 +175,34 @@ TEST(CliSpecError, TableShowsBothFits) {
   EXPECT_NE(r.out.find("fit level"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("fit minimax"), std::string::npos) << r.out;
 }
+
+TEST(CliCosim, SpanJsonKeys) {
+  const CmdResult r = run("cosim --unit span --mode sierpinski --triangles 3000 --seed 4 --json --quiet");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* k : {"mode", "triangles", "fragments", "cycles", "mismatches"}) EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["mode"], "sierpinski");
+  EXPECT_EQ(j["mismatches"], 0);
+  EXPECT_GT(j["fragments"].get<long>(), 10000);
+  const CmdResult bad = run("cosim --unit span --mode zigzag --triangles 10");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.err.find("--mode"), std::string::npos) << bad.err;
+}
+
+TEST(CliSpanCycles, ReportChecksTheRtlCycles) {
+  const CmdResult r = run("span-cycles --triangles 400 --soft-repeats 1 --rtl --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j["sets"].size(), 7u);  // five size classes, the mixed stream, the sphere
+  for (const auto& set : j["sets"]) {
+    ASSERT_EQ(set["modes"].size(), 6u);
+    const double serial = set["modes"][0]["cycles"].get<double>();
+    for (const auto& m : set["modes"]) {
+      EXPECT_EQ(m["rtl_cycles"], m["cycles"]) << set["set"] << " " << m["mode"];
+      EXPECT_EQ(m["rtl_mismatches"], 0);
+      EXPECT_EQ(m["fragments"], set["modes"][0]["fragments"]);  // every mode draws the same pixels
+      // No lane mode is slower than the serial unit.
+      EXPECT_LE(m["cycles"].get<double>(), serial) << set["set"] << " " << m["mode"];
+    }
+  }
+}
