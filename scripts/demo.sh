@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds, then for the default configuration of the
 # specular unit generates the PROM (every format), runs the exhaustive co-simulation of the
-# verilated RTL against the golden model, prints the error table, and synthesises the unit.
-# Results go to out/.
+# verilated RTL against the golden model, prints the error table, and synthesises the unit;
+# then measures the span unit's cycles per mode, checked against its RTL. Results go to out/.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out"
@@ -35,6 +35,11 @@ cat "$out/spec_error_default.txt"
 echo "== 4. synthesis with yosys (out/synth/default/)"
 "$root/scripts/synth.sh" --config "$root/vectors/config/spec_default.json" \
   --prom "$out/prom/spec_default.hex" --out "$out/synth/default" --target both --check
+
+echo "== 5. span unit: cycles per mode on the size classes and the idx3d sphere, checked against the RTL"
+"$S" span-cycles --triangles 20000 --rtl --json-out "$out/span_cycles.json" > "$out/span_cycles.txt.tmp"
+mv "$out/span_cycles.txt.tmp" "$out/span_cycles.txt"
+cat "$out/span_cycles.txt"
 
 echo "== results in $out"
 ls -1 "$out"
