@@ -52,7 +52,7 @@ module shd_span_unit #(
   parameter integer LanesPerTri = 1,
   parameter integer AlignLanes  = 0,
   parameter integer NumAttr     = 4,
-  parameter integer AttrBits    = 40,
+  parameter integer AttrBits    = 32,
   parameter integer CoordBits   = 16,
   parameter integer RemBits     = 27,
   parameter integer PixBits     = 12,
