@@ -8,6 +8,7 @@ packages=(
   verilator iverilog yosys
   libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
+  libassimp-dev assimp-testmodels
 )
 missing=()
 for p in "${packages[@]}"; do

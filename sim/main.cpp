@@ -19,7 +19,12 @@
 #include "device/prom_io.h"
 #include "progress.h"
 #include "report/spec_error.h"
+#include "image/image.h"
+#include "image/metrics.h"
 #include "raster/desc_stream.h"
+#include "render/render.h"
+#include "render_rtl.h"
+#include "scene/scene.h"
 #include "report/span_cycles.h"
 #include "scene/sphere.h"
 #include "span_cosim.h"
@@ -466,6 +471,195 @@ struct SpanCyclesCmd {
   }
 };
 
+// ---------------------------------------------------------------- render
+struct RenderCmd {
+  std::string scene = "builtin:sphere", method = "gouraud", brdf, mode = "serial", output, json_path, heatmap;
+  bool rtl = false, quiet = false;
+  int bench = 0;
+  double heat_scale = 8, highlight_lsb = 32;
+
+  void add(CLI::App& app) {
+    app.add_option("--scene", scene, "builtin:sphere | builtin:plane | builtin:torus | builtin:materials or a JSON file");
+    app.add_option("--method", method, "flat | gouraud | gouraud-classical | phong | phong-incremental | reference")
+        ->check(CLI::IsMember({"flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "reference"}));
+    app.add_option("--brdf", brdf, "override every material's brdf: phong | blinn | normalized-blinn | schlick | "
+                                   "quadratic | cubic | cook-torrance | pow")
+        ->check(CLI::IsMember({"phong", "blinn", "normalized-blinn", "schlick", "quadratic", "cubic", "cook-torrance", "pow"}));
+    app.add_option("--mode", mode, "span unit lane mode")
+        ->check(CLI::IsMember({"serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"}));
+    app.add_flag("--rtl", rtl, "also render with the verilated span and specular units; the images must be identical");
+    app.add_option("-o,--output", output, "the image (PNG); beside it <name>_reference.png and <name>_error.png")
+        ->required();
+    app.add_option("--json", json_path, "write the statistics as JSON to this file");
+    app.add_option("--heat-scale", heat_scale, "error (LSB) shown white in the heat map")->check(CLI::PositiveNumber);
+    app.add_option("--highlight", highlight_lsb, "the highlight: pixels whose reference specular part exceeds this many LSBs")
+        ->check(CLI::NonNegativeNumber);
+    app.add_option("--bench", bench, "render this many frames and report the median time")->check(CLI::Range(0, 10000));
+    app.add_flag("--quiet", quiet, "no progress lines");
+  }
+
+  // The engines of one path (model or RTL) for the device lobes the scene uses.
+  struct Engines {
+    std::unique_ptr<SpanEngine> span;
+    std::vector<std::unique_ptr<SpecEngine>> spec;
+    SpecEngines view;
+  };
+
+  Engines makeEngines(const Scene& sc, const RenderOptions& ro, bool with_rtl, const fs::path& tmp) {
+    Engines e;
+    const SpanMode m = parseSpanMode(mode);
+    if (with_rtl) e.span = std::make_unique<RtlSpanEngine>(m);
+    else e.span = std::make_unique<ModelSpanEngine>(SpanParams::forMode(m));
+    for (Lobe l : deviceLobesUsed(sc, ro)) {
+      const std::string cfg_name = specConfigForLobe(l);
+      const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(cfg_name));
+      PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
+      if (with_rtl) {
+        fs::create_directories(tmp);
+        e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg_name, std::move(t), (tmp / ("spec_" + cfg_name + ".hex")).string()));
+      } else {
+        e.spec.push_back(std::make_unique<ModelSpecEngine>(std::move(t)));
+      }
+      (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.spec.back().get();
+    }
+    return e;
+  }
+
+  static Image toImage(const Framebuffer& fb) {
+    Image img(fb.width, fb.height);
+    img.rgb = fb.rgb;
+    return img;
+  }
+
+  int run() {
+    const Scene sc = loadScene(scene);
+    RenderOptions ro;
+    ro.method = parseMethod(method);
+    ro.brdf = brdf;
+    ro.span_mode = parseSpanMode(mode);
+    const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-render-{}", getpid());
+    auto say = [&](const std::string& m) {
+      if (!quiet) std::fprintf(stderr, "render: %s\n", m.c_str());
+    };
+    // The golden model.
+    Engines model = makeEngines(sc, ro, false, tmp);
+    say(fmt::format("{} with {} ({}), model", sc.name, method, mode));
+    RenderResult res = render(sc, ro, *model.span, model.view);
+    std::vector<double> frame_ms{res.stats.ms};
+    for (int i = 1; i < bench; ++i) {
+      Engines e = makeEngines(sc, ro, false, tmp);
+      frame_ms.push_back(render(sc, ro, *e.span, e.view).stats.ms);
+    }
+    std::sort(frame_ms.begin(), frame_ms.end());
+    const Image img = toImage(res.fb);
+    // The reference and the error against it.
+    RenderOptions rref = ro;
+    rref.method = Method::Reference;
+    Engines none;
+    none.span = std::make_unique<ModelSpanEngine>(SpanParams::forMode(SpanMode::Serial));
+    say("reference (double precision, exact pow)");
+    const RenderResult ref = render(sc, rref, *none.span, none.view);
+    ImageF reff(ref.fb.width, ref.fb.height), spec_ref(ref.fb.width, ref.fb.height);
+    // What a display shows: the reference clamped to the output range (an over-exposed
+    // highlight is 255, not its unclamped value).
+    reff.rgb = ref.fb.lsb;
+    for (double& v : reff.rgb) v = std::clamp(v, 0.0, 255.0);
+    spec_ref.rgb = ref.fb.spec_lsb;
+    PixelMask covered(img.width, img.height), highlight;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x)
+        if (res.fb.covered(x, y) && ref.fb.covered(x, y)) covered.set(x, y);
+    highlight = intersect(covered, thresholdMask(spec_ref, highlight_lsb));
+    const ImageMetrics all = imageMetrics(img, reff, covered);
+    const ImageMetrics hl = imageMetrics(img, reff, highlight);
+    const Image heat = errorHeatmap(img, reff, heat_scale, covered);
+    const Image ref_img = roundToUnorm8(reff);
+    // The RTL in the loop.
+    nlohmann::json rtl_json;
+    uint64_t mismatches = 0;
+    std::string first_mismatch;
+    if (rtl) {
+      say("the same frame with the verilated span and specular units");
+      Engines hw = makeEngines(sc, ro, true, tmp);
+      const RenderResult hres = render(sc, ro, *hw.span, hw.view);
+      fs::remove_all(tmp);
+      const Image himg = toImage(hres.fb);
+      mismatches = differingPixels(img, himg).count();
+      if (auto d = firstDifference(img, himg)) {
+        const int32_t tm = res.fb.tri[static_cast<size_t>(d->y) * img.width + d->x];
+        const int32_t th = hres.fb.tri[static_cast<size_t>(d->y) * img.width + d->x];
+        auto who = [&](const RenderResult& r, int32_t t) {
+          if (t < 0) return std::string("no triangle");
+          const ScreenTriangleInfo& i = r.triangles[static_cast<size_t>(t)];
+          return fmt::format("triangle {} of object '{}' (mesh triangle {}, screen ({:.2f},{:.2f}) ({:.2f},{:.2f}) ({:.2f},{:.2f}))",
+                             t, sc.objects[static_cast<size_t>(i.object)].name, i.mesh_triangle, i.xy[0][0], i.xy[0][1],
+                             i.xy[1][0], i.xy[1][1], i.xy[2][0], i.xy[2][1]);
+        };
+        first_mismatch = fmt::format("pixel ({}, {}): model ({}, {}, {}) written by {}; rtl ({}, {}, {}) written by {}", d->x,
+                                     d->y, d->a.r, d->a.g, d->a.b, who(res, tm), d->b.r, d->b.g, d->b.b, who(hres, th));
+      }
+      rtl_json = {{"ms", hres.stats.ms},
+                  {"span_cycles", hres.stats.span_cycles},
+                  {"spec_cycles", hres.stats.spec_cycles},
+                  {"cycles_equal", hres.stats.span_cycles == res.stats.span_cycles &&
+                                       hres.stats.spec_cycles == res.stats.spec_cycles}};
+    }
+    const RenderStats& st = res.stats;
+    nlohmann::json j = {{"scene", sc.name},
+                        {"method", method},
+                        {"brdf", brdf.empty() ? "per material" : brdf},
+                        {"mode", mode},
+                        {"width", img.width},
+                        {"height", img.height},
+                        {"triangles", st.triangles},
+                        {"culled", st.culled},
+                        {"clipped", st.clipped},
+                        {"drawn", st.drawn},
+                        {"fragments", st.fragments},
+                        {"pixels_covered", st.pixels_covered},
+                        {"cycles", st.span_cycles},
+                        {"spec_cycles", st.spec_cycles},
+                        {"spec_evaluations", st.spec_evaluations},
+                        {"divisions", st.divisions},
+                        {"ms", frame_ms[frame_ms.size() / 2]},
+                        {"frames", frame_ms.size()},
+                        {"max_abs_lsb", all.max_abs_lsb},
+                        {"psnr_db", toJson(all)["psnr_db"]},
+                        {"metrics", toJson(all)},
+                        {"highlight_lsb_threshold", highlight_lsb},
+                        {"highlight", toJson(hl)}};
+    if (rtl) {
+      j["pixel_mismatches"] = mismatches;
+      j["rtl"] = rtl_json;
+      if (!first_mismatch.empty()) j["first_mismatch"] = first_mismatch;
+    }
+    // Every output is written only now, each atomically: a failure above leaves nothing.
+    const fs::path out(output);
+    const std::string stem = (out.parent_path() / out.stem()).string();
+    writePng(output, img);
+    writePng(stem + "_reference.png", ref_img);
+    writePng(heatmap.empty() ? stem + "_error.png" : heatmap, heat);
+    if (!json_path.empty()) writeFileAtomic(json_path, j.dump(2) + "\n");
+    std::printf("%s %s %s: %llu triangles (%llu culled), %llu fragments, %llu pixels, %llu span cycles, %.2f ms; "
+                "vs reference: max %.2f LSB, PSNR %s dB, %.2f%% of pixels over 1 LSB; highlight (%llu px): max %.2f LSB\n",
+                sc.name.c_str(), method.c_str(), mode.c_str(), static_cast<unsigned long long>(st.triangles),
+                static_cast<unsigned long long>(st.culled), static_cast<unsigned long long>(st.fragments),
+                static_cast<unsigned long long>(st.pixels_covered), static_cast<unsigned long long>(st.span_cycles),
+                frame_ms[frame_ms.size() / 2], all.max_abs_lsb, toJson(all)["psnr_db"].dump().c_str(),
+                100 * all.share_over_1lsb, static_cast<unsigned long long>(hl.pixels), hl.max_abs_lsb);
+    if (rtl) {
+      std::printf("rtl in the loop: %llu pixel mismatches, %.1f ms per frame, span cycles %s\n",
+                  static_cast<unsigned long long>(mismatches), rtl_json["ms"].get<double>(),
+                  rtl_json["cycles_equal"].get<bool>() ? "equal" : "DIFFERENT");
+      if (mismatches > 0 || !rtl_json["cycles_equal"].get<bool>()) {
+        std::fprintf(stderr, "MISMATCH: %s\n", first_mismatch.c_str());
+        return 1;
+      }
+    }
+    return 0;
+  }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -479,6 +673,9 @@ int main(int argc, char** argv) {
   CLI::App* cosim_app = app.add_subcommand("cosim", "run the verilated RTL against the golden model");
   CLI::App* err_app = app.add_subcommand("spec-error", "error report of the specular unit");
   SpanCyclesCmd span_cycles;
+  RenderCmd render_cmd;
+  CLI::App* render_app = app.add_subcommand("render", "render a scene with a shading method (and the RTL in the loop)");
+  render_cmd.add(*render_app);
   CLI::App* cyc_app = app.add_subcommand("span-cycles", "cycles of the span unit per mode, and the paper's speed-up claims");
   span_cycles.add(*cyc_app);
   prom.add(*prom_app);
@@ -495,6 +692,7 @@ int main(int argc, char** argv) {
     if (cmd == cosim_app) return cosim.run();
     if (cmd == err_app) return spec_error.run();
     if (cmd == cyc_app) return span_cycles.run();
+    if (cmd == render_app) return render_cmd.run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shadesim %s: error: %s\n", cmd->get_name().c_str(), e.what());
     return 2;

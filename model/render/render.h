@@ -1,0 +1,149 @@
+// Whole-scene rendering: transform, near-plane clip, project, back-face cull, guard-band clip,
+// triangle setup, the span unit, per-pixel shading and a z-buffer.
+//
+// The span unit and the specular unit are engines: their bit-exact models here, or their
+// verilated RTL (sim/render_rtl.h), with the same interface, so the same scene rendered either
+// way must give the same framebuffer, pixel for pixel. Everything else is shared code.
+//
+// Attributes through the span unit (interpolated linearly in screen space, as the paper's
+// hardware does): 0..2 the colour (Gouraud, flat; in output LSBs, 12 fraction bits) or the
+// normal (Phong; camera space, 28 fraction bits), 3 the depth w = z_near / Z in (0, 1] with 28
+// fraction bits. w is linear in screen space for a planar triangle, so the z-test is exact and
+// the camera-space position of a pixel follows from (x, y, w) (point lights, Phong).
+// Z-test: a fragment is written where its w is strictly greater (closer) than the stored one;
+// triangles are drawn in scene order, so the image does not depend on the lane mode.
+//
+// Methods:
+//   flat               one colour per triangle: the face normal at the centroid
+//   gouraud            vertex colours, the constant increment of the span unit (paper 4.1)
+//   gouraud-classical  vertex colours; per raster line the colour is interpolated along both
+//                      edges and divided by the span length (one division per line, float, as
+//                      the idx3d listings)
+//   phong              vertex normals interpolated by the span unit, normalised exactly per pixel
+//   phong-incremental  the same normals; |N|^2 along each span by the recurrence of errata 4.1
+//                      (F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, C_1 = C: additions
+//                      only) and a fixed-point reciprocal square root (table + one Newton step)
+//   reference          per pixel in double precision: the exact barycentric normal of the pixel
+//                      centre, exact normalisation, exact pow (device lobes: the Blinn lobe they
+//                      approximate)
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "device/prom.h"
+#include "device/spec_unit.h"
+#include "raster/setup.h"
+#include "render/shading.h"
+#include "scene/scene.h"
+
+namespace shd {
+
+enum class Method { Flat, Gouraud, GouraudClassical, Phong, PhongIncremental, Reference };
+Method parseMethod(const std::string& s);  // std::invalid_argument naming the choices
+const char* toString(Method m);
+std::vector<Method> allMethods();
+
+// The span unit: fragments of one descriptor, and the cycles they took.
+class SpanEngine {
+ public:
+  virtual ~SpanEngine() = default;
+  virtual const SpanParams& params() const = 0;
+  virtual SpanRun run(const SpanDesc& d) = 0;
+};
+
+class ModelSpanEngine final : public SpanEngine {
+ public:
+  explicit ModelSpanEngine(SpanParams p) : unit_(p) {}
+  const SpanParams& params() const override { return unit_.params(); }
+  SpanRun run(const SpanDesc& d) override { return runSpanUnit(unit_, d); }
+
+ private:
+  SpanUnitModel unit_;
+};
+
+// The specular unit: a batch of evaluations streamed one per cycle.
+class SpecEngine {
+ public:
+  virtual ~SpecEngine() = default;
+  virtual const PromTable& table() const = 0;
+  // out[i] = the unorm8 RGB of in[i]; returns the cycles the batch took (with the pipeline fill).
+  virtual uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) = 0;
+};
+
+class ModelSpecEngine final : public SpecEngine {
+ public:
+  explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words) {}
+  const PromTable& table() const override { return t_; }
+  uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
+
+ private:
+  PromTable t_;
+  SpecUnitModel unit_;
+};
+
+struct RenderOptions {
+  Method method = Method::Gouraud;
+  std::string brdf;  // "" : each material's own
+  SpanMode span_mode = SpanMode::Serial;
+  int subpixel_bits = 4;
+};
+
+struct RenderStats {
+  uint64_t triangles = 0;       // input triangles of every object
+  uint64_t culled = 0;          // back faces, behind the camera, zero area on screen
+  uint64_t clipped = 0;         // triangles cut by the near plane or the guard band
+  uint64_t drawn = 0;           // screen triangles sent to the span unit
+  uint64_t fragments = 0;
+  uint64_t pixels_covered = 0;  // pixels of the final image some triangle wrote
+  uint64_t span_cycles = 0;     // span unit cycles over the frame
+  uint64_t spec_cycles = 0;     // specular unit cycles (0 when no device lobe is used)
+  uint64_t spec_evaluations = 0;
+  uint64_t divisions = 0;       // gouraud-classical: raster lines with a division
+  double ms = 0;
+};
+
+struct Framebuffer {
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;    // unorm8, row-major, top row first
+  std::vector<int64_t> depth;  // w code of the visible fragment, 0 where nothing was drawn
+  std::vector<int32_t> tri;    // id of the screen triangle that wrote the pixel, -1 none
+  std::vector<double> lsb;     // reference only: the exact colour in LSBs (3 per pixel)
+  std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
+  bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
+};
+
+// Where each screen triangle came from (for "the triangle that wrote pixel (x, y)").
+struct ScreenTriangleInfo {
+  int object = 0;
+  uint32_t mesh_triangle = 0;
+  std::array<std::array<double, 2>, 3> xy{};
+};
+
+struct RenderResult {
+  Framebuffer fb;
+  RenderStats stats;
+  std::vector<ScreenTriangleInfo> triangles;
+};
+
+// The specular units of the device lobes (null where the scene does not use the lobe).
+struct SpecEngines {
+  SpecEngine* quadratic = nullptr;  // configuration "default"
+  SpecEngine* cubic = nullptr;      // configuration "cubic"
+  SpecEngine* forLobe(Lobe l) const { return l == Lobe::Cubic ? cubic : (l == Lobe::Quadratic ? quadratic : nullptr); }
+};
+
+// The device lobes the scene uses with these options (to build only the engines needed).
+std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt);
+
+// Throws std::invalid_argument for an unknown brdf, a shininess the specular unit's PROM does
+// not hold, or a scene the pipeline cannot take (named).
+RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& spec);
+
+// The specular unit configuration for a lobe: "default" (quadratic) or "cubic".
+std::string specConfigForLobe(Lobe l);
+
+}  // namespace shd

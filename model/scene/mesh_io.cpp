@@ -1,0 +1,166 @@
+// loadMeshFile: mesh files through assimp 5.2 (the policy is documented in scene/scene.h).
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "scene/scene.h"
+
+namespace shd {
+
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& what) {
+  throw SceneError(fmt::format("{}: {}", path, what));
+}
+
+bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// The outward face normal in shadesim's convention, area-weighted: (c - a) x (b - a) (see
+// scene.h, "Handedness"; sphere.h for the winding).
+Vec3 outwardAreaNormal(const Mesh& m, const std::array<uint32_t, 3>& t) {
+  const Vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+  return cross(c - a, b - a);
+}
+
+// Faces of the plain import that post-processing cannot take: no indices, or an index past
+// the mesh's vertices (both left by truncated files).
+void checkFaces(const std::string& path, const aiScene* scene) {
+  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+    const aiMesh* am = scene->mMeshes[k];
+    if (am->mNumVertices > 0 && am->mVertices == nullptr) fail(path, fmt::format("mesh {} has no positions", k));
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices == 0 || face.mIndices == nullptr)
+        fail(path, fmt::format("mesh {} face {} has no vertex indices (truncated or malformed file)", k, f));
+      for (unsigned i = 0; i < face.mNumIndices; ++i)
+        if (face.mIndices[i] >= am->mNumVertices)
+          fail(path, fmt::format("mesh {} face {}: vertex index {} out of range (the mesh has {} "
+                                 "vertices; truncated or malformed file)",
+                                 k, f, face.mIndices[i], am->mNumVertices));
+    }
+  }
+}
+
+}  // namespace
+
+Mesh loadMeshFile(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+
+  // Two stages: the plain import, a check of its faces, then the post-processing. Merging
+  // every mesh into one needs the node transforms applied (PreTransformVertices). The check
+  // comes first because Debian's assimp 5.2 is built with its assertions on and aborts the
+  // process in TriangulateProcess on the faces a truncated ASCII PLY leaves (faces with no
+  // indices), instead of reporting an error.
+  constexpr unsigned kPostFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                  aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices;
+  Assimp::Importer importer;
+  const aiScene* scene = nullptr;
+  try {
+    scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+    if (scene != nullptr) {
+      checkFaces(path, scene);
+      scene = importer.ApplyPostProcessing(kPostFlags);
+    }
+  } catch (const SceneError&) {
+    throw;
+  } catch (const std::exception& e) {  // assimp reports through the error string; be safe
+    fail(path, fmt::format("assimp cannot read it: {}", e.what()));
+  }
+  if (scene == nullptr) fail(path, fmt::format("assimp cannot read it: {}", importer.GetErrorString()));
+  if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mNumMeshes == 0)
+    fail(path, "no triangles (the file has no meshes)");
+
+  // Merge: every mesh's vertices, then its triangles (points and lines are skipped), with
+  // z mirrored from assimp's right-handed frame into shadesim's left-handed one (scene.h).
+  Mesh raw;
+  for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
+    const aiMesh* am = scene->mMeshes[k];
+    const size_t base = raw.positions.size();
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const aiVector3D& p = am->mVertices[v];
+      const Vec3 pos{p.x, p.y, -static_cast<double>(p.z)};
+      if (!finite(pos))
+        fail(path, fmt::format("mesh {} vertex {}: position ({}, {}, {}) is not finite", k, v, p.x,
+                               p.y, p.z));
+      raw.positions.push_back(pos);
+      // NaN marks "none" (assimp leaves NaN for vertices of degenerate faces); fixed below.
+      if (am->mNormals != nullptr) {
+        const aiVector3D& n = am->mNormals[v];
+        raw.normals.push_back({n.x, n.y, -static_cast<double>(n.z)});
+      } else {
+        raw.normals.push_back({NAN, NAN, NAN});
+      }
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // a point or a line: nothing to shade
+      std::array<uint32_t, 3> t{};
+      for (int i = 0; i < 3; ++i) t[i] = static_cast<uint32_t>(base + face.mIndices[i]);
+      raw.triangles.push_back(t);
+    }
+  }
+  if (raw.triangles.empty()) fail(path, "no triangles (only points or lines)");
+
+  // Drop the triangles without area and then the vertices no triangle uses: neither can ever
+  // be drawn (a degenerate triangle projects to a segment), and afterwards every vertex has a
+  // triangle with a defined face normal.
+  Mesh m;
+  std::vector<uint32_t> remap(raw.positions.size(), UINT32_MAX);
+  for (const auto& t : raw.triangles) {
+    const Vec3 w = outwardAreaNormal(raw, t);
+    if (!(length(w) > 0.0)) continue;
+    std::array<uint32_t, 3> nt{};
+    for (int i = 0; i < 3; ++i) {
+      uint32_t& r = remap[t[i]];
+      if (r == UINT32_MAX) {
+        r = static_cast<uint32_t>(m.positions.size());
+        m.positions.push_back(raw.positions[t[i]]);
+        m.normals.push_back(raw.normals[t[i]]);
+      }
+      nt[i] = r;
+    }
+    m.triangles.push_back(nt);
+  }
+  if (m.triangles.empty()) fail(path, "no triangles with a non-zero area");
+
+  // Normals: the file's or assimp's smooth ones, normalised. A missing (NaN), infinite or
+  // zero-length one is replaced by the normalised area-weighted sum of the outward normals of
+  // the vertex's triangles (idx3d's vertex normal, sphere.h); if that sum is zero too (the
+  // triangles cancel, e.g. a two-sided sheet), the vertex has no usable normal: error.
+  std::vector<Vec3> face_sum;
+  for (size_t v = 0; v < m.normals.size(); ++v) {
+    const Vec3 n = m.normals[v];
+    const double len = length(n);
+    if (std::isfinite(len) && len > 1e-12) {
+      m.normals[v] = (1.0 / len) * n;
+      continue;
+    }
+    if (face_sum.empty()) {
+      face_sum.assign(m.positions.size(), Vec3{0, 0, 0});
+      for (const auto& t : m.triangles) {
+        const Vec3 w = outwardAreaNormal(m, t);
+        for (uint32_t i : t) face_sum[i] += w;
+      }
+    }
+    const double flen = length(face_sum[v]);
+    if (!(flen > 0.0) || !std::isfinite(flen))
+      fail(path, fmt::format("vertex at ({}, {}, {}) has a zero-length normal and its faces' "
+                             "normals cancel",
+                             m.positions[v].x, m.positions[v].y, -m.positions[v].z));
+    m.normals[v] = (1.0 / flen) * face_sum[v];
+  }
+  return m;
+}
+
+}  // namespace shd

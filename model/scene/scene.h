@@ -1,0 +1,185 @@
+// Scenes: meshes with transforms, materials, lights, the camera and the viewport, from a JSON
+// scene file (meshes loaded through assimp) or built in.
+//
+// Scene file (JSON; unknown keys and wrong types are errors naming the file and the field):
+//   {
+//     "camera":    {"eye": [0,0,-3], "target": [0,0,0], "px_per_unit": 512,
+//                   "width": 512, "height": 512, "z_near": 0.1},
+//     "ambient":   [0.0, 0.0, 0.0],
+//     "lights":    [{"type": "directional", "direction": [-1, 1, -1], "colour": [1,1,1]},
+//                   {"type": "point", "position": [2, 2, -2], "colour": [1,1,1]}],
+//     "materials": [{"name": "blue", "colour": "#3070C0" or [r,g,b] in 0..1,
+//                    "kd": 1.0, "ks": 1.0, "shininess": 32, "brdf": "blinn",
+//                    "roughness": 0.3, "f0": 0.04}],
+//     "objects":   [{"name": "teapot", "mesh": "teapot.dae" (relative to the scene file) or
+//                    "builtin:sphere(1,64)" | "builtin:torus(1,0.35,48,24)" | "builtin:plane(4,4,16)",
+//                    "material": "blue",
+//                    "transform": {"translate": [0,0,0], "rotate_deg": [0,0,0] (x, then y,
+//                                  then z), "scale": 1 or [sx,sy,sz]}}]
+//   }
+// A directional light's "direction" points from the surface toward the light (it is
+// normalised on load). brdf: phong | blinn | normalized-blinn | schlick | quadratic | cubic |
+// cook-torrance | pow (the method decides how it is evaluated).
+//
+// Rules of the file format (every violation is a SceneError "<file>: <field path>: <what>",
+// e.g. "scenes/x.json: objects[2].transform.scale: expected a number or an array of 3 numbers"):
+//   - "objects" is required and non-empty; every other top-level key is optional.
+//   - camera: each field optional (the defaults are Camera's, i.e. the default scene's);
+//     width, height integers in 1..4096; px_per_unit > 0; z_near > 0; eye != target.
+//   - ambient and light colours: 3 numbers >= 0 (above 1 is a brighter light); material colours
+//     in 0..1, or "#RRGGBB" (the hex digits / 255, taken as linear like Material's default).
+//   - lights: "type" is required; a directional light needs a non-zero "direction", a point
+//     light a "position"; the other type's field is an unknown key. "lights" may be empty.
+//   - materials: "name" required, non-empty, unique; kd, ks >= 0; shininess in [1, 1000];
+//     brdf one of the names above; roughness > 0; f0 in [0, 1]. Omitted fields take
+//     Material's defaults.
+//   - objects: "mesh" required; "name" defaults to "object<i>"; "material" names a material of
+//     the file; without it the object uses the material named "default" (the file's, or else
+//     Material{} appended to Scene::materials). transform: every field optional; scale factors
+//     must be non-zero (a negative one mirrors: worldMesh keeps front faces front).
+//   - builtin mesh sources: "builtin:sphere(radius,segments)" = idx3dSphere, "builtin:torus(
+//     major,minor,major_segments,minor_segments)" = torusMesh, "builtin:plane(size_x,size_z,
+//     divisions)" = planeMesh; without the parenthesis the defaults sphere(1,64),
+//     torus(1,0.35,48,24), plane(4,4,16). Segments/divisions are integers, at most 1024.
+//   - every number must be finite (JSON has no NaN, but 1e999 reads as infinity).
+//   The same mesh file named by several objects is loaded once.
+//
+// Transforms: world = translate * rotate * scale * object, rotate = Rz * Ry * Rx (x first),
+// each the usual matrix acting on column vectors, e.g. Rx(a) = [1 0 0; 0 c -s; 0 s c]. In
+// shadesim's left-handed frame (x right, y up, z into the screen, sphere.h) a positive angle
+// about y turns +z toward +x.
+//
+// Handedness of mesh files: assimp delivers right-handed data with counter-clockwise front
+// faces, i.e. outward normal = (b - a) x (c - a). Shadesim's frame is left-handed with the
+// outward normal = (c - a) x (b - a) (idx3d's winding, sphere.h). loadMeshFile therefore
+// mirrors z (positions and normals) and keeps the vertex order: the mirror turns the winding
+// rule of one frame into the other's, and the model looks as in its authoring tool (a
+// right-handed viewer looking down -z shows the same image as shadesim's camera looking down
+// +z at the mirrored model). A model authored facing +z faces the default camera.
+//
+// Builtin scenes (loadScene("builtin:<name>"); builtinSceneNames() lists them):
+//   sphere     DESIGN.md's default scene: idx3dSphere(1, 64), Camera{} (eye (0,0,-3), target
+//              origin, 512 px per unit, 512x512, z_near 0.1), one white directional light with
+//              direction (-1, 1, -1)/sqrt 3 ("toward the upper left front": -x is left, +y up,
+//              -z is toward the viewer), material Material{} (0x3070C0, kd 1, ks 1, n 32,
+//              blinn), ambient 0.
+//   plane      the paper's flat-surface case (Fig. 4 c, d): planeMesh(8, 8, 64) translated to
+//              z in [-3, 5], camera eye (0, 1, -3) looking at the origin (18.4 deg below the
+//              horizon), a white point light at (0, 0.5, 1.5), low over the plane behind the
+//              origin, material 0x405060, kd 1, ks 1, n 300, blinn. With the renderer's infinite
+//              viewer (V = the camera's backward axis, render/shading.h) a directional light
+//              would light a plane uniformly; the point light's L varies instead, and it is
+//              placed so that the mirror direction of V points at it from the origin: the
+//              highlight peaks at the centre of the image, the light meets the surface 18.4 deg
+//              above grazing (71.6 deg from the normal). There Blinn's highlight is a streak
+//              running from the centre toward the viewer (N.H > cos-level contour ~110 x 280 px
+//              for 0.1) while Phong's is a compact, nearly round spot (~70 x 90 px): the
+//              elongation the paper describes. n = 300 keeps both inside the plane's image.
+//   torus      torusMesh(1, 0.4, 64, 32) in the x-z plane, camera eye (0, 2.2, -3.2) looking at
+//              the origin (34.5 deg from above: the hole is visible), the default light,
+//              material 0xC06030, n 32, blinn.
+//   materials  five idx3dSphere(0.42, 32) in a row, centres x = -1.9 .. 1.9 (step 0.95),
+//              camera eye (0, 0, -10), 1024 px per unit (little perspective distortion), the
+//              default light; shininess 1, 8, 32, 200, 1000 with brdf phong, cubic, blinn,
+//              schlick, quadratic and colours red, orange, blue (0x3070C0), green, purple.
+//              (The cubic device holds n <= 256, the quadratic one n <= 1000.)
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "scene/sphere.h"
+#include "scene/vec.h"
+
+namespace shd {
+
+// Row-major affine transform.
+struct Mat4 {
+  double m[4][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+  static Mat4 translate(Vec3 t);
+  static Mat4 scale(Vec3 s);
+  static Mat4 rotateDeg(Vec3 xyz);  // rotation about x, then y, then z
+  Mat4 operator*(const Mat4& o) const;
+  Vec3 point(Vec3 p) const;
+  Vec3 direction(Vec3 d) const;  // no translation
+  Vec3 normal(Vec3 n) const;     // by the inverse transpose, normalised
+  double determinant3() const;   // of the linear (upper-left 3x3) part; < 0 mirrors
+};
+
+struct Material {
+  std::string name = "default";
+  Vec3 colour{0x30 / 255.0, 0x70 / 255.0, 0xC0 / 255.0};  // base colour, linear 0..1
+  double kd = 1.0, ks = 1.0;
+  double shininess = 32;  // n in [1, 1000]
+  std::string brdf = "blinn";
+  double roughness = 0.3, f0 = 0.04;  // cook-torrance
+};
+
+struct Light {
+  enum class Kind { Directional, Point };
+  Kind kind = Kind::Directional;
+  Vec3 direction{-1, 1, -1};  // directional: toward the light, unit length
+  Vec3 position{0, 0, 0};     // point
+  Vec3 colour{1, 1, 1};
+};
+
+struct SceneObject {
+  std::string name;
+  std::string source;  // the mesh file or builtin generator it came from
+  Mesh mesh;           // object space
+  Mat4 transform;      // object -> world
+  int material = 0;    // index into Scene::materials
+};
+
+struct Scene {
+  std::string name;  // "builtin:sphere" or the file path
+  Camera camera;
+  Vec3 ambient{0, 0, 0};
+  std::vector<Light> lights;
+  std::vector<Material> materials;
+  std::vector<SceneObject> objects;
+};
+
+// A clear error naming the file (or builtin) and the field.
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// "builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials", or a JSON file.
+Scene loadScene(const std::string& spec);
+// The builtin specs, with the prefix: {"builtin:sphere", "builtin:plane", "builtin:torus",
+// "builtin:materials"}.
+std::vector<std::string> builtinSceneNames();
+
+// An object's mesh in world space: positions by transform.point, normals by transform.normal;
+// a mirroring transform (determinant3 < 0) also swaps two vertices of every triangle, so the
+// winding rule (sphere.h) still holds. The identity transform returns the mesh unchanged.
+Mesh worldMesh(const SceneObject& obj);
+
+// All meshes of a file through assimp (triangulated, identical vertices joined, smooth normals
+// generated where the file has none), in one Mesh. SceneError for a missing, empty, truncated or
+// unsupported file, NaN/infinite coordinates or zero-length normals (named with the file).
+// Details:
+//   - node transforms are applied (PreTransformVertices) and every mesh is merged, in file
+//     order; points and lines are dropped; z is mirrored (see "Handedness" above);
+//   - triangles with zero area are dropped, then the vertices no triangle uses (neither can be
+//     drawn); a file left without triangles is an error;
+//   - normals are normalised; a missing, non-finite or zero-length one (assimp leaves NaN at
+//     vertices of degenerate faces) is replaced by the normalised area-weighted sum of the
+//     vertex's face normals; if that sum is zero as well (faces that cancel, as a two-sided
+//     sheet), SceneError.
+Mesh loadMeshFile(const std::string& path);
+
+// A torus about the y axis: centre circle of radius major_radius in the x-z plane, tube radius
+// minor_radius (0 < minor < major). major_segments x minor_segments vertices (shared, no seam
+// duplicates), 2 * major_segments * minor_segments triangles; exact positions (angles at
+// multiples of 90 deg exact) and analytic unit normals; idx3d's winding. Segments >= 3.
+// Throws std::invalid_argument otherwise.
+Mesh torusMesh(double major_radius, double minor_radius, int major_segments, int minor_segments);
+// A size_x by size_z grid centred on the origin in y = 0, normal +y, front face seen from +y:
+// (divisions + 1)^2 vertices, 2 divisions^2 triangles. Sizes > 0, divisions >= 1, else
+// std::invalid_argument.
+Mesh planeMesh(double size_x, double size_z, int divisions);  // in y = 0, normal +y
+
+}  // namespace shd
