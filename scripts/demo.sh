@@ -41,5 +41,24 @@ echo "== 5. span unit: cycles per mode on the size classes and the idx3d sphere,
 mv "$out/span_cycles.txt.tmp" "$out/span_cycles.txt"
 cat "$out/span_cycles.txt"
 
+echo "== 6. builtin:sphere rendered with the main methods, by the model and with the RTL in the loop (out/render/)"
+mkdir -p "$out/render"
+for method in flat gouraud gouraud-classical phong phong-incremental; do
+  for brdf in blinn quadratic; do
+    "$S" render --scene builtin:sphere --method "$method" --brdf "$brdf" --rtl --quiet \
+      -o "$out/render/sphere_${method}_${brdf}.png" --json "$out/render/sphere_${method}_${brdf}.json" > /dev/null
+  done
+done
+python3 - "$out/render" > "$out/render/summary.txt" <<'PY'
+import glob, json, os, sys
+rows = [json.load(open(f)) for f in sorted(glob.glob(os.path.join(sys.argv[1], "sphere_*.json")))]
+print(f"{'method':<18} {'brdf':<10} {'max LSB':>8} {'PSNR dB':>8} {'>1 LSB':>7} {'hl max':>7} {'cycles':>8} {'spec cyc':>9} {'ms':>7} {'rtl ms':>7} {'mismatch':>8}")
+for j in rows:
+    psnr = j["psnr_db"] if j["psnr_db"] is not None else float("inf")
+    print(f"{j['method']:<18} {j['brdf']:<10} {j['max_abs_lsb']:>8.2f} {psnr:>8.2f} {100*j['metrics']['share_over_1lsb']:>6.2f}% "
+          f"{j['highlight']['max_abs_lsb']:>7.2f} {j['cycles']:>8} {j['spec_cycles']:>9} {j['ms']:>7.1f} {j['rtl']['ms']:>7.1f} {j['pixel_mismatches']:>8}")
+PY
+cat "$out/render/summary.txt"
+
 echo "== results in $out"
 ls -1 "$out"
