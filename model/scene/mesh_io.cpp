@@ -3,9 +3,11 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <cctype>
 #include <cmath>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -29,6 +31,24 @@ bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::is
 Vec3 outwardAreaNormal(const Mesh& m, const std::array<uint32_t, 3>& t) {
   const Vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
   return cross(c - a, b - a);
+}
+
+// assimp 5.2's PLY reader loops forever on a header without "end_header" (a file cut inside its
+// header): refuse such a file before assimp sees it. A PLY file starts with "ply" and a newline.
+void checkPlyHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  in.read(magic, 4);
+  if (in.gcount() < 4 || magic[0] != 'p' || magic[1] != 'l' || magic[2] != 'y' ||
+      (magic[3] != '\n' && magic[3] != '\r'))
+    return;
+  // The header is ASCII lines; real headers are a few hundred bytes, comments included.
+  std::string line;
+  for (int lines = 0; lines < 10000 && std::getline(in, line); ++lines) {
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    if (line == "end_header") return;
+  }
+  fail(path, "PLY header without end_header (truncated file)");
 }
 
 // Faces of the plain import that post-processing cannot take: no indices, or an index past
@@ -56,6 +76,7 @@ Mesh loadMeshFile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  checkPlyHeader(path);
 
   // Two stages: the plain import, a check of its faces, then the post-processing. Merging
   // every mesh into one needs the node transforms applied (PreTransformVertices). The check
@@ -134,31 +155,35 @@ Mesh loadMeshFile(const std::string& path) {
   }
   if (m.triangles.empty()) fail(path, "no triangles with a non-zero area");
 
-  // Normals: the file's or assimp's smooth ones, normalised. A missing (NaN), infinite or
-  // zero-length one is replaced by the normalised area-weighted sum of the outward normals of
-  // the vertex's triangles (idx3d's vertex normal, sphere.h); if that sum is zero too (the
-  // triangles cancel, e.g. a two-sided sheet), the vertex has no usable normal: error.
-  std::vector<Vec3> face_sum;
+  // Normals: the file's or assimp's smooth ones, normalised, checked against the faces. face_sum
+  // is the area-weighted sum of the outward normals of a vertex's triangles (idx3d's vertex
+  // normal, sphere.h).
+  //   - A missing (NaN), infinite or zero-length normal is replaced by normalize(face_sum); if
+  //     face_sum is zero too (the triangles cancel, e.g. a two-sided sheet), the vertex has no
+  //     usable normal: error.
+  //   - A normal pointing against face_sum is negated. The winding decides the outside (it is
+  //     what back-face culling uses); a file normal only refines the direction. Files whose
+  //     normals are inverted against a correct winding exist (assimp-testmodels'
+  //     STL/Spider_*.stl: every facet normal points inward), and shading them unflipped would
+  //     light the back of every visible face.
+  std::vector<Vec3> face_sum(m.positions.size(), Vec3{0, 0, 0});
+  for (const auto& t : m.triangles) {
+    const Vec3 w = outwardAreaNormal(m, t);
+    for (uint32_t i : t) face_sum[i] += w;
+  }
   for (size_t v = 0; v < m.normals.size(); ++v) {
-    const Vec3 n = m.normals[v];
+    const Vec3 n = m.normals[v], f = face_sum[v];
     const double len = length(n);
     if (std::isfinite(len) && len > 1e-12) {
-      m.normals[v] = (1.0 / len) * n;
+      m.normals[v] = (dot(n, f) < 0 ? -1.0 / len : 1.0 / len) * n;
       continue;
     }
-    if (face_sum.empty()) {
-      face_sum.assign(m.positions.size(), Vec3{0, 0, 0});
-      for (const auto& t : m.triangles) {
-        const Vec3 w = outwardAreaNormal(m, t);
-        for (uint32_t i : t) face_sum[i] += w;
-      }
-    }
-    const double flen = length(face_sum[v]);
+    const double flen = length(f);
     if (!(flen > 0.0) || !std::isfinite(flen))
       fail(path, fmt::format("vertex at ({}, {}, {}) has a zero-length normal and its faces' "
                              "normals cancel",
                              m.positions[v].x, m.positions[v].y, -m.positions[v].z));
-    m.normals[v] = (1.0 / flen) * face_sum[v];
+    m.normals[v] = (1.0 / flen) * f;
   }
   return m;
 }

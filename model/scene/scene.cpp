@@ -638,7 +638,7 @@ Scene loadSceneFile(const std::string& file) {
   json root;
   try {
     root = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // parse_error; out_of_range for 1e999
     throw SceneError(fmt::format("{}: not valid JSON: {}", file, e.what()));
   }
   return SceneReader(file).read(root);

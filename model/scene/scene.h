@@ -41,7 +41,8 @@
 //     major,minor,major_segments,minor_segments)" = torusMesh, "builtin:plane(size_x,size_z,
 //     divisions)" = planeMesh; without the parenthesis the defaults sphere(1,64),
 //     torus(1,0.35,48,24), plane(4,4,16). Segments/divisions are integers, at most 1024.
-//   - every number must be finite (JSON has no NaN, but 1e999 reads as infinity).
+//   - every number must be finite (JSON has no NaN or infinity; an overflowing literal such as
+//     1e999 is reported as "not valid JSON").
 //   The same mesh file named by several objects is loaded once.
 //
 // Transforms: world = translate * rotate * scale * object, rotate = Rz * Ry * Rx (x first),
@@ -64,17 +65,20 @@
 //              -z is toward the viewer), material Material{} (0x3070C0, kd 1, ks 1, n 32,
 //              blinn), ambient 0.
 //   plane      the paper's flat-surface case (Fig. 4 c, d): planeMesh(8, 8, 64) translated to
-//              z in [-3, 5], camera eye (0, 1, -3) looking at the origin (18.4 deg below the
-//              horizon), a white point light at (0, 0.5, 1.5), low over the plane behind the
-//              origin, material 0x405060, kd 1, ks 1, n 300, blinn. With the renderer's infinite
-//              viewer (V = the camera's backward axis, render/shading.h) a directional light
-//              would light a plane uniformly; the point light's L varies instead, and it is
-//              placed so that the mirror direction of V points at it from the origin: the
-//              highlight peaks at the centre of the image, the light meets the surface 18.4 deg
-//              above grazing (71.6 deg from the normal). There Blinn's highlight is a streak
-//              running from the centre toward the viewer (N.H > cos-level contour ~110 x 280 px
-//              for 0.1) while Phong's is a compact, nearly round spot (~70 x 90 px): the
-//              elongation the paper describes. n = 300 keeps both inside the plane's image.
+//              z in [-3, 5] (8192 triangles; nothing behind the eye), camera eye (0, 1, -3)
+//              looking at the origin (18.4 deg below the horizon), one white point light at
+//              (0, 0.5, 1.5), low over the plane beyond the origin; material 0x405060, kd 1,
+//              ks 1, n 300, blinn. Why a point light: with the renderer's infinite viewer
+//              (V = the camera's backward axis, render/shading.h) a directional light gives
+//              every point of a plane the same N.H and R.V, i.e. no highlight shape at all; a
+//              point light's L varies. It sits where the mirror direction of V at the origin
+//              points, so the highlight peaks at the image centre with the light 18.4 deg above
+//              the surface (71.6 deg from the normal: grazing). There, lobe > 0.1 covers for
+//              Blinn a streak 114 x 286 px running from the centre (y 226) to the bottom edge,
+//              for Phong a compact spot 76 x 92 px (test_scene measures it per pixel): the
+//              elongated Blinn highlight of the paper. n = 300 keeps Phong's spot and the
+//              streak's width well inside the image; the diffuse term is dim (N.L ~ 0.3 at the
+//              peak), so the highlight dominates.
 //   torus      torusMesh(1, 0.4, 64, 32) in the x-z plane, camera eye (0, 2.2, -3.2) looking at
 //              the origin (34.5 deg from above: the hole is visible), the default light,
 //              material 0xC06030, n 32, blinn.
@@ -83,6 +87,10 @@
 //              default light; shininess 1, 8, 32, 200, 1000 with brdf phong, cubic, blinn,
 //              schlick, quadratic and colours red, orange, blue (0x3070C0), green, purple.
 //              (The cubic device holds n <= 256, the quadratic one n <= 1000.)
+//   Front faces (projectFrontFaces of every object's worldMesh, test_scene): sphere 2088 of
+//   8190; plane 8192 of 8192 (seen from above; 4269 touch the viewport, the rest reach into
+//   the guard band); torus 1872 of 4096; materials 4336 of 10230. All but the plane's lie
+//   wholly inside the 512x512 viewport.
 #pragma once
 
 #include <stdexcept>
@@ -161,14 +169,27 @@ Mesh worldMesh(const SceneObject& obj);
 // generated where the file has none), in one Mesh. SceneError for a missing, empty, truncated or
 // unsupported file, NaN/infinite coordinates or zero-length normals (named with the file).
 // Details:
+//   - every error reads "<path>: <what>"; assimp's own error string follows "assimp cannot
+//     read it: ";
 //   - node transforms are applied (PreTransformVertices) and every mesh is merged, in file
 //     order; points and lines are dropped; z is mirrored (see "Handedness" above);
 //   - triangles with zero area are dropped, then the vertices no triangle uses (neither can be
 //     drawn); a file left without triangles is an error;
-//   - normals are normalised; a missing, non-finite or zero-length one (assimp leaves NaN at
+//   - normals are normalised. A missing, non-finite or zero-length one (assimp leaves NaN at
 //     vertices of degenerate faces) is replaced by the normalised area-weighted sum of the
-//     vertex's face normals; if that sum is zero as well (faces that cancel, as a two-sided
-//     sheet), SceneError.
+//     vertex's outward face normals; if that sum is zero as well (faces that cancel, as a
+//     two-sided sheet), SceneError. A normal pointing against that sum is negated: the
+//     winding decides the outside, as it does for culling (assimp-testmodels' STL spiders have
+//     an outward winding and inward facet normals). A file wound inside out throughout loads
+//     inside out (OFF/Wuson.off);
+//   - truncated files: the faces of the plain import are checked before post-processing (a
+//     truncated ASCII PLY leaves faces without indices, on which Debian's assimp 5.2 aborts
+//     in an assertion instead of failing), and a PLY header without end_header is refused up
+//     front (assimp 5.2 loops forever on it). A text file cut at a line boundary is a valid
+//     smaller file and loads. Not guarded: assimp 5.2 terminates the process on some
+//     truncated COB files (an exception thrown where it cannot be caught), and a file that
+//     declares billions of elements (invalid/OutOfMemory.off) makes it allocate them: under a
+//     memory limit that is a SceneError (std::bad_alloc), without one it takes the memory.
 Mesh loadMeshFile(const std::string& path);
 
 // A torus about the y axis: centre circle of radius major_radius in the x-z plane, tube radius
