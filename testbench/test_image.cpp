@@ -5,6 +5,8 @@
 #include "image/metrics.h"
 
 #include <gtest/gtest.h>
+
+#include "test_util.h"
 #include <nlohmann/json.hpp>
 
 #include <cmath>
@@ -28,22 +30,6 @@ using shd::Rgb8;
 namespace {
 
 constexpr uint32_t kSeed = 20261122;
-
-fs::path testDir() {
-  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir =
-      fs::path(testing::TempDir()) / "test_image" / (std::string(info->test_suite_name()) + "." + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::vector<std::string> dirEntries(const fs::path& dir) {
-  std::vector<std::string> out;
-  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
-  std::sort(out.begin(), out.end());
-  return out;
-}
 
 std::string readAll(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -141,7 +127,7 @@ TEST(PixelMask, ThresholdIsStrictOnTheLargestChannelAndIntersectIsAnd) {
 TEST(Png, RoundTripIsByteExactForRandomImages) {
   std::cout << "seed " << kSeed << "\n";
   std::mt19937 rng(kSeed);
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const int sizes[][2] = {{1, 1}, {3, 7}, {7, 3}, {1, 300}, {300, 1}, {512, 512}};
   for (const auto& s : sizes) {
     const Image img = randomImage(s[0], s[1], rng);
@@ -152,12 +138,12 @@ TEST(Png, RoundTripIsByteExactForRandomImages) {
     ASSERT_EQ(back.height, img.height);
     EXPECT_TRUE(back == img) << s[0] << "x" << s[1] << " differs after the round trip";
   }
-  EXPECT_EQ(dirEntries(dir).size(), std::size(sizes));  // no temporaries left
+  EXPECT_EQ(shd::testutil::dirEntries(dir).size(), std::size(sizes));  // no temporaries left
 }
 
 TEST(Png, EncodingIsAPureFunctionOfThePixels) {
   std::mt19937 rng(kSeed + 1);
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const Image img = randomImage(33, 17, rng);
   shd::writePng((dir / "a.png").string(), img);
   shd::writePng((dir / "b.png").string(), img);
@@ -167,36 +153,36 @@ TEST(Png, EncodingIsAPureFunctionOfThePixels) {
 }
 
 TEST(Png, MissingDirectoryThrowsAndLeavesNothing) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const fs::path p = dir / "no_such_dir" / "out.png";
   const std::string e = errorOf<std::runtime_error>([&] { shd::writePng(p.string(), filled(2, 2, 1, 2, 3)); });
   EXPECT_NE(e.find(p.string()), std::string::npos) << e;
   EXPECT_FALSE(fs::exists(dir / "no_such_dir"));
-  EXPECT_TRUE(dirEntries(dir).empty());
+  EXPECT_TRUE(shd::testutil::dirEntries(dir).empty());
 }
 
 TEST(Png, OverwriteReplacesTheFileWithNoTemporaryLeft) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const fs::path p = dir / "frame.png";
   shd::writePng(p.string(), filled(4, 4, 10, 20, 30));
   const Image second = filled(9, 5, 200, 100, 0);
   shd::writePng(p.string(), second);
   EXPECT_TRUE(shd::readPng(p.string()) == second);
-  EXPECT_EQ(dirEntries(dir), std::vector<std::string>{"frame.png"});
+  EXPECT_EQ(shd::testutil::dirEntries(dir), std::vector<std::string>{"frame.png"});
 }
 
 TEST(Png, WriteOverADirectoryThrowsAndLeavesItAlone) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const fs::path target = dir / "frame.png";
   fs::create_directory(target);
   const std::string e = errorOf<std::runtime_error>([&] { shd::writePng(target.string(), filled(1, 1, 0, 0, 0)); });
   EXPECT_NE(e.find(target.string()), std::string::npos) << e;
-  EXPECT_EQ(dirEntries(dir), std::vector<std::string>{"frame.png"});
+  EXPECT_EQ(shd::testutil::dirEntries(dir), std::vector<std::string>{"frame.png"});
   EXPECT_TRUE(fs::is_directory(target));
 }
 
 TEST(Png, WriteRejectsEmptyAndMisSizedImages) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const std::string p = (dir / "x.png").string();
   std::string e = errorOf<std::invalid_argument>([&] { shd::writePng(p, Image()); });
   EXPECT_NE(e.find(p), std::string::npos) << e;
@@ -204,12 +190,12 @@ TEST(Png, WriteRejectsEmptyAndMisSizedImages) {
   bad.rgb.pop_back();
   e = errorOf<std::invalid_argument>([&] { shd::writePng(p, bad); });
   EXPECT_NE(e.find("11 bytes, expected 12"), std::string::npos) << e;
-  EXPECT_TRUE(dirEntries(dir).empty());
+  EXPECT_TRUE(shd::testutil::dirEntries(dir).empty());
 }
 
 TEST(Png, ReadRejectsMissingTruncatedAndCorruptFilesNamingThem) {
   std::mt19937 rng(kSeed + 2);
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_image");
   const fs::path good = dir / "good.png";
   shd::writePng(good.string(), randomImage(64, 48, rng));  // random: incompressible, a long IDAT
   const std::string bytes = readAll(good);
@@ -261,7 +247,7 @@ TEST(Png, ReadRefusesAHeaderAskingForTooManyPixels) {
       "\x86\xa0\x08\x02\x00\x00\x00\x27\x30\x9c\x9f\x00\x00\x00\x08\x49\x44\x41\x54\x78\x9c\x03\x00"
       "\x00\x00\x00\x01\x48\x06\x89\xd2\x00\x00\x00\x00\x49\x45\x4e\x44\xae\x42\x60\x82",
       65);
-  const fs::path p = testDir() / "huge.png";
+  const fs::path p = shd::testutil::freshTestDir("test_image") / "huge.png";
   writeAll(p, huge);
   const std::string e = errorOf<std::runtime_error>([&] { shd::readPng(p.string()); });
   EXPECT_NE(e.find(p.string()), std::string::npos) << e;

@@ -4,6 +4,8 @@
 #include "device/prom_io.h"
 
 #include <gtest/gtest.h>
+
+#include "test_util.h"
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -168,22 +170,6 @@ std::vector<std::string> splitCsv(const std::string& l) {
   return out;
 }
 
-// A fresh directory per test under testing::TempDir().
-fs::path testDir() {
-  const auto* info = testing::UnitTest::GetInstance()->current_test_info();
-  const fs::path dir =
-      fs::path(testing::TempDir()) / "test_prom_io" / (std::string(info->test_suite_name()) + "." + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::vector<std::string> dirEntries(const fs::path& dir) {
-  std::vector<std::string> out;
-  for (const auto& e : fs::directory_iterator(dir)) out.push_back(e.path().filename().string());
-  return out;
-}
-
 void writePlain(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
@@ -246,7 +232,7 @@ TEST(PromTables, FixtureShapes) {
 }
 
 TEST(PromHex, RoundTripsThroughReader) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_prom_io");
   for (const PromTable& t : tables()) {
     const std::string text = shd::renderProm(t, PromFormat::Hex);
     const std::vector<std::string> data = dataLines(text);
@@ -388,7 +374,7 @@ TEST(PromRender, RejectsATableOfTheWrongDepth) {
 }
 
 TEST(PromHexReader, RejectsBrokenFilesNamingTheLine) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_prom_io");
   const PromTable t = degree2Table();  // 8 words of 24 bits
   const std::string good = shd::renderProm(t, PromFormat::Hex);
   const int header = static_cast<int>(lines(good).size()) - 8;  // comment lines before the data
@@ -457,14 +443,14 @@ TEST(PromHexReader, RejectsBrokenFilesNamingTheLine) {
 }
 
 TEST(PromHexReader, AcceptsCommentsBlankLinesCrlfAndSeveralWordsPerLine) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_prom_io");
   writePlain(dir / "loose.hex", "// a\r\n\r\n1 2 // two words\r\n\t3\r\nFF\r\n");
   const std::vector<PromWord> w = shd::readPromHex((dir / "loose.hex").string(), 8, 4);
   EXPECT_EQ(w, (std::vector<PromWord>{1, 2, 3, 0xff}));
 }
 
 TEST(WriteFileAtomic, WritesAndReplacesLeavingNoTemporary) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_prom_io");
   const fs::path p = dir / "rom.hex";
   shd::writeFileAtomic(p.string(), "first\n");
   EXPECT_EQ(readAll(p), "first\n");
@@ -472,29 +458,29 @@ TEST(WriteFileAtomic, WritesAndReplacesLeavingNoTemporary) {
   EXPECT_EQ(readAll(p), "second, longer content\n");
   shd::writeFileAtomic((dir / "empty").string(), "");
   EXPECT_EQ(fs::file_size(dir / "empty"), 0u);
-  std::vector<std::string> entries = dirEntries(dir);
+  std::vector<std::string> entries = shd::testutil::dirEntries(dir);
   std::sort(entries.begin(), entries.end());
   EXPECT_EQ(entries, (std::vector<std::string>{"empty", "rom.hex"}));
 }
 
 TEST(WriteFileAtomic, MissingDirectoryThrowsAndCreatesNothing) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_prom_io");
   const fs::path p = dir / "no_such_dir" / "rom.hex";
   const std::string e = runtimeError([&] { shd::writeFileAtomic(p.string(), "x\n"); });
   EXPECT_NE(e.find(p.string()), std::string::npos) << e;
   EXPECT_NE(e.find("No such file or directory"), std::string::npos) << e;
   EXPECT_FALSE(fs::exists(dir / "no_such_dir"));
-  EXPECT_TRUE(dirEntries(dir).empty());
+  EXPECT_TRUE(shd::testutil::dirEntries(dir).empty());
 }
 
 TEST(WriteFileAtomic, TargetIsADirectoryThrowsAndRemovesTheTemporary) {
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("test_prom_io");
   const fs::path target = dir / "rom.hex";
   fs::create_directory(target);
   const std::string e = runtimeError([&] { shd::writeFileAtomic(target.string(), "x\n"); });
   EXPECT_NE(e.find(target.string()), std::string::npos) << e;
   EXPECT_NE(e.find("rename"), std::string::npos) << e;
-  EXPECT_EQ(dirEntries(dir), std::vector<std::string>{"rom.hex"});
+  EXPECT_EQ(shd::testutil::dirEntries(dir), std::vector<std::string>{"rom.hex"});
   EXPECT_TRUE(fs::is_directory(target));
   EXPECT_TRUE(fs::is_empty(target));
 }

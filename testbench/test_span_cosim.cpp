@@ -2,6 +2,8 @@
 // every mode, with random back-pressure and descriptor gaps.
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include <filesystem>
 #include <fstream>
 
@@ -12,14 +14,6 @@ using namespace shd;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path testDir() {
-  const testing::TestInfo* t = testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = std::string(t->test_suite_name()) + "." + t->name();
-  for (char& ch : name)
-    if (ch == '/') ch = '_';
-  return fs::path(testing::TempDir()) / "span_cosim" / name;
-}
 
 // Generator triangles through setup for `mode`; triangles setup drops are skipped.
 std::function<bool(SpanDesc&)> stream(SpanMode mode, uint64_t seed, long count) {
@@ -37,7 +31,7 @@ TEST_P(SpanCosimModes, RandomTrianglesWithBackPressure) {
   const SpanMode mode = parseSpanMode(GetParam());
   SpanCosimOptions o;
   o.seed = 31;
-  o.fail_dir = testDir().string();
+  o.fail_dir = shd::testutil::freshTestDir("span_cosim").string();
   const SpanCosimResult r = runSpanCosim(GetParam(), stream(mode, 20261122, 30000), o);
   std::printf("span %s: %llu triangles, %llu fragments, %llu cycles, %llu mismatches, %.2f s\n", GetParam().c_str(),
               static_cast<unsigned long long>(r.triangles), static_cast<unsigned long long>(r.fragments),
@@ -54,7 +48,7 @@ TEST(SpanCosim, DetectsAModelOfAnotherLaneLayout) {
   // The checker must be able to fail: seg2 and evenodd draw the same pixels with the same
   // values but put them in different lanes and cycles.
   SpanCosimOptions o;
-  o.fail_dir = testDir().string();
+  o.fail_dir = shd::testutil::freshTestDir("span_cosim").string();
   o.model_params = SpanParams::forMode(SpanMode::EvenOdd);
   const SpanCosimResult r = runSpanCosim("seg2", stream(SpanMode::Seg2, 5, 200), o);
   ASSERT_GT(r.mismatches, 0u);

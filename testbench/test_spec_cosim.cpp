@@ -1,6 +1,8 @@
 // Co-simulation of the verilated shd_spec_unit against SpecUnitModel, cycle by cycle.
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include <filesystem>
 #include <fstream>
 
@@ -22,20 +24,11 @@ struct CosimSetup {
 };
 
 // The configuration's table, written as the hex file the simulator loads.
-// ctest runs each test as its own process, in parallel: each test keeps its files apart.
-fs::path testDir() {
-  const testing::TestInfo* t = testing::UnitTest::GetInstance()->current_test_info();
-  std::string name = std::string(t->test_suite_name()) + "." + t->name();
-  for (char& ch : name)
-    if (ch == '/') ch = '_';
-  return fs::path(testing::TempDir()) / "spec_cosim" / name;
-}
-
 CosimSetup setup(const std::string& name) {
   CosimSetup s;
   s.cfg = SpecUnitConfig::load(configPath(name));
   s.table = buildPromTable(PromRequest::fromContent(s.cfg.prom), s.cfg.rtl);
-  const fs::path dir = testDir();
+  const fs::path dir = shd::testutil::freshTestDir("spec_cosim");
   fs::create_directories(dir);
   s.prom_path = (dir / fmt::format("spec_{}.hex", name)).string();
   writeFileAtomic(s.prom_path, renderProm(s.table, PromFormat::Hex));
@@ -45,7 +38,7 @@ CosimSetup setup(const std::string& name) {
 SpecCosimOptions options(const CosimSetup& s) {
   SpecCosimOptions o;
   o.prom_path = s.prom_path;
-  o.fail_dir = testDir().string();
+  o.fail_dir = fs::path(s.prom_path).parent_path().string();  // the test's directory
   return o;
 }
 

@@ -1,0 +1,34 @@
+// Helpers shared by the test suites.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace shd::testutil {
+
+// A fresh, empty directory for the running test: <TempDir>/<area>/<Suite.Test> ('/' of
+// parameterised names replaced). ctest runs the tests of a file as parallel processes, so each
+// test keeps its files apart.
+inline std::filesystem::path freshTestDir(const std::string& area) {
+  const testing::TestInfo* t = testing::UnitTest::GetInstance()->current_test_info();
+  std::string name = std::string(t->test_suite_name()) + "." + t->name();
+  std::replace(name.begin(), name.end(), '/', '_');
+  const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / area / name;
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// The names in a directory, sorted.
+inline std::vector<std::string> dirEntries(const std::filesystem::path& dir) {
+  std::vector<std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) out.push_back(e.path().filename().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace shd::testutil
