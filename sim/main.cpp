@@ -480,8 +480,10 @@ struct RenderCmd {
 
   void add(CLI::App& app) {
     app.add_option("--scene", scene, "builtin:sphere | builtin:plane | builtin:torus | builtin:materials or a JSON file");
-    app.add_option("--method", method, "flat | gouraud | gouraud-classical | phong | phong-incremental | reference")
-        ->check(CLI::IsMember({"flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "reference"}));
+    app.add_option("--method", method,
+                   "flat | gouraud | gouraud-classical | phong | phong-incremental | modified-gouraud | adaptive | reference")
+        ->check(CLI::IsMember({"flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "modified-gouraud",
+                               "adaptive", "reference"}));
     app.add_option("--brdf", brdf, "override every material's brdf: phong | blinn | normalized-blinn | schlick | "
                                    "quadratic | cubic | cook-torrance | pow")
         ->check(CLI::IsMember({"phong", "blinn", "normalized-blinn", "schlick", "quadratic", "cubic", "cook-torrance", "pow"}));
@@ -621,6 +623,9 @@ struct RenderCmd {
                         {"spec_cycles", st.spec_cycles},
                         {"spec_evaluations", st.spec_evaluations},
                         {"divisions", st.divisions},
+                        {"split_parts", st.split_parts},
+                        {"adaptive_gouraud", st.adaptive_gouraud},
+                        {"adaptive_phong", st.adaptive_phong},
                         {"ms", frame_ms[frame_ms.size() / 2]},
                         {"frames", frame_ms.size()},
                         {"max_abs_lsb", all.max_abs_lsb},

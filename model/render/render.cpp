@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <set>
 #include <stdexcept>
 
@@ -24,6 +25,8 @@ constexpr MethodName kMethods[] = {{Method::Flat, "flat"},
                                    {Method::GouraudClassical, "gouraud-classical"},
                                    {Method::Phong, "phong"},
                                    {Method::PhongIncremental, "phong-incremental"},
+                                   {Method::ModifiedGouraud, "modified-gouraud"},
+                                   {Method::Adaptive, "adaptive"},
                                    {Method::Reference, "reference"}};
 
 constexpr int kColourFrac = 12;  // colour attributes in LSBs: 0..255 with 12 fraction bits
@@ -67,13 +70,95 @@ double area2(const PVertex& a, const PVertex& b, const PVertex& c) {
   return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
 }
 
+struct Part {
+  std::array<PVertex, 3> v;
+  Method method;
+};
+
+using ShadeFn = std::function<std::array<double, 3>(Vec3 n, Vec3 p)>;
+
+// Modified Gouraud: the triangle split at its edges' specular maxima (see render.h).
+std::vector<std::array<PVertex, 3>> splitAtEdgeMaxima(const std::array<PVertex, 3>& t, const ShadeContext& ctx,
+                                                      double threshold, const ShadeFn& shade,
+                                                      const std::function<Vec3(const PVertex&)>& camOf) {
+  std::array<bool, 3> has{};
+  std::array<PVertex, 3> pt;
+  for (size_t e = 0; e < 3; ++e) {
+    const PVertex& a = t[e];
+    const PVertex& b = t[(e + 1) % 3];
+    double best_gain = threshold;
+    for (const CameraLight& l : ctx.lights) {
+      const Vec3 mid = 0.5 * (a.cam + b.cam);
+      const Vec3 h = normalize(lightDirection(l, mid) + ctx.view);
+      const double tm = edgeMaximumT(normalize(a.n), normalize(b.n), h);
+      if (tm < 0) continue;
+      PVertex v = lerp(a, b, tm);
+      v.cam = camOf(v);
+      v.n = normalize(v.n);
+      v.colour = shade(v.n, v.cam);
+      double gain = 0;
+      for (size_t k = 0; k < 3; ++k)
+        gain = std::max(gain, v.colour[k] - (a.colour[k] + tm * (b.colour[k] - a.colour[k])));
+      if (gain > best_gain) {
+        best_gain = gain;
+        pt[e] = v;
+        has[e] = true;
+      }
+    }
+  }
+  const int count = has[0] + has[1] + has[2];
+  if (count == 0) return {t};
+  if (count == 3)
+    return {std::array<PVertex, 3>{t[0], pt[0], pt[2]}, std::array<PVertex, 3>{pt[0], t[1], pt[1]},
+            std::array<PVertex, 3>{pt[2], pt[1], t[2]}, std::array<PVertex, 3>{pt[0], pt[1], pt[2]}};
+  // Rotate so that the split edges come first: edge 0 (and edge 1 for two points).
+  size_t r = 0;
+  if (count == 1) r = has[0] ? 0 : (has[1] ? 1 : 2);
+  else r = !has[2] ? 0 : (!has[0] ? 1 : 2);  // the unsplit edge becomes edge 2
+  const PVertex &v0 = t[r], &v1 = t[(r + 1) % 3], &v2 = t[(r + 2) % 3];
+  const PVertex& P = pt[r];
+  if (count == 1) return {std::array<PVertex, 3>{v0, P, v2}, std::array<PVertex, 3>{P, v1, v2}};
+  const PVertex& Q = pt[(r + 1) % 3];
+  return {std::array<PVertex, 3>{P, v1, Q}, std::array<PVertex, 3>{v0, P, Q}, std::array<PVertex, 3>{v0, Q, v2}};
+}
+
+// Adaptive: Gouraud (true) or Phong, by the listing's vertex test (see render.h).
+bool adaptiveChoice(const std::array<PVertex, 3>& t, const ShadeContext& ctx, const RenderOptions& opt) {
+  if (ctx.lights.empty()) return true;
+  const CameraLight& l = ctx.lights.front();
+  std::array<double, 3> q{}, p{};
+  for (size_t i = 0; i < 3; ++i) {
+    const Vec3 n = normalize(t[i].n);
+    const Vec3 ld = lightDirection(l, t[i].cam);
+    q[i] = dot(n, normalize(ld + ctx.view));
+    p[i] = dot(n, ld);
+  }
+  for (size_t i = 0; i < 3; ++i) {
+    const size_t j = (i + 1) % 3;
+    if (dot(normalize(t[i].n), normalize(t[j].n)) < opt.adaptive_m) return false;
+    if (std::fabs(q[i] - q[j]) > opt.adaptive_q || std::fabs(p[i] - p[j]) > opt.adaptive_p) return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+double edgeMaximumT(Vec3 na, Vec3 nb, Vec3 h) {
+  const double cchi = dot(na, h), calpha = dot(nb, h), cpsi = dot(na, nb);
+  if (1 - cpsi < 1e-12) return -1;    // equal normals: the cosine is constant along the edge
+  if (1 + cpsi < 1e-12) return -1;    // opposite normals: N(t) vanishes at t = 1/2
+  if (calpha + cchi <= 0) return -1;  // the root is a minimum (or none): the maximum is an end
+  const double t = (cchi * cpsi - calpha) / ((cpsi - 1) * (calpha + cchi));
+  return t > 0 && t < 1 ? t : -1;
+}
 
 Method parseMethod(const std::string& s) {
   for (const MethodName& m : kMethods)
     if (s == m.name) return m.m;
   throw std::invalid_argument(fmt::format(
-      "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental or reference)", s));
+      "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental, modified-gouraud, "
+      "adaptive or reference)",
+      s));
 }
 
 const char* toString(Method m) {
@@ -127,8 +212,6 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
   const CameraBasis basis = cameraBasis(cam);
   const ShadeContext ctx = makeShadeContext(scene);
   const double cx = 0.5 * W, cy = 0.5 * H, f = cam.px_per_unit;
-  const bool colour_attrs = opt.method == Method::Flat || opt.method == Method::Gouraud ||
-                            opt.method == Method::GouraudClassical;
 
   RasterConfig rc;
   rc.width = W;
@@ -136,8 +219,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
   rc.subpixel_bits = opt.subpixel_bits;
   rc.unit = span.params();
   if (rc.unit.NumAttr != 4) throw std::invalid_argument("render: the span unit must carry 4 attributes");
-  rc.attr_frac_bits = colour_attrs ? std::vector<int>{kColourFrac, kColourFrac, kColourFrac, kUnitFrac}
-                                   : std::vector<int>{kUnitFrac, kUnitFrac, kUnitFrac, kUnitFrac};
+  rc.attr_frac_bits = {kColourFrac, kColourFrac, kColourFrac, kUnitFrac};  // per triangle below
   rc.validate();
 
   // The coding of a device lobe's requests for its specular unit.
@@ -192,7 +274,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
       v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
       v.n = normalize(toCameraDirection(basis, obj.transform.normal(obj.mesh.normals[i])));
     }
-    if (opt.method == Method::Gouraud || opt.method == Method::GouraudClassical)
+    if (opt.method == Method::Gouraud || opt.method == Method::GouraudClassical ||
+        opt.method == Method::ModifiedGouraud || opt.method == Method::Adaptive)
       for (PVertex& v : verts) v.colour = shadeNow(mat, lobe, v.n, v.cam);
 
     for (size_t ti = 0; ti < obj.mesh.triangles.size(); ++ti) {
@@ -243,22 +326,44 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
         const Vec3 centroid = (1.0 / 3) * (poly[0].cam + poly[1].cam + poly[2].cam);
         flat = shadeNow(mat, lobe, fn, centroid);
       }
-      for (size_t k = 1; k + 1 < poly.size(); ++k) {  // fan
-        const std::array<const PVertex*, 3> tv{&poly[0], &poly[k], &poly[k + 1]};
+      // The screen triangles to draw (a fan of the clipped polygon), each with the method that
+      // draws it: modified Gouraud may split one into parts, adaptive picks per triangle.
+      std::vector<Part> parts;
+      for (size_t k = 1; k + 1 < poly.size(); ++k) {
+        const std::array<PVertex, 3> t{poly[0], poly[k], poly[k + 1]};
+        if (opt.method == Method::ModifiedGouraud) {
+          const auto subs = splitAtEdgeMaxima(
+              t, ctx, opt.modified_threshold_lsb, [&](Vec3 n, Vec3 p) { return shadeNow(mat, lobe, n, p); },
+              [&](const PVertex& v) { return pixelCam(v.x - 0.5, v.y - 0.5, v.w); });
+          if (subs.size() > 1) st.split_parts += subs.size();
+          for (const auto& sub : subs) parts.push_back({sub, Method::Gouraud});
+        } else if (opt.method == Method::Adaptive) {
+          parts.push_back({t, adaptiveChoice(t, ctx, opt) ? Method::Gouraud : Method::Phong});
+        } else {
+          parts.push_back({t, opt.method});
+        }
+      }
+      for (const Part& part : parts) {
+        const Method m = part.method;
+        const std::array<const PVertex*, 3> tv{&part.v[0], &part.v[1], &part.v[2]};
+        const bool colour_attrs_m = m == Method::Flat || m == Method::Gouraud || m == Method::GouraudClassical;
+        RasterConfig rcm = rc;
+        rcm.attr_frac_bits = colour_attrs_m ? std::vector<int>{kColourFrac, kColourFrac, kColourFrac, kUnitFrac}
+                                            : std::vector<int>{kUnitFrac, kUnitFrac, kUnitFrac, kUnitFrac};
         std::array<SetupVertex, 3> sv;
         for (size_t i = 0; i < 3; ++i) {
           const PVertex& v = *tv[i];
           sv[i].x = v.x;
           sv[i].y = v.y;
-          if (colour_attrs) {
-            const std::array<double, 3> c = opt.method == Method::Flat ? flat : v.colour;
+          if (colour_attrs_m) {
+            const std::array<double, 3> c = m == Method::Flat ? flat : v.colour;
             sv[i].attr = {std::clamp(c[0], 0.0, 255.0), std::clamp(c[1], 0.0, 255.0), std::clamp(c[2], 0.0, 255.0), v.w};
           } else {
             sv[i].attr = {v.n.x, v.n.y, v.n.z, v.w};
           }
         }
         const uint32_t tag = static_cast<uint32_t>(res.triangles.size());
-        SetupResult s = setupTriangle(sv, tag, rc);
+        SetupResult s = setupTriangle(sv, tag, rcm);
         if (!s.desc) {
           ++st.culled;
           continue;
@@ -269,11 +374,12 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
         for (size_t i = 0; i < 3; ++i) info.xy[i] = {tv[i]->x, tv[i]->y};
         res.triangles.push_back(info);
         ++st.drawn;
+        if (opt.method == Method::Adaptive) ++(m == Method::Gouraud ? st.adaptive_gouraud : st.adaptive_phong);
 
         // Fragments: the reference walks the same pixel set by direct edge evaluation.
         std::vector<SpanFragment> frags;
         if (reference) {
-          frags = rasterizeReference(s, rc);
+          frags = rasterizeReference(s, rcm);
         } else {
           SpanRun run = span.run(*s.desc);
           st.span_cycles += run.cycles;
@@ -294,7 +400,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
         // phong-incremental: |N|^2 of every fragment by the span recurrence, row by row in x
         // order (lane modes emit a row's pixels out of order).
         std::vector<uint64_t> sqnorm;
-        if (opt.method == Method::PhongIncremental) {
+        if (m == Method::PhongIncremental) {
           std::vector<size_t> order(frags.size());
           for (size_t i = 0; i < order.size(); ++i) order[i] = i;
           std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -319,7 +425,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
           const int64_t wcode = fr.attr[3];
           if (wcode <= fb.depth[p]) continue;
           Pending pd{p, wcode, {}, requests.size(), 0, {0, 0, 0}};
-          switch (opt.method) {
+          switch (m) {
             case Method::Flat:
             case Method::Gouraud:
               for (size_t k = 0; k < 3; ++k) pd.lsb[k] = std::ldexp(static_cast<double>(fr.attr[k]), -kColourFrac);
@@ -363,7 +469,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
                               std::ldexp(static_cast<double>(fr.attr[1]), -kUnitFrac),
                               std::ldexp(static_cast<double>(fr.attr[2]), -kUnitFrac)};
               Vec3 n;
-              if (opt.method == Method::Phong) {
+              if (m == Method::Phong) {
                 n = normalize(nraw);
               } else {
                 // |N|^2 from the recurrence (exact integers), then the fixed-point 1/sqrt.
@@ -376,6 +482,9 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
               requests.insert(requests.end(), sh.device.begin(), sh.device.end());
               break;
             }
+            case Method::ModifiedGouraud:
+            case Method::Adaptive:
+              throw std::logic_error("render: split and adaptive triangles are drawn as gouraud or phong");
             case Method::Reference: {
               // Exact barycentrics of the pixel centre on the unsnapped screen triangle.
               const double px = fr.x + 0.5, py = fr.y + 0.5;

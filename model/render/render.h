@@ -23,6 +23,20 @@
 //   phong-incremental  the same normals; |N|^2 along each span by the recurrence of errata 4.1
 //                      (F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, C_1 = C: additions
 //                      only) and a fixed-point reciprocal square root (table + one Newton step)
+//   modified-gouraud   paper 4.4 with the errata: on each edge the point where N(t).H peaks,
+//                      t1 = (cos chi cos psi - cos alpha) / ((cos psi - 1)(cos alpha + cos chi)),
+//                      a maximum only when cos alpha + cos chi > 0 and t1 in (0, 1) (equal or
+//                      opposite normals: no interior maximum). Where the exactly shaded colour
+//                      there exceeds the Gouraud colour by more than modified_threshold_lsb, the
+//                      point becomes a vertex: 1, 2 or 3 such points split the triangle into 2,
+//                      3 or 4 parts (Fig. 13), each drawn by Gouraud.
+//   adaptive           per triangle Gouraud or Phong by the listing's test of the vertex
+//                      normals (AdaptivGourauAndPhong.selectMetod, with its thresholds as
+//                      defaults): Gouraud where all pairs have N_i.N_j >= adaptive_m,
+//                      |N_i.H - N_j.H| <= adaptive_q and |N_i.L - N_j.L| <= adaptive_p, else
+//                      Phong. The listing returns Phong when |N_i.N_j| > 0.9, i.e. for nearly
+//                      equal normals, the opposite of its evident intent; shadesim follows the
+//                      intent.
 //   reference          per pixel in double precision: the exact barycentric normal of the pixel
 //                      centre, exact normalisation, exact pow (device lobes: the Blinn lobe they
 //                      approximate)
@@ -42,7 +56,7 @@
 
 namespace shd {
 
-enum class Method { Flat, Gouraud, GouraudClassical, Phong, PhongIncremental, Reference };
+enum class Method { Flat, Gouraud, GouraudClassical, Phong, PhongIncremental, ModifiedGouraud, Adaptive, Reference };
 Method parseMethod(const std::string& s);  // std::invalid_argument naming the choices
 const char* toString(Method m);
 std::vector<Method> allMethods();
@@ -90,6 +104,8 @@ struct RenderOptions {
   std::string brdf;  // "" : each material's own
   SpanMode span_mode = SpanMode::Serial;
   int subpixel_bits = 4;
+  double modified_threshold_lsb = 4;  // modified-gouraud: split where exact - Gouraud exceeds this
+  double adaptive_m = 0.9, adaptive_q = 0.004, adaptive_p = 0.008;  // the listing's opt_m, opt_q, opt_p
 };
 
 struct RenderStats {
@@ -103,6 +119,8 @@ struct RenderStats {
   uint64_t spec_cycles = 0;     // specular unit cycles (0 when no device lobe is used)
   uint64_t spec_evaluations = 0;
   uint64_t divisions = 0;       // gouraud-classical: raster lines with a division
+  uint64_t split_parts = 0;     // modified-gouraud: triangles drawn after splitting
+  uint64_t adaptive_gouraud = 0, adaptive_phong = 0;  // adaptive: the choices
   double ms = 0;
 };
 
@@ -115,6 +133,10 @@ struct Framebuffer {
   std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
   bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
 };
+
+// The errata 4.4 edge maximum of the specular cosine between unit normals na and nb for the
+// half vector h: t in (0, 1), or -1 when the edge has no interior maximum.
+double edgeMaximumT(Vec3 na, Vec3 nb, Vec3 h);
 
 // Where each screen triangle came from (for "the triangle that wrote pixel (x, y)").
 struct ScreenTriangleInfo {
