@@ -199,3 +199,23 @@ TEST(Render, AdaptiveFollowsItsThresholds) {
               static_cast<unsigned long long>(strict.stats.adaptive_phong));
   EXPECT_EQ(strict.stats.adaptive_gouraud + strict.stats.adaptive_phong, strict.stats.drawn);
 }
+
+TEST(Render, NormalBisectionBetweenPhongAndLinearNormals) {
+  const Scene s = loadScene("builtin:sphere");
+  ModelEngines e(SpanMode::Serial);
+  RenderOptions o;
+  o.method = Method::Phong;
+  const RenderResult phong = render(s, o, e.span, e.view);
+  o.method = Method::NormalBisection;
+  o.bisection_threshold = 0;  // bisect down to every pixel: each normal exact
+  const RenderResult all = render(s, o, e.span, e.view);
+  EXPECT_EQ(all.stats.normalisations, all.stats.fragments);
+  EXPECT_EQ(all.fb.rgb, phong.fb.rgb);
+  o.bisection_threshold = 0.02;  // the listing's
+  const RenderResult listing = render(s, o, e.span, e.view);
+  EXPECT_LT(listing.stats.normalisations, listing.stats.fragments / 2);
+  EXPECT_NE(listing.fb.rgb, phong.fb.rgb);
+  std::printf("normal-bisection (0.02): %llu exact normalisations for %llu fragments\n",
+              static_cast<unsigned long long>(listing.stats.normalisations),
+              static_cast<unsigned long long>(listing.stats.fragments));
+}

@@ -25,6 +25,7 @@ constexpr MethodName kMethods[] = {{Method::Flat, "flat"},
                                    {Method::GouraudClassical, "gouraud-classical"},
                                    {Method::Phong, "phong"},
                                    {Method::PhongIncremental, "phong-incremental"},
+                                   {Method::NormalBisection, "normal-bisection"},
                                    {Method::ModifiedGouraud, "modified-gouraud"},
                                    {Method::Adaptive, "adaptive"},
                                    {Method::Reference, "reference"}};
@@ -156,8 +157,8 @@ Method parseMethod(const std::string& s) {
   for (const MethodName& m : kMethods)
     if (s == m.name) return m.m;
   throw std::invalid_argument(fmt::format(
-      "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental, modified-gouraud, "
-      "adaptive or reference)",
+      "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental, normal-bisection, "
+      "modified-gouraud, adaptive or reference)",
       s));
 }
 
@@ -400,6 +401,57 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
         // phong-incremental: |N|^2 of every fragment by the span recurrence, row by row in x
         // order (lane modes emit a row's pixels out of order).
         std::vector<uint64_t> sqnorm;
+        std::vector<Vec3> bisected;  // normal-bisection: the normal used at each fragment
+        auto rawNormal = [&](const SpanFragment& f) {
+          return Vec3{std::ldexp(static_cast<double>(f.attr[0]), -kUnitFrac), std::ldexp(static_cast<double>(f.attr[1]), -kUnitFrac),
+                      std::ldexp(static_cast<double>(f.attr[2]), -kUnitFrac)};
+        };
+        if (m == Method::NormalBisection) {
+          std::vector<size_t> order(frags.size());
+          for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+          std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+            return frags[a].y != frags[b].y ? frags[a].y < frags[b].y : frags[a].x < frags[b].x;
+          });
+          bisected.assign(frags.size(), Vec3{0, 0, 0});
+          for (size_t i = 0; i < order.size();) {
+            size_t j = i;
+            while (j < order.size() && frags[order[j]].y == frags[order[i]].y) ++j;
+            // Nodes at the ends, then recursive bisection (positions within the row i..j-1).
+            std::vector<Vec3> n(j - i);
+            std::vector<bool> node(j - i, false);
+            auto exact = [&](size_t k) {
+              n[k] = normalize(rawNormal(frags[order[i + k]]));
+              node[k] = true;
+              ++st.normalisations;
+            };
+            exact(0);
+            if (j - i > 1) exact(j - i - 1);
+            std::function<void(size_t, size_t)> bisect = [&](size_t a, size_t b) {
+              if (b - a < 2) return;
+              const double err = 1 - length(0.5 * (n[a] + n[b]));  // 1 - cos(W/2)
+              if (err <= opt.bisection_threshold) return;
+              const size_t mid = (a + b) / 2;
+              exact(mid);
+              bisect(a, mid);
+              bisect(mid, b);
+            };
+            bisect(0, j - i - 1);
+            // Between nodes: linear interpolation, not normalised.
+            size_t a = 0;
+            for (size_t k = 0; k < j - i; ++k) {
+              if (node[k]) {
+                a = k;
+                bisected[order[i + k]] = n[k];
+                continue;
+              }
+              size_t b = k;
+              while (!node[b]) ++b;
+              const double t = static_cast<double>(k - a) / static_cast<double>(b - a);
+              bisected[order[i + k]] = n[a] + t * (n[b] - n[a]);
+            }
+            i = j;
+          }
+        }
         if (m == Method::PhongIncremental) {
           std::vector<size_t> order(frags.size());
           for (size_t i = 0; i < order.size(); ++i) order[i] = i;
@@ -464,13 +516,14 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
               break;
             }
             case Method::Phong:
-            case Method::PhongIncremental: {
-              const Vec3 nraw{std::ldexp(static_cast<double>(fr.attr[0]), -kUnitFrac),
-                              std::ldexp(static_cast<double>(fr.attr[1]), -kUnitFrac),
-                              std::ldexp(static_cast<double>(fr.attr[2]), -kUnitFrac)};
+            case Method::PhongIncremental:
+            case Method::NormalBisection: {
+              const Vec3 nraw = rawNormal(fr);
               Vec3 n;
               if (m == Method::Phong) {
                 n = normalize(nraw);
+              } else if (m == Method::NormalBisection) {
+                n = bisected[fi];
               } else {
                 // |N|^2 from the recurrence (exact integers), then the fixed-point 1/sqrt.
                 n = rsqrtFixed(sqnorm[fi], 2 * kUnitFrac) * nraw;

@@ -23,6 +23,11 @@
 //   phong-incremental  the same normals; |N|^2 along each span by the recurrence of errata 4.1
 //                      (F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, C_1 = C: additions
 //                      only) and a fixed-point reciprocal square root (table + one Newton step)
+//   normal-bisection   the listing NormalVector: along each span the unit normal is computed
+//                      exactly only at nodes found by recursive bisection (ends first, then the
+//                      middle of a segment while 1 - |(N_a + N_b)/2|, the listing's error
+//                      1 - sqrt(2 + 2 cos W)/2, exceeds bisection_threshold); between nodes the
+//                      normal is interpolated linearly and used unnormalised
 //   modified-gouraud   paper 4.4 with the errata: on each edge the point where N(t).H peaks,
 //                      t1 = (cos chi cos psi - cos alpha) / ((cos psi - 1)(cos alpha + cos chi)),
 //                      a maximum only when cos alpha + cos chi > 0 and t1 in (0, 1) (equal or
@@ -56,7 +61,17 @@
 
 namespace shd {
 
-enum class Method { Flat, Gouraud, GouraudClassical, Phong, PhongIncremental, ModifiedGouraud, Adaptive, Reference };
+enum class Method {
+  Flat,
+  Gouraud,
+  GouraudClassical,
+  Phong,
+  PhongIncremental,
+  NormalBisection,
+  ModifiedGouraud,
+  Adaptive,
+  Reference
+};
 Method parseMethod(const std::string& s);  // std::invalid_argument naming the choices
 const char* toString(Method m);
 std::vector<Method> allMethods();
@@ -105,6 +120,7 @@ struct RenderOptions {
   SpanMode span_mode = SpanMode::Serial;
   int subpixel_bits = 4;
   double modified_threshold_lsb = 4;  // modified-gouraud: split where exact - Gouraud exceeds this
+  double bisection_threshold = 0.02;  // normal-bisection: the listing's error bound per segment
   double adaptive_m = 0.9, adaptive_q = 0.004, adaptive_p = 0.008;  // the listing's opt_m, opt_q, opt_p
 };
 
@@ -120,6 +136,7 @@ struct RenderStats {
   uint64_t spec_evaluations = 0;
   uint64_t divisions = 0;       // gouraud-classical: raster lines with a division
   uint64_t split_parts = 0;     // modified-gouraud: triangles drawn after splitting
+  uint64_t normalisations = 0;  // normal-bisection: exact normalisations (nodes)
   uint64_t adaptive_gouraud = 0, adaptive_phong = 0;  // adaptive: the choices
   double ms = 0;
 };
