@@ -481,10 +481,10 @@ struct RenderCmd {
   void add(CLI::App& app) {
     app.add_option("--scene", scene, "builtin:sphere | builtin:plane | builtin:torus | builtin:materials or a JSON file");
     app.add_option("--method", method,
-                   "flat | gouraud | gouraud-classical | phong | phong-incremental | normal-bisection | modified-gouraud | "
-                   "adaptive | reference")
+                   "flat | gouraud | gouraud-classical | phong | phong-incremental | normal-bisection | biquadratic | "
+                   "modified-gouraud | adaptive | reference")
         ->check(CLI::IsMember({"flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "normal-bisection",
-                               "modified-gouraud", "adaptive", "reference"}));
+                               "biquadratic", "modified-gouraud", "adaptive", "reference"}));
     app.add_option("--brdf", brdf, "override every material's brdf: phong | blinn | normalized-blinn | schlick | "
                                    "quadratic | cubic | cook-torrance | pow")
         ->check(CLI::IsMember({"phong", "blinn", "normalized-blinn", "schlick", "quadratic", "cubic", "cook-torrance", "pow"}));

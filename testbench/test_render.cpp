@@ -94,9 +94,12 @@ TEST(Render, MethodsAgainstTheReference) {
   const double gouraud = maxError(renderModel(s, Method::Gouraud, "", SpanMode::Serial).fb, ref.fb);
   const double phong = maxError(renderModel(s, Method::Phong, "", SpanMode::Serial).fb, ref.fb);
   const double phong_inc = maxError(renderModel(s, Method::PhongIncremental, "", SpanMode::Serial).fb, ref.fb);
-  std::printf("max error vs reference (LSB): flat %.2f gouraud %.2f phong %.2f phong-incremental %.2f\n", flat, gouraud,
-              phong, phong_inc);
+  const double biquad = maxError(renderModel(s, Method::Biquadratic, "", SpanMode::Serial).fb, ref.fb);
+  std::printf("max error vs reference (LSB): flat %.2f gouraud %.2f biquadratic %.2f phong %.2f phong-incremental %.2f\n",
+              flat, gouraud, biquad, phong, phong_inc);
   EXPECT_GT(flat, gouraud);
+  EXPECT_GT(gouraud, biquad);  // the quadratic surface follows the curvature Gouraud misses
+  EXPECT_GT(biquad, phong);
   EXPECT_GT(gouraud, phong);
   // Per-pixel normalisation: only the affine screen-space interpolation of the normal and the
   // final rounding separate phong from the reference; the fixed-point 1/sqrt adds < 2^-14.

@@ -26,6 +26,7 @@ constexpr MethodName kMethods[] = {{Method::Flat, "flat"},
                                    {Method::Phong, "phong"},
                                    {Method::PhongIncremental, "phong-incremental"},
                                    {Method::NormalBisection, "normal-bisection"},
+                                   {Method::Biquadratic, "biquadratic"},
                                    {Method::ModifiedGouraud, "modified-gouraud"},
                                    {Method::Adaptive, "adaptive"},
                                    {Method::Reference, "reference"}};
@@ -158,7 +159,7 @@ Method parseMethod(const std::string& s) {
     if (s == m.name) return m.m;
   throw std::invalid_argument(fmt::format(
       "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental, normal-bisection, "
-      "modified-gouraud, adaptive or reference)",
+      "biquadratic, modified-gouraud, adaptive or reference)",
       s));
 }
 
@@ -275,7 +276,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
       v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
       v.n = normalize(toCameraDirection(basis, obj.transform.normal(obj.mesh.normals[i])));
     }
-    if (opt.method == Method::Gouraud || opt.method == Method::GouraudClassical ||
+    if (opt.method == Method::Gouraud || opt.method == Method::GouraudClassical || opt.method == Method::Biquadratic ||
         opt.method == Method::ModifiedGouraud || opt.method == Method::Adaptive)
       for (PVertex& v : verts) v.colour = shadeNow(mat, lobe, v.n, v.cam);
 
@@ -347,7 +348,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
       for (const Part& part : parts) {
         const Method m = part.method;
         const std::array<const PVertex*, 3> tv{&part.v[0], &part.v[1], &part.v[2]};
-        const bool colour_attrs_m = m == Method::Flat || m == Method::Gouraud || m == Method::GouraudClassical;
+        const bool colour_attrs_m =
+            m == Method::Flat || m == Method::Gouraud || m == Method::GouraudClassical || m == Method::Biquadratic;
         RasterConfig rcm = rc;
         rcm.attr_frac_bits = colour_attrs_m ? std::vector<int>{kColourFrac, kColourFrac, kColourFrac, kUnitFrac}
                                             : std::vector<int>{kUnitFrac, kUnitFrac, kUnitFrac, kUnitFrac};
@@ -469,6 +471,21 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
             i = j;
           }
         }
+        // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
+        std::array<std::array<double, 3>, 3> mid_colour{};
+        if (m == Method::Biquadratic)
+          for (size_t e = 0; e < 3; ++e) {
+            PVertex mv = lerp(*tv[e], *tv[(e + 1) % 3], 0.5);
+            mid_colour[e] = shadeNow(mat, lobe, normalize(mv.n), pixelCam(mv.x - 0.5, mv.y - 0.5, mv.w));
+          }
+        // Barycentric coordinates of a pixel centre on the unsnapped screen triangle.
+        auto barycentric = [&](const SpanFragment& f) {
+          const double px = f.x + 0.5, py = f.y + 0.5;
+          const double d = area2(*tv[0], *tv[1], *tv[2]);
+          const double l1 = ((px - tv[0]->x) * (tv[2]->y - tv[0]->y) - (tv[2]->x - tv[0]->x) * (py - tv[0]->y)) / d;
+          const double l2 = ((tv[1]->x - tv[0]->x) * (py - tv[0]->y) - (px - tv[0]->x) * (tv[1]->y - tv[0]->y)) / d;
+          return std::array<double, 3>{1 - l1 - l2, l1, l2};
+        };
         size_t frag_index = 0;
         std::set<int32_t> divided_rows;  // gouraud-classical: rows that paid a division
         for (const SpanFragment& fr : frags) {
@@ -538,13 +555,20 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
             case Method::ModifiedGouraud:
             case Method::Adaptive:
               throw std::logic_error("render: split and adaptive triangles are drawn as gouraud or phong");
+            case Method::Biquadratic: {
+              // The quadratic Lagrange basis: vertices c_i, edge midpoints c_ij (edge e = i..i+1).
+              const auto l = barycentric(fr);
+              for (size_t k = 0; k < 3; ++k) {
+                double v = 0;
+                for (size_t i = 0; i < 3; ++i) v += std::clamp(tv[i]->colour[k], 0.0, 255.0) * l[i] * (2 * l[i] - 1);
+                for (size_t e = 0; e < 3; ++e) v += 4 * mid_colour[e][k] * l[e] * l[(e + 1) % 3];
+                pd.lsb[k] = v;
+              }
+              break;
+            }
             case Method::Reference: {
-              // Exact barycentrics of the pixel centre on the unsnapped screen triangle.
-              const double px = fr.x + 0.5, py = fr.y + 0.5;
-              const double d = area2(*tv[0], *tv[1], *tv[2]);
-              const double l1 = ((px - tv[0]->x) * (tv[2]->y - tv[0]->y) - (tv[2]->x - tv[0]->x) * (py - tv[0]->y)) / d;
-              const double l2 = ((tv[1]->x - tv[0]->x) * (py - tv[0]->y) - (px - tv[0]->x) * (tv[1]->y - tv[0]->y)) / d;
-              const double l0 = 1 - l1 - l2;
+              const auto lb = barycentric(fr);
+              const double l0 = lb[0], l1 = lb[1], l2 = lb[2];
               const Vec3 n = normalize(l0 * tv[0]->n + l1 * tv[1]->n + l2 * tv[2]->n);
               const double w = l0 * tv[0]->w + l1 * tv[1]->w + l2 * tv[2]->w;
               const Vec3 pc = pixelCam(fr.x, fr.y, w);

@@ -28,6 +28,15 @@
 //                      middle of a segment while 1 - |(N_a + N_b)/2|, the listing's error
 //                      1 - sqrt(2 + 2 cos W)/2, exceeds bisection_threshold); between nodes the
 //                      normal is interpolated linearly and used unnormalised
+//   biquadratic        the listing GouraudRasterizer4's intent: a quadratic colour surface
+//                      I(x, y) through six exactly shaded points, the vertices and the edge
+//                      midpoints. The listing solves a 6x6 system by Cramer's rule (singular
+//                      when sample points coincide, and its right-hand side averaged the vertex
+//                      colours, which makes the surface linear); its exact solution is the
+//                      quadratic Lagrange basis on barycentric coordinates,
+//                      I = sum c_i l_i (2 l_i - 1) + sum 4 c_ij l_i l_j, evaluated here
+//                      directly: no solve, no conditioning problem. Per pixel (not a span-unit
+//                      increment: a quadratic has no constant step); coverage from the span unit.
 //   modified-gouraud   paper 4.4 with the errata: on each edge the point where N(t).H peaks,
 //                      t1 = (cos chi cos psi - cos alpha) / ((cos psi - 1)(cos alpha + cos chi)),
 //                      a maximum only when cos alpha + cos chi > 0 and t1 in (0, 1) (equal or
@@ -68,6 +77,7 @@ enum class Method {
   Phong,
   PhongIncremental,
   NormalBisection,
+  Biquadratic,
   ModifiedGouraud,
   Adaptive,
   Reference
