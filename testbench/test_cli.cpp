@@ -115,7 +115,7 @@ TEST(CliProm, BadInputIsNamedAndLeavesNoFile) {
   // An output directory that does not exist: an error, nothing created.
   const CmdResult r = run("prom --fit level --format hex -o " + tmp("nodir") + "/x.hex");
   EXPECT_NE(r.code, 0);
-  EXPECT_FALSE(fs::exists(tmp("nodir")));
+  EXPECT_FALSE(fs::exists(testDir() / "nodir"));
 }
 
 TEST(CliCosim, JsonKeysAndZeroMismatches) {
@@ -205,4 +205,49 @@ TEST(CliSpanCycles, ReportChecksTheRtlCycles) {
       EXPECT_LE(m["cycles"].get<double>(), serial) << set["set"] << " " << m["mode"];
     }
   }
+}
+
+TEST(CliRender, WritesImagesAndStats) {
+  const std::string out = tmp("sphere.png"), js = tmp("sphere.json");
+  const CmdResult r = run("render --scene builtin:sphere --method gouraud --brdf quadratic --rtl --quiet -o " + out +
+                          " --json " + js);
+  ASSERT_EQ(r.code, 0) << r.err;
+  for (const fs::path& f : {fs::path(out), testDir() / "sphere_reference.png", testDir() / "sphere_error.png", fs::path(js)})
+    EXPECT_TRUE(fs::exists(f)) << f;
+  std::ifstream in(js);
+  const auto j = nlohmann::json::parse(in);
+  for (const char* k : {"triangles", "culled", "fragments", "pixels_covered", "cycles", "ms", "max_abs_lsb", "psnr_db",
+                        "pixel_mismatches"})
+    EXPECT_TRUE(j.contains(k)) << k;
+  EXPECT_EQ(j["pixel_mismatches"], 0);
+  EXPECT_EQ(j["triangles"], 8190);
+}
+
+TEST(CliRender, BadInputIsNamedAndLeavesNoImage) {
+  const std::string out = tmp("bad.png");
+  auto rejected = [&](const std::string& args, const std::string& needle) {
+    const CmdResult r = run("render --quiet " + args + " -o " + out);
+    EXPECT_NE(r.code, 0) << args;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\nstderr: " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+    EXPECT_FALSE(fs::exists(testDir() / "bad_reference.png")) << args;  // (tmp() would delete it first)
+    EXPECT_FALSE(fs::exists(testDir() / "bad_error.png")) << args;
+  };
+  rejected("--scene /nonexistent/scene.json", "/nonexistent/scene.json");
+  rejected("--scene builtin:teapot", "builtin:teapot");
+  rejected("--scene /usr/share/assimp/models/invalid/empty.obj", "empty.obj");
+  rejected("--method toon", "--method");
+  rejected("--brdf glossy", "--brdf");
+  // The materials row uses n up to 1000; the cubic unit's PROM holds 1..256.
+  rejected("--scene builtin:materials --brdf cubic", "shininess 1000");
+  // A scene file with an unknown key, and one with shininess out of range.
+  const std::string bad_key = tmp("bad_key.json"), bad_n = tmp("bad_n.json");
+  std::ofstream(bad_key) << R"({"objects": [{"mesh": "builtin:sphere", "colour": [1,0,0]}]})";
+  std::ofstream(bad_n) << R"({"materials": [{"name": "m", "shininess": 5000}], "objects": [{"mesh": "builtin:sphere", "material": "m"}]})";
+  rejected("--scene " + bad_key, "objects[0]");
+  rejected("--scene " + bad_n, "shininess");
+  // An output directory that does not exist.
+  const CmdResult r = run("render --quiet --scene builtin:sphere -o " + tmp("nodir") + "/x.png");
+  EXPECT_NE(r.code, 0);
+  EXPECT_FALSE(fs::exists(testDir() / "nodir"));
 }

@@ -3,6 +3,7 @@
 #include "scene/scene.h"
 
 #include <cctype>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -644,6 +645,34 @@ Scene loadSceneFile(const std::string& file) {
   return SceneReader(file).read(root);
 }
 
+// A mesh file given as the scene: the default material and light of builtin:sphere, the
+// camera on -z looking at the centre of the mesh's bounding box from far enough that its
+// bounding sphere fills about 80 % of the 512x512 view.
+Scene sceneForMeshFile(const std::string& file) {
+  Scene s = builtinSphere();
+  s.name = file;
+  s.objects.clear();
+  SceneObject o;
+  o.name = std::filesystem::path(file).stem().string();
+  o.source = file;
+  o.mesh = loadMeshFile(file);
+  Vec3 lo = o.mesh.positions.front(), hi = lo;
+  for (const Vec3& p : o.mesh.positions) {
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  const Vec3 centre = 0.5 * (lo + hi);
+  const double radius = std::max(1e-9, 0.5 * length(hi - lo));
+  // Screen radius of the bounding sphere at distance d: px_per_unit * r / sqrt(d^2 - r^2).
+  const double want = 0.4 * s.camera.width;
+  const double d = radius * std::sqrt(1 + std::pow(s.camera.px_per_unit / want, 2));
+  s.camera.target = centre;
+  s.camera.eye = centre - Vec3{0, 0, d};
+  s.camera.z_near = std::max(1e-6, 1e-3 * d);
+  s.objects.push_back(std::move(o));
+  return s;
+}
+
 }  // namespace
 
 Scene loadScene(const std::string& spec) {
@@ -656,6 +685,9 @@ Scene loadScene(const std::string& spec) {
     for (const std::string& n : builtinSceneNames()) names += (names.empty() ? "" : ", ") + n;
     throw SceneError(fmt::format("{}: unknown builtin scene (known: {})", spec, names));
   }
+  std::string ext = std::filesystem::path(spec).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext != ".json") return sceneForMeshFile(spec);
   return loadSceneFile(spec);
 }
 

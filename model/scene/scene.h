@@ -154,7 +154,9 @@ struct SceneError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// "builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials", or a JSON file.
+// "builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials", a JSON scene file, or
+// a mesh file of any format assimp reads (e.g. teapots.DAE): then the mesh alone, with
+// builtin:sphere's material and light, and the camera on -z framing its bounding sphere.
 Scene loadScene(const std::string& spec);
 // The builtin specs, with the prefix: {"builtin:sphere", "builtin:plane", "builtin:torus",
 // "builtin:materials"}.
