@@ -590,9 +590,8 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
           st.spec_evaluations += requests.size();
         }
         for (const Pending& pd : pend) {
-          std::vector<std::array<uint32_t, 3>> dev(device_out.begin() + static_cast<long>(pd.dev_first),
-                                                   device_out.begin() + static_cast<long>(pd.dev_first + pd.dev_count));
-          const std::array<uint8_t, 3> c = combine(pd.lsb, dev);
+          const std::array<uint8_t, 3> c =
+              combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count);
           for (size_t k = 0; k < 3; ++k) fb.rgb[pd.pixel * 3 + k] = c[k];
           fb.depth[pd.pixel] = pd.w;
           fb.tri[pd.pixel] = static_cast<int32_t>(tag);

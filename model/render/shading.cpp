@@ -112,11 +112,11 @@ Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, 
   return s;
 }
 
-std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::vector<std::array<uint32_t, 3>>& device_rgb) {
+std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb, size_t count) {
   std::array<uint8_t, 3> out{};
   for (size_t k = 0; k < 3; ++k) {
     double v = std::round(std::clamp(lsb[k], 0.0, 255.0));
-    for (const auto& d : device_rgb) v += d[k];
+    for (size_t i = 0; i < count; ++i) v += device_rgb[i][k];
     out[k] = static_cast<uint8_t>(std::min(255.0, v));
   }
   return out;

@@ -69,6 +69,7 @@ Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n_u
                  const DeviceCoding* coding);
 
 // Final unorm8: round(lsb) plus the device outputs, clamped to 0..255.
-std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::vector<std::array<uint32_t, 3>>& device_rgb);
+// device_rgb points at `count` specular-unit results (may be null when count is 0).
+std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb, size_t count);
 
 }  // namespace shd
