@@ -11,8 +11,8 @@ namespace shd {
 
 RtlSpanEngine::RtlSpanEngine(SpanMode mode) : dut_(makeSpanDut(toString(mode), "")) { dut_->reset(); }
 
-SpanRun RtlSpanEngine::run(const SpanDesc& d) {
-  SpanRun run;
+SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
+  SpanWalk run;
   SpanIn in;
   in.desc_valid = true;
   in.desc = &d;
@@ -26,15 +26,16 @@ SpanRun RtlSpanEngine::run(const SpanDesc& d) {
       in.desc_valid = false;
       continue;
     }
-    if (out_.out_valid) ++run.span_cycles;
     for (const SpanLaneOut& l : out_.lane)
-      if (l.valid) run.fragments.push_back({out_.tag, l.x, l.y, l.attr});
+      if (l.valid) {
+        out.push_back({out_.tag, l.x, l.y, l.attr});
+        ++run.fragments;
+      }
     if (out_.desc_ready) {  // back in IDLE: this cycle belongs to the next descriptor
       --run.cycles;
       break;
     }
   }
-  run.valid_lanes = run.fragments.size();
   return run;
 }
 

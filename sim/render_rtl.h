@@ -11,12 +11,13 @@
 
 namespace shd {
 
-// Each descriptor runs from IDLE to IDLE with the consumer always ready.
+// Each descriptor runs from IDLE to IDLE with the consumer always ready. The ports show the
+// cycles and the fragments; the ROW/SPAN split of the cycles is internal (left 0).
 class RtlSpanEngine final : public SpanEngine {
  public:
   explicit RtlSpanEngine(SpanMode mode);
   const SpanParams& params() const override { return dut_->params(); }
-  SpanRun run(const SpanDesc& d) override;
+  SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override;
 
  private:
   std::unique_ptr<SpanDut> dut_;

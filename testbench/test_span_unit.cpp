@@ -25,7 +25,13 @@ RasterConfig configFor(SpanMode m, int w = 64, int h = 48) {
   return c;
 }
 
-SetupVertex vtx(double x, double y, std::vector<double> a = {0, 0, 0, 0}) { return {x, y, std::move(a)}; }
+SetupVertex vtx(double x, double y, std::initializer_list<double> a = {0, 0, 0, 0}) {
+  SetupVertex v;
+  v.x = x;
+  v.y = y;
+  v.attr = a;
+  return v;
+}
 
 std::vector<SpanFragment> sorted(std::vector<SpanFragment> f) {
   std::sort(f.begin(), f.end(), [](const SpanFragment& a, const SpanFragment& b) {
@@ -77,6 +83,8 @@ std::string describe(const GenTriangle& t) {
 }
 
 // Every mode against the serial mode on `count` generator triangles: same pixels, same codes.
+// And in every mode the functional walker (walkSpanUnit, the renderer's fast path) against the
+// cycle-by-cycle model: the same fragments in the same order, the same cycles.
 void checkModesAgainstSerial(uint64_t seed, long count) {
   RasterConfig c;  // 512 x 512
   c.unit = SpanParams::forMode(SpanMode::Serial);
@@ -89,19 +97,37 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
     units.emplace_back(cfgs.back().unit);
   }
   long frags = 0;
+  std::vector<SpanFragment> walked;
   for (long n = 0; n < count; ++n) {
     const GenTriangle t = gen.next();
     const auto v = toSetupVertices(t, c.unit.NumAttr);
     std::vector<SpanFragment> serial;
     for (size_t mi = 0; mi < units.size(); ++mi) {
+      const char* mode = toString(allSpanModes()[mi]);
       const SetupResult s = setupTriangle(v, t.id, cfgs[mi]);
-      std::vector<SpanFragment> got = s.desc ? sorted(runSpanUnit(units[mi], *s.desc).fragments) : std::vector<SpanFragment>{};
+      std::vector<SpanFragment> got;
+      if (s.desc) {
+        const SpanRun run = runSpanUnit(units[mi], *s.desc);
+        walked.clear();
+        const SpanWalk wk = walkSpanUnit(cfgs[mi].unit, *s.desc, walked);
+        ASSERT_EQ(wk.cycles, run.cycles) << mode << " walker cycles, " << describe(t);
+        ASSERT_EQ(wk.row_cycles, run.row_cycles) << mode << " walker ROW cycles, " << describe(t);
+        ASSERT_EQ(wk.span_cycles, run.span_cycles) << mode << " walker SPAN cycles, " << describe(t);
+        ASSERT_EQ(wk.fragments, run.fragments.size()) << mode << " walker fragment count, " << describe(t);
+        ASSERT_EQ(walked.size(), run.fragments.size()) << mode << " walker fragments, " << describe(t);
+        for (size_t i = 0; i < walked.size(); ++i) {
+          const SpanFragment &a = walked[i], &b = run.fragments[i];
+          ASSERT_TRUE(a.tag == b.tag && a.x == b.x && a.y == b.y && a.attr == b.attr)
+              << mode << " walker fragment " << i << " (" << a.x << ", " << a.y << ") vs the cycle model's (" << b.x
+              << ", " << b.y << "), " << describe(t);
+        }
+        got = sorted(run.fragments);
+      }
       if (mi == 0) {
         serial = std::move(got);
         frags += static_cast<long>(serial.size());
         continue;
       }
-      const char* mode = toString(allSpanModes()[mi]);
       ASSERT_EQ(got.size(), serial.size()) << mode << " seed " << seed << " " << describe(t);
       for (size_t i = 0; i < got.size(); ++i) {
         ASSERT_EQ(got[i].x, serial[i].x) << mode << " seed " << seed << " " << describe(t);
@@ -110,7 +136,7 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
       }
     }
   }
-  std::printf("seed %llu: %ld triangles, %ld fragments per mode, every mode equal to serial\n",
+  std::printf("seed %llu: %ld triangles, %ld fragments per mode, every mode equal to serial, the walker equal to the cycle model\n",
               static_cast<unsigned long long>(seed), count, frags);
 }
 

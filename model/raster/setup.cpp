@@ -263,7 +263,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   }
 
   // Lane-triangles in the walker frame.
-  std::vector<SpanLaneTri> lanes;
+  InlineVec<SpanLaneTri, kMaxLaneTri> lanes;
   const SpanMode mode = p.mode();
   if (mode != SpanMode::Sierpinski) {
     lanes.push_back(buildLaneTri(whole, false, 0, 0, cfg));
@@ -324,7 +324,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
                               : wrap(dx * l.ox + dy * l.oy));
     }
   }
-  d.tri = std::move(lanes);
+  d.tri = lanes;
   res.desc = std::move(d);
   return res;
 }

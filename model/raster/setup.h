@@ -73,13 +73,13 @@ std::vector<int> defaultAttrFracBitsFor(int width, int height, int num_attr);
 
 struct SetupVertex {
   double x = 0, y = 0;        // pixels, y down
-  std::vector<double> attr;   // NumAttr values in the attribute's units
+  InlineVec<double, kMaxAttr> attr;  // NumAttr values in the attribute's units
 };
 
 // The fixed-point triangle after snapping: kept for references and diagnostics.
 struct SnappedTriangle {
   std::array<int64_t, 3> X{}, Y{};                 // subpixel units, det > 0 order
-  std::vector<std::array<int64_t, 3>> a;           // attribute codes per attribute
+  InlineVec<std::array<int64_t, 3>, kMaxAttr> a;   // attribute codes per attribute
   bool swapped = false;                            // vertices 1 and 2 were swapped
   int64_t det = 0;
 };
@@ -92,7 +92,7 @@ struct EdgeFunction {
 
 struct AttributePlane {
   int64_t xref = 0, yref = 0;
-  std::vector<int64_t> iref, didx, didy;  // codes (not wrapped)
+  AttrVec iref, didx, didy;  // codes (not wrapped)
   int64_t at(int k, int64_t px, int64_t py) const {
     const size_t i = static_cast<size_t>(k);
     return iref[i] + didx[i] * (px - xref) + didy[i] * (py - yref);

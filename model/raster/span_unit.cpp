@@ -1,6 +1,7 @@
 #include "raster/span_unit.h"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -60,7 +61,7 @@ void SpanParams::validate() const {
   need(LanesPerTri == 1 || LanesPerTri == 2 || LanesPerTri == 4 || LanesPerTri == 8, "LanesPerTri", LanesPerTri,
        "must be 1, 2, 4 or 8");
   need(AlignLanes == 0 || AlignLanes == 1, "AlignLanes", AlignLanes, "must be 0 or 1");
-  need(NumAttr >= 1 && NumAttr <= 16, "NumAttr", NumAttr, "must be in 1..16");
+  need(NumAttr >= 1 && NumAttr <= static_cast<int>(kMaxAttr), "NumAttr", NumAttr, "must be in 1..16");
   need(AttrBits >= 8 && AttrBits <= 62, "AttrBits", AttrBits, "must be in 8..62");
   need(CoordBits >= 8 && CoordBits <= 30, "CoordBits", CoordBits, "must be in 8..30");
   need(RemBits >= 2 && RemBits <= 60, "RemBits", RemBits, "must be in 2..60");
@@ -80,6 +81,61 @@ int64_t wrapTo(uint64_t v, int bits) {
 
 uint64_t u(int64_t v) { return static_cast<uint64_t>(v); }
 
+// The ROW cycle, combinational part, for one lane-triangle at walker row w with its edges'
+// current quotients: the span [lo, hi]; returns ne (the lane-triangle has pixels on the row).
+bool laneRowBounds(const SpanLaneTri& t, int64_t w, const SpanDdaState* e, int64_t& lo, int64_t& hi) {
+  lo = t.clip_x0;
+  hi = t.clip_x1;
+  for (int s = 0; s < 3; ++s) {
+    const SpanEdge& g = t.edge[s];
+    if (w < g.row_first || w > g.row_last) continue;
+    if (g.right) hi = std::min(hi, -e[s].q);
+    else lo = std::max(lo, e[s].q);
+  }
+  return t.row_first <= w && w <= t.row_last && lo <= hi;
+}
+
+// The ROW cycle's register update of one lane-triangle's edges: the DDA step of every edge
+// active at w that stays active at w + 1.
+void stepEdges(const SpanLaneTri& t, int64_t w, SpanDdaState* e, int coord_bits) {
+  for (int s = 0; s < 3; ++s) {
+    const SpanEdge& g = t.edge[s];
+    if (w < g.row_first || w >= g.row_last) continue;
+    SpanDdaState& st = e[s];
+    const int64_t r = st.r - g.m;
+    if (r < 0) {
+      st.r = r + g.div;
+      st.q = wrapTo(u(st.q + g.k + 1), coord_bits);
+    } else {
+      st.r = r;
+      st.q = wrapTo(u(st.q + g.k), coord_bits);
+    }
+  }
+}
+
+void checkDescriptor(const SpanParams& p, const SpanDesc& d) {
+  if (static_cast<int>(d.tri.size()) != p.NumTri || static_cast<int>(d.iref.size()) != p.NumAttr)
+    throw std::invalid_argument("span descriptor does not match the unit's NumTri/NumAttr");
+  if (d.row_first > d.row_last)  // the RTL would walk until w wraps
+    throw std::invalid_argument("span descriptor without rows: setup drops such triangles");
+}
+
+// The lane fragment at walker column x of row wspan, attribute base icur + i*didx (lane i).
+void laneFragment(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t x, int64_t wspan,
+                  const int64_t* icur, int i, int32_t& px_out, int32_t& py_out, AttrVec& attr) {
+  const int64_t px = t.flip ? t.ox - x : x + t.ox;
+  const int64_t py = t.flip ? t.oy - wspan : wspan + t.oy;
+  const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
+  px_out = static_cast<int32_t>(px & pix_mask);
+  py_out = static_cast<int32_t>(py & pix_mask);
+  attr.resize(static_cast<size_t>(p.NumAttr));
+  for (int a = 0; a < p.NumAttr; ++a) {
+    const size_t ai = static_cast<size_t>(a);
+    const uint64_t v = u(icur[ai]) + static_cast<uint64_t>(i) * u(d.didx[ai]);
+    attr[ai] = wrapTo(t.flip ? u(t.aoff[ai]) - v : v + u(t.aoff[ai]), p.AttrBits);
+  }
+}
+
 }  // namespace
 
 SpanUnitModel::SpanUnitModel(SpanParams p) : p_(p) {
@@ -92,7 +148,7 @@ int64_t SpanUnitModel::wrapCoord(int64_t v) const { return wrapTo(u(v), p_.Coord
 
 void SpanUnitModel::reset() {
   state_ = State::Idle;
-  e_.assign(static_cast<size_t>(p_.NumTri) * 3, EdgeState{});
+  e_.assign(static_cast<size_t>(p_.NumTri) * 3, SpanDdaState{});
   irow_.assign(static_cast<size_t>(p_.NumAttr), 0);
   icur_.assign(static_cast<size_t>(p_.NumAttr), 0);
   lo_.assign(static_cast<size_t>(p_.NumTri), 0);
@@ -117,16 +173,7 @@ void SpanUnitModel::outputs(SpanOut& o) const {
       const int64_t x = xg_ + i;  // CoordBits + 1 bits: no wrap
       lane.valid = ne_[static_cast<size_t>(j)] && lo_[static_cast<size_t>(j)] <= x && x <= hi_[static_cast<size_t>(j)];
       if (!lane.valid) continue;
-      const int64_t px = t.flip ? t.ox - x : x + t.ox;
-      const int64_t py = t.flip ? t.oy - wspan_ : wspan_ + t.oy;
-      lane.x = static_cast<int32_t>(px & ((int64_t{1} << p_.PixBits) - 1));
-      lane.y = static_cast<int32_t>(py & ((int64_t{1} << p_.PixBits) - 1));
-      lane.attr.resize(static_cast<size_t>(p_.NumAttr));
-      for (int a = 0; a < p_.NumAttr; ++a) {
-        const size_t ai = static_cast<size_t>(a);
-        const uint64_t v = u(icur_[ai]) + static_cast<uint64_t>(i) * u(d_.didx[ai]);
-        lane.attr[ai] = wrapAttr(t.flip ? u(t.aoff[ai]) - v : v + u(t.aoff[ai]));
-      }
+      laneFragment(p_, d_, t, x, wspan_, icur_.data(), i, lane.x, lane.y, lane.attr);
       o.out_valid = true;
     }
   }
@@ -146,11 +193,8 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
   switch (state_) {
     case State::Idle:
       if (in.desc_valid) {
-        if (in.desc == nullptr || static_cast<int>(in.desc->tri.size()) != p_.NumTri ||
-            static_cast<int>(in.desc->iref.size()) != p_.NumAttr)
-          throw std::invalid_argument("span descriptor does not match the unit's NumTri/NumAttr");
-        if (in.desc->row_first > in.desc->row_last)  // the RTL would walk until w wraps
-          throw std::invalid_argument("span descriptor without rows: setup drops such triangles");
+        if (in.desc == nullptr) throw std::invalid_argument("span descriptor missing");
+        checkDescriptor(p_, *in.desc);
         d_ = *in.desc;
         w_ = d_.row_first;
         for (int j = 0; j < p_.NumTri; ++j)
@@ -158,7 +202,7 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
             const SpanEdge& e = d_.tri[static_cast<size_t>(j)].edge[s];
             e_[static_cast<size_t>(j * 3 + s)] = {e.q, e.r};
           }
-        irow_ = d_.iref;
+        irow_.assign(d_.iref.begin(), d_.iref.end());
         state_ = State::Row;
       }
       break;
@@ -167,16 +211,8 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
       int64_t xs = 0, xe = 0;
       for (int j = 0; j < p_.NumTri; ++j) {
         const size_t ju = static_cast<size_t>(j);
-        const SpanLaneTri& t = d_.tri[ju];
-        int64_t lo = t.clip_x0, hi = t.clip_x1;
-        for (int s = 0; s < 3; ++s) {
-          const SpanEdge& e = t.edge[s];
-          if (w_ < e.row_first || w_ > e.row_last) continue;
-          const int64_t q = e_[static_cast<size_t>(j * 3 + s)].q;
-          if (e.right) hi = std::min(hi, -q);
-          else lo = std::max(lo, q);
-        }
-        const bool ne = t.row_first <= w_ && w_ <= t.row_last && lo <= hi;
+        int64_t lo = 0, hi = 0;
+        const bool ne = laneRowBounds(d_.tri[ju], w_, &e_[ju * 3], lo, hi);
         lo_[ju] = lo;
         hi_[ju] = hi;
         ne_[ju] = ne;
@@ -200,19 +236,7 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
       }
       // Advance to the next row: DDA steps of the edges active here that stay active.
       for (int j = 0; j < p_.NumTri; ++j)
-        for (int s = 0; s < 3; ++s) {
-          const SpanEdge& e = d_.tri[static_cast<size_t>(j)].edge[s];
-          if (w_ < e.row_first || w_ >= e.row_last) continue;
-          EdgeState& st = e_[static_cast<size_t>(j * 3 + s)];
-          const int64_t r = st.r - e.m;
-          if (r < 0) {
-            st.r = r + e.div;
-            st.q = wrapCoord(st.q + e.k + 1);
-          } else {
-            st.r = r;
-            st.q = wrapCoord(st.q + e.k);
-          }
-        }
+        stepEdges(d_.tri[static_cast<size_t>(j)], w_, &e_[static_cast<size_t>(j) * 3], p_.CoordBits);
       for (int a = 0; a < p_.NumAttr; ++a) {
         const size_t ai = static_cast<size_t>(a);
         irow_[ai] = wrapAttr(u(irow_[ai]) + u(d_.didy[ai]));
@@ -262,6 +286,75 @@ SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d) {
   run.row_cycles = m.rowCycles() - rows0;
   run.span_cycles = m.spanCycles() - spans0;
   return run;
+}
+
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out) {
+  checkDescriptor(p, d);
+  const int L = p.LanesPerTri, T = p.NumTri, K = p.NumAttr;
+  SpanWalk walk;
+  walk.cycles = 1;  // IDLE, accepting the descriptor
+  std::array<SpanDdaState, kMaxLaneTri * 3> e{};
+  for (int j = 0; j < T; ++j)
+    for (int s = 0; s < 3; ++s) {
+      const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];
+      e[static_cast<size_t>(j * 3 + s)] = {g.q, g.r};
+    }
+  std::array<int64_t, kMaxAttr> irow{}, icur{};
+  std::copy(d.iref.begin(), d.iref.end(), irow.begin());
+  std::array<int64_t, kMaxLaneTri> lo{}, hi{};
+  std::array<bool, kMaxLaneTri> ne{};
+  SpanFragment f;
+  f.tag = d.tag;
+  for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
+    ++walk.row_cycles;
+    bool any = false;
+    int64_t xs = 0, xe = 0;
+    for (int j = 0; j < T; ++j) {
+      const size_t ju = static_cast<size_t>(j);
+      ne[ju] = laneRowBounds(d.tri[ju], w, &e[ju * 3], lo[ju], hi[ju]);
+      if (ne[ju]) {
+        xs = any ? std::min(xs, lo[ju]) : lo[ju];
+        xe = any ? std::max(xe, hi[ju]) : hi[ju];
+        any = true;
+      }
+    }
+    if (any) {
+      int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+      for (int a = 0; a < K; ++a) {
+        const size_t ai = static_cast<size_t>(a);
+        icur[ai] = wrapTo(u(irow[ai]) + u(d.didx[ai]) * u(xg - d.xref), p.AttrBits);
+      }
+      for (;;) {  // SPAN cycles
+        ++walk.span_cycles;
+        for (int j = 0; j < T; ++j) {
+          const size_t ju = static_cast<size_t>(j);
+          if (!ne[ju]) continue;
+          for (int i = 0; i < L; ++i) {
+            const int64_t x = xg + i;
+            if (x < lo[ju] || x > hi[ju]) continue;
+            laneFragment(p, d, d.tri[ju], x, w, icur.data(), i, f.x, f.y, f.attr);
+            out.push_back(f);
+            ++walk.fragments;
+          }
+        }
+        if (xg + L > xe) break;
+        xg += L;
+        for (int a = 0; a < K; ++a) {
+          const size_t ai = static_cast<size_t>(a);
+          icur[ai] = wrapTo(u(icur[ai]) + static_cast<uint64_t>(L) * u(d.didx[ai]), p.AttrBits);
+        }
+      }
+    }
+    for (int j = 0; j < T; ++j)
+      stepEdges(d.tri[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
+    for (int a = 0; a < K; ++a) {
+      const size_t ai = static_cast<size_t>(a);
+      irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
+    }
+    if (w == d.row_last) break;
+  }
+  walk.cycles += walk.row_cycles + walk.span_cycles;
+  return walk;
 }
 
 }  // namespace shd

@@ -80,7 +80,13 @@
 #include <string>
 #include <vector>
 
+#include "raster/inline_vec.h"
+
 namespace shd {
+
+constexpr size_t kMaxAttr = 16;    // NumAttr <= 16
+constexpr size_t kMaxLaneTri = 4;  // NumTri is 1 or 4
+using AttrVec = InlineVec<int64_t, kMaxAttr>;  // attribute codes, held in place (no heap)
 
 enum class SpanMode { Serial, EvenOdd, Seg2, Seg4, Seg8, Sierpinski };
 const char* toString(SpanMode m);        // "serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"
@@ -121,7 +127,7 @@ struct SpanLaneTri {
   SpanEdge edge[3];
   bool flip = false;
   int32_t ox = 0, oy = 0;
-  std::vector<int64_t> aoff;  // NumAttr
+  AttrVec aoff;  // NumAttr
 };
 
 struct SpanDesc {
@@ -131,20 +137,20 @@ struct SpanDesc {
   // otherwise walk until w wraps.
   int32_t row_first = 0, row_last = -1;
   int32_t xref = 0;                      // iref is the plane at (xref, row_first)
-  std::vector<int64_t> iref, didx, didy;  // NumAttr each
-  std::vector<SpanLaneTri> tri;           // NumTri
+  AttrVec iref, didx, didy;                  // NumAttr each
+  InlineVec<SpanLaneTri, kMaxLaneTri> tri;  // NumTri
 };
 
 struct SpanFragment {
   uint32_t tag = 0;
   int32_t x = 0, y = 0;
-  std::vector<int64_t> attr;
+  AttrVec attr;
 };
 
 struct SpanLaneOut {
   bool valid = false;
   int32_t x = 0, y = 0;
-  std::vector<int64_t> attr;
+  AttrVec attr;
 };
 
 struct SpanIn {
@@ -158,6 +164,11 @@ struct SpanOut {
   bool out_valid = false;
   uint32_t tag = 0;
   std::vector<SpanLaneOut> lane;  // lanes(); data meaningful where valid
+};
+
+// An edge's DDA registers: the quotient q and remainder r of the current row.
+struct SpanDdaState {
+  int64_t q = 0, r = 0;
 };
 
 class SpanUnitModel {
@@ -179,9 +190,6 @@ class SpanUnitModel {
 
  private:
   enum class State { Idle, Row, Span };
-  struct EdgeState {
-    int64_t q = 0, r = 0;
-  };
   void outputs(SpanOut& o) const;
   int64_t wrapAttr(uint64_t v) const;
   int64_t wrapCoord(int64_t v) const;
@@ -190,7 +198,7 @@ class SpanUnitModel {
   State state_ = State::Idle;
   SpanDesc d_;
   int64_t w_ = 0, wspan_ = 0, xg_ = 0, xe_ = 0;
-  std::vector<EdgeState> e_;         // NumTri*3
+  std::vector<SpanDdaState> e_;      // NumTri*3
   std::vector<int64_t> irow_, icur_;  // NumAttr
   std::vector<int64_t> lo_, hi_;      // NumTri
   std::vector<bool> ne_;
@@ -207,5 +215,16 @@ struct SpanRun {
   uint64_t row_cycles = 0;   // ROW cycles
 };
 SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d);
+
+// The same unit without the cycle-by-cycle machinery: the fragments of one descriptor in the
+// order SpanUnitModel hands them over with out_ready always 1 (cycle by cycle, lane by lane
+// within a cycle), appended to `out`, and the cycles it takes, counted as runSpanUnit counts
+// them. It shares the ROW logic with SpanUnitModel and is bit- and cycle-exact to it
+// (test_span_unit compares them on the generator's streams in every mode): the renderer's
+// fast path, with no allocation beyond the growth of `out`.
+struct SpanWalk {
+  uint64_t cycles = 0, row_cycles = 0, span_cycles = 0, fragments = 0;
+};
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out);
 
 }  // namespace shd

@@ -7,23 +7,8 @@ namespace shd {
 
 std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn,
                                             size_t count) {
-  std::vector<uint64_t> f;
-  if (count == 0) return f;
-  f.reserve(count);
-  uint64_t A = 0, B = 0, C = 0;
-  for (size_t k = 0; k < 3; ++k) {
-    const uint64_t a = static_cast<uint64_t>(n0[k]), d = static_cast<uint64_t>(dn[k]);
-    A += a * a;
-    B += a * d;
-    C += d * d;
-  }
-  uint64_t F = A, Ci = C;  // F_0 = A, C_1 = C
-  f.push_back(F);
-  for (size_t i = 1; i < count; ++i) {
-    F += 2 * B + Ci;  // F_i = F_{i-1} + 2B + C_i
-    Ci += 2 * C;      // C_{i+1} = C_i + 2C
-    f.push_back(F);
-  }
+  std::vector<uint64_t> f(count);
+  squaredNormsAlongSpan(n0, dn, count, [&](size_t i, uint64_t v) { f[i] = v; });
   return f;
 }
 
@@ -55,7 +40,11 @@ double rsqrtFixed(uint64_t v, int frac_bits) {
   const int64_t r1 = static_cast<int64_t>(r0) * ((int64_t{3} << 32) - static_cast<int64_t>(mr)) >> 33;  // Q16
   // value = (m / 2^62) * 2^e with e = 62 - 2 shift - frac_bits
   const int e = 62 - 2 * shift - frac_bits;
-  return std::ldexp(static_cast<double>(r1), -16) * std::pow(2.0, -0.5 * e);
+  // 2^(-e/2): a power of two, times sqrt(2) when e is odd (what pow(2, -e/2) rounds to).
+  static const double kSqrt2 = std::sqrt(2.0);
+  const int h = e >= 0 ? -((e + 1) / 2) : (-e) / 2;  // floor(-e/2)
+  const double scale = (e & 1) != 0 ? std::ldexp(kSqrt2, h) : std::ldexp(1.0, h);
+  return std::ldexp(static_cast<double>(r1), -16) * scale;
 }
 
 }  // namespace shd

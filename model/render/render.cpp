@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <set>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -54,10 +53,14 @@ PVertex lerp(const PVertex& a, const PVertex& b, double t) {
   return r;
 }
 
+// A polygon of the clipper: a triangle cut by the near plane and the four guard-band planes
+// has at most 3 + 5 vertices.
+using Poly = InlineVec<PVertex, 8>;
+
 // Sutherland-Hodgman against one half-plane dist(v) >= 0.
 template <class Dist>
-std::vector<PVertex> clipPolygon(const std::vector<PVertex>& in, Dist dist) {
-  std::vector<PVertex> out;
+Poly clipPolygon(const Poly& in, Dist dist) {
+  Poly out;
   for (size_t i = 0; i < in.size(); ++i) {
     const PVertex& a = in[i];
     const PVertex& b = in[(i + 1) % in.size()];
@@ -195,8 +198,15 @@ std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt) 
 }
 
 RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& engines) {
-  const auto t0 = std::chrono::steady_clock::now();
   RenderResult res;
+  render(scene, opt, span, engines, res);
+  return res;
+}
+
+void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& engines, RenderResult& res) {
+  const auto t0 = std::chrono::steady_clock::now();
+  res.stats = RenderStats{};
+  res.triangles.clear();
   RenderStats& st = res.stats;
   const Camera& cam = scene.camera;
   const int W = cam.width, H = cam.height;
@@ -210,6 +220,9 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
   if (reference) {
     fb.lsb.assign(static_cast<size_t>(W) * H * 3, 0.0);
     fb.spec_lsb.assign(static_cast<size_t>(W) * H * 3, 0.0);
+  } else {
+    fb.lsb.clear();
+    fb.spec_lsb.clear();
   }
   const CameraBasis basis = cameraBasis(cam);
   const ShadeContext ctx = makeShadeContext(scene);
@@ -255,11 +268,38 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
     return s.lsb;
   };
 
+  // Camera space -> screen (pixels, y down) and w = z_near / Z, for Z >= z_near.
+  auto project = [&](PVertex& v) {
+    v.x = cx + f * v.cam.x / v.cam.z;
+    v.y = cy - f * v.cam.y / v.cam.z;
+    v.w = cam.z_near / v.cam.z;
+  };
   // Pixel centre -> camera space point of the surface, from w = z_near / Z.
   auto pixelCam = [&](double px, double py, double w) {
     const double Z = cam.z_near / w;
     return Vec3{(px + 0.5 - cx) * Z / f, -(py + 0.5 - cy) * Z / f, Z};
   };
+
+  // Per-triangle buffers, reused across the frame (no allocation per triangle or fragment once
+  // they have grown).
+  std::vector<Part> parts;
+  std::vector<SpanFragment> frags;
+  struct Pending {  // a fragment waiting for its specular-unit results
+    size_t pixel;
+    int64_t w;
+    std::array<double, 3> lsb;
+    size_t dev_first, dev_count;
+  };
+  std::vector<Pending> pend;
+  std::vector<SpecRequest> requests;
+  std::vector<size_t> order;
+  std::vector<uint64_t> sqnorm;
+  std::vector<Vec3> bisected;
+  std::vector<uint8_t> row_divided(static_cast<size_t>(H), 0);
+  std::vector<int32_t> divided_rows;
+  RasterConfig rc_colour = rc, rc_unit = rc;
+  rc_colour.attr_frac_bits = {kColourFrac, kColourFrac, kColourFrac, kUnitFrac};
+  rc_unit.attr_frac_bits = {kUnitFrac, kUnitFrac, kUnitFrac, kUnitFrac};
 
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) {
     const SceneObject& obj = scene.objects[oi];
@@ -269,12 +309,14 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
     if (isDeviceLobe(lobe) && spec == nullptr && !reference)
       throw std::invalid_argument(fmt::format("object '{}': brdf {} needs the specular unit", obj.name, toString(lobe)));
     coding = codingFor(spec);
-    // Object -> camera space, and the Gouraud vertex colours.
+    // Object -> camera space, the projection of the vertices in front of the near plane, and
+    // the Gouraud vertex colours.
     std::vector<PVertex> verts(obj.mesh.positions.size());
     for (size_t i = 0; i < verts.size(); ++i) {
       PVertex& v = verts[i];
       v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
       v.n = normalize(toCameraDirection(basis, obj.transform.normal(obj.mesh.normals[i])));
+      if (v.cam.z >= cam.z_near) project(v);
     }
     if (opt.method == Method::Gouraud || opt.method == Method::GouraudClassical || opt.method == Method::Biquadratic ||
         opt.method == Method::ModifiedGouraud || opt.method == Method::Adaptive)
@@ -283,26 +325,27 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
     for (size_t ti = 0; ti < obj.mesh.triangles.size(); ++ti) {
       ++st.triangles;
       const auto& tri = obj.mesh.triangles[ti];
-      std::vector<PVertex> poly{verts[tri[0]], verts[tri[1]], verts[tri[2]]};
-      // Near plane, camera space.
-      const bool all_in = std::all_of(poly.begin(), poly.end(), [&](const PVertex& v) { return v.cam.z >= cam.z_near; });
-      if (!all_in) {
+      const PVertex &v0 = verts[tri[0]], &v1 = verts[tri[1]], &v2 = verts[tri[2]];
+      const bool all_in = v0.cam.z >= cam.z_near && v1.cam.z >= cam.z_near && v2.cam.z >= cam.z_near;
+      // Back faces: the idx3d front face has a negative screen area (y down), see sphere.h.
+      // A triangle wholly in front of the near plane is culled before anything is copied.
+      if (all_in && !(area2(v0, v1, v2) < 0)) {
+        ++st.culled;
+        continue;
+      }
+      Poly poly{v0, v1, v2};
+      if (!all_in) {  // near plane, camera space
         poly = clipPolygon(poly, [&](const PVertex& v) { return v.cam.z - cam.z_near; });
         if (poly.size() < 3) {
           ++st.culled;
           continue;
         }
         ++st.clipped;
-      }
-      for (PVertex& v : poly) {
-        v.x = cx + f * v.cam.x / v.cam.z;
-        v.y = cy - f * v.cam.y / v.cam.z;
-        v.w = cam.z_near / v.cam.z;
-      }
-      // Back faces: the idx3d front face has a negative screen area (y down), see sphere.h.
-      if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
-        ++st.culled;
-        continue;
+        for (PVertex& v : poly) project(v);
+        if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
+          ++st.culled;
+          continue;
+        }
       }
       // Guard band, screen space (attributes interpolate linearly there, as in the span unit).
       const bool in_guard = std::all_of(poly.begin(), poly.end(), [&](const PVertex& v) {
@@ -330,7 +373,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
       }
       // The screen triangles to draw (a fan of the clipped polygon), each with the method that
       // draws it: modified Gouraud may split one into parts, adaptive picks per triangle.
-      std::vector<Part> parts;
+      parts.clear();
       for (size_t k = 1; k + 1 < poly.size(); ++k) {
         const std::array<PVertex, 3> t{poly[0], poly[k], poly[k + 1]};
         if (opt.method == Method::ModifiedGouraud) {
@@ -350,9 +393,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
         const std::array<const PVertex*, 3> tv{&part.v[0], &part.v[1], &part.v[2]};
         const bool colour_attrs_m =
             m == Method::Flat || m == Method::Gouraud || m == Method::GouraudClassical || m == Method::Biquadratic;
-        RasterConfig rcm = rc;
-        rcm.attr_frac_bits = colour_attrs_m ? std::vector<int>{kColourFrac, kColourFrac, kColourFrac, kUnitFrac}
-                                            : std::vector<int>{kUnitFrac, kUnitFrac, kUnitFrac, kUnitFrac};
+        const RasterConfig& rcm = colour_attrs_m ? rc_colour : rc_unit;
         std::array<SetupVertex, 3> sv;
         for (size_t i = 0; i < 3; ++i) {
           const PVertex& v = *tv[i];
@@ -366,7 +407,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
           }
         }
         const uint32_t tag = static_cast<uint32_t>(res.triangles.size());
-        SetupResult s = setupTriangle(sv, tag, rcm);
+        const SetupResult s = setupTriangle(sv, tag, rcm);
         if (!s.desc) {
           ++st.culled;
           continue;
@@ -380,40 +421,41 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
         if (opt.method == Method::Adaptive) ++(m == Method::Gouraud ? st.adaptive_gouraud : st.adaptive_phong);
 
         // Fragments: the reference walks the same pixel set by direct edge evaluation.
-        std::vector<SpanFragment> frags;
+        frags.clear();
         if (reference) {
           frags = rasterizeReference(s, rcm);
         } else {
-          SpanRun run = span.run(*s.desc);
-          st.span_cycles += run.cycles;
-          frags = std::move(run.fragments);
+          st.span_cycles += span.run(*s.desc, frags).cycles;
         }
         st.fragments += frags.size();
 
-        // Z-test against the triangles drawn before this one.
-        struct Pending {
-          size_t pixel;
-          int64_t w;
-          std::array<double, 3> lsb;
-          size_t dev_first, dev_count;
-          double spec_lsb[3];
+        // A fragment's colour, written at once, or (per-pixel device lobes) once the specular
+        // unit has evaluated the triangle's batch of requests.
+        const bool batched =
+            !reference && isDeviceLobe(lobe) && (m == Method::Phong || m == Method::PhongIncremental || m == Method::NormalBisection);
+        pend.clear();
+        requests.clear();
+        auto write = [&](size_t p, int64_t w, const std::array<uint8_t, 3>& c) {
+          for (size_t k = 0; k < 3; ++k) fb.rgb[p * 3 + k] = c[k];
+          fb.depth[p] = static_cast<int32_t>(w);
+          fb.tri[p] = static_cast<int32_t>(tag);
         };
-        std::vector<Pending> pend;
-        std::vector<SpecRequest> requests;
-        // phong-incremental: |N|^2 of every fragment by the span recurrence, row by row in x
-        // order (lane modes emit a row's pixels out of order).
-        std::vector<uint64_t> sqnorm;
-        std::vector<Vec3> bisected;  // normal-bisection: the normal used at each fragment
         auto rawNormal = [&](const SpanFragment& f) {
           return Vec3{std::ldexp(static_cast<double>(f.attr[0]), -kUnitFrac), std::ldexp(static_cast<double>(f.attr[1]), -kUnitFrac),
                       std::ldexp(static_cast<double>(f.attr[2]), -kUnitFrac)};
         };
-        if (m == Method::NormalBisection) {
-          std::vector<size_t> order(frags.size());
+        // Row-major order of the fragments (lane modes emit a row's pixels out of order, and
+        // the Sierpinski lanes interleave rows): the incremental methods walk each row in x.
+        auto rowOrder = [&] {
+          order.resize(frags.size());
           for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-          std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+          auto before = [&](size_t a, size_t b) {
             return frags[a].y != frags[b].y ? frags[a].y < frags[b].y : frags[a].x < frags[b].x;
-          });
+          };
+          if (!std::is_sorted(order.begin(), order.end(), before)) std::sort(order.begin(), order.end(), before);
+        };
+        if (m == Method::NormalBisection) {
+          rowOrder();
           bisected.assign(frags.size(), Vec3{0, 0, 0});
           for (size_t i = 0; i < order.size();) {
             size_t j = i;
@@ -455,19 +497,17 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
           }
         }
         if (m == Method::PhongIncremental) {
-          std::vector<size_t> order(frags.size());
-          for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-          std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-            return frags[a].y != frags[b].y ? frags[a].y < frags[b].y : frags[a].x < frags[b].x;
-          });
-          sqnorm.assign(frags.size(), 0);
+          // |N|^2 of every fragment by the span recurrence, row by row in x order.
+          rowOrder();
+          sqnorm.resize(frags.size());
           const std::array<int64_t, 3> dn{s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]};
           for (size_t i = 0; i < order.size();) {
             size_t j = i;
             while (j < order.size() && frags[order[j]].y == frags[order[i]].y) ++j;
             const SpanFragment& first = frags[order[i]];
-            const auto f = squaredNormsAlongSpan({first.attr[0], first.attr[1], first.attr[2]}, dn, j - i);
-            for (size_t k = i; k < j; ++k) sqnorm[order[k]] = f[k - i];
+            squaredNormsAlongSpan({first.attr[0], first.attr[1], first.attr[2]}, dn, j - i, [&](size_t k, uint64_t f) {
+              sqnorm[order[i + k]] = f;
+            });
             i = j;
           }
         }
@@ -486,19 +526,20 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
           const double l2 = ((tv[1]->x - tv[0]->x) * (py - tv[0]->y) - (px - tv[0]->x) * (tv[1]->y - tv[0]->y)) / d;
           return std::array<double, 3>{1 - l1 - l2, l1, l2};
         };
-        size_t frag_index = 0;
-        std::set<int32_t> divided_rows;  // gouraud-classical: rows that paid a division
-        for (const SpanFragment& fr : frags) {
-          const size_t fi = frag_index++;
+        for (size_t fi = 0; fi < frags.size(); ++fi) {
+          const SpanFragment& fr = frags[fi];
           const size_t p = static_cast<size_t>(fr.y) * W + fr.x;
           const int64_t wcode = fr.attr[3];
+          // Z-test against the triangles drawn before this one.
           if (wcode <= fb.depth[p]) continue;
-          Pending pd{p, wcode, {}, requests.size(), 0, {0, 0, 0}};
+          std::array<double, 3> lsb{};
           switch (m) {
             case Method::Flat:
             case Method::Gouraud:
-              for (size_t k = 0; k < 3; ++k) pd.lsb[k] = std::ldexp(static_cast<double>(fr.attr[k]), -kColourFrac);
-              break;
+              // The interpolated colour codes straight to unorm8 (what combine() gives them).
+              write(p, wcode, {unorm8FromCode(fr.attr[0], kColourFrac), unorm8FromCode(fr.attr[1], kColourFrac),
+                               unorm8FromCode(fr.attr[2], kColourFrac)});
+              continue;
             case Method::GouraudClassical: {
               // The classical loop: along both edges, then one division per raster line (float).
               const float yc = static_cast<float>(fr.y) + 0.5f;
@@ -525,10 +566,15 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
                 }
               }
               const float len = xr - xl;
-              if (len > 0 && divided_rows.insert(fr.y).second) ++st.divisions;
+              const size_t row = static_cast<size_t>(fr.y);
+              if (len > 0 && !row_divided[row]) {
+                row_divided[row] = 1;
+                divided_rows.push_back(fr.y);
+                ++st.divisions;
+              }
               for (size_t k = 0; k < 3; ++k) {
                 const float step = len > 0 ? (cr[k] - cl[k]) / len : 0.0f;
-                pd.lsb[k] = cl[k] + step * (static_cast<float>(fr.x) + 0.5f - xl);
+                lsb[k] = cl[k] + step * (static_cast<float>(fr.x) + 0.5f - xl);
               }
               break;
             }
@@ -546,10 +592,13 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
                 n = rsqrtFixed(sqnorm[fi], 2 * kUnitFrac) * nraw;
               }
               const Vec3 pc = pixelCam(fr.x, fr.y, std::ldexp(static_cast<double>(wcode), -kUnitFrac));
-              Shade sh = shadePoint(ctx, mat, lobe, n, pc, isDeviceLobe(lobe) ? &coding : nullptr);
-              pd.lsb = sh.lsb;
-              pd.dev_count = sh.device.size();
-              requests.insert(requests.end(), sh.device.begin(), sh.device.end());
+              Shade sh = shadePoint(ctx, mat, lobe, n, pc, batched ? &coding : nullptr);
+              lsb = sh.lsb;
+              if (batched) {
+                pend.push_back({p, wcode, lsb, requests.size(), sh.device.size()});
+                requests.insert(requests.end(), sh.device.begin(), sh.device.end());
+                continue;
+              }
               break;
             }
             case Method::ModifiedGouraud:
@@ -562,7 +611,7 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
                 double v = 0;
                 for (size_t i = 0; i < 3; ++i) v += std::clamp(tv[i]->colour[k], 0.0, 255.0) * l[i] * (2 * l[i] - 1);
                 for (size_t e = 0; e < 3; ++e) v += 4 * mid_colour[e][k] * l[e] * l[(e + 1) % 3];
-                pd.lsb[k] = v;
+                lsb[k] = v;
               }
               break;
             }
@@ -574,39 +623,33 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
               const Vec3 pc = pixelCam(fr.x, fr.y, w);
               const Lobe ref_lobe = isDeviceLobe(lobe) ? Lobe::Blinn : lobe;
               const Shade sh = shadePoint(ctx, mat, ref_lobe, n, pc, nullptr);
-              pd.lsb = sh.lsb;
+              lsb = sh.lsb;
               // The specular part alone, for highlight masks.
               Material nospec = mat;
               nospec.ks = 0;
               const Shade dif = shadePoint(ctx, nospec, ref_lobe, n, pc, nullptr);
-              for (size_t k = 0; k < 3; ++k) pd.spec_lsb[k] = sh.lsb[k] - dif.lsb[k];
+              for (size_t k = 0; k < 3; ++k) {
+                fb.lsb[p * 3 + k] = sh.lsb[k];
+                fb.spec_lsb[p * 3 + k] = sh.lsb[k] - dif.lsb[k];
+              }
               break;
             }
           }
-          pend.push_back(pd);
+          write(p, wcode, combine(lsb, nullptr, 0));
         }
+        for (int32_t row : divided_rows) row_divided[static_cast<size_t>(row)] = 0;
+        divided_rows.clear();
         if (!requests.empty()) {
           st.spec_cycles += spec->evaluate(requests, device_out);
           st.spec_evaluations += requests.size();
         }
-        for (const Pending& pd : pend) {
-          const std::array<uint8_t, 3> c =
-              combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count);
-          for (size_t k = 0; k < 3; ++k) fb.rgb[pd.pixel * 3 + k] = c[k];
-          fb.depth[pd.pixel] = pd.w;
-          fb.tri[pd.pixel] = static_cast<int32_t>(tag);
-          if (reference)
-            for (size_t k = 0; k < 3; ++k) {
-              fb.lsb[pd.pixel * 3 + k] = pd.lsb[k];
-              fb.spec_lsb[pd.pixel * 3 + k] = pd.spec_lsb[k];
-            }
-        }
+        for (const Pending& pd : pend)
+          write(pd.pixel, pd.w, combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count));
       }
     }
   }
   for (int32_t t : fb.tri) st.pixels_covered += t >= 0 ? 1 : 0;
   st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  return res;
 }
 
 }  // namespace shd

@@ -86,22 +86,24 @@ Method parseMethod(const std::string& s);  // std::invalid_argument naming the c
 const char* toString(Method m);
 std::vector<Method> allMethods();
 
-// The span unit: fragments of one descriptor, and the cycles they took.
+// The span unit: the fragments of one descriptor, appended to `out` in the unit's output order,
+// and the cycles they took (IDLE to IDLE, the consumer always ready).
 class SpanEngine {
  public:
   virtual ~SpanEngine() = default;
   virtual const SpanParams& params() const = 0;
-  virtual SpanRun run(const SpanDesc& d) = 0;
+  virtual SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) = 0;
 };
 
+// The model: walkSpanUnit, bit- and cycle-exact to the cycle-by-cycle SpanUnitModel.
 class ModelSpanEngine final : public SpanEngine {
  public:
-  explicit ModelSpanEngine(SpanParams p) : unit_(p) {}
-  const SpanParams& params() const override { return unit_.params(); }
-  SpanRun run(const SpanDesc& d) override { return runSpanUnit(unit_, d); }
+  explicit ModelSpanEngine(SpanParams p) : p_(p) { p_.validate(); }
+  const SpanParams& params() const override { return p_; }
+  SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override { return walkSpanUnit(p_, d, out); }
 
  private:
-  SpanUnitModel unit_;
+  SpanParams p_;
 };
 
 // The specular unit: a batch of evaluations streamed one per cycle.
@@ -154,7 +156,7 @@ struct RenderStats {
 struct Framebuffer {
   int width = 0, height = 0;
   std::vector<uint8_t> rgb;    // unorm8, row-major, top row first
-  std::vector<int64_t> depth;  // w code of the visible fragment, 0 where nothing was drawn
+  std::vector<int32_t> depth;  // w code (28 fraction bits, <= 2^28) of the visible fragment, 0: none
   std::vector<int32_t> tri;    // id of the screen triangle that wrote the pixel, -1 none
   std::vector<double> lsb;     // reference only: the exact colour in LSBs (3 per pixel)
   std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
@@ -191,6 +193,8 @@ std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt);
 // Throws std::invalid_argument for an unknown brdf, a shininess the specular unit's PROM does
 // not hold, or a scene the pipeline cannot take (named).
 RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& spec);
+// The same into `res`, reusing its buffers (a frame loop allocates nothing after the first frame).
+void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& spec, RenderResult& res);
 
 // The specular unit configuration for a lobe: "default" (quadratic) or "cubic".
 std::string specConfigForLobe(Lobe l);

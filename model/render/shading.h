@@ -10,6 +10,7 @@
 // evaluation, and combine() adds them to the rest of the colour in the output's LSBs.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -71,5 +72,13 @@ Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n_u
 // Final unorm8: round(lsb) plus the device outputs, clamped to 0..255.
 // device_rgb points at `count` specular-unit results (may be null when count is 0).
 std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb, size_t count);
+
+// combine() of one channel without device outputs, from a fixed-point code with `frac` fraction
+// bits: round(clamp(code 2^-frac, 0, 255)) in integers (round half up = half away from zero
+// for the non-negative values left after the clamp).
+inline uint8_t unorm8FromCode(int64_t code, int frac) {
+  const int64_t c = std::clamp<int64_t>(code, 0, int64_t{255} << frac);
+  return static_cast<uint8_t>((c + (int64_t{1} << (frac - 1))) >> frac);
+}
 
 }  // namespace shd
