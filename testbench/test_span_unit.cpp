@@ -1,6 +1,7 @@
 // Triangle setup and the span unit model: the DDA walk against direct edge-function evaluation,
 // every lane mode against the serial mode, the fill rule on shared edges, the plane's error
 // bound, the cycle formula, and stalls.
+#include "fixed/fixed.h"
 #include "raster/setup.h"
 #include "raster/span_unit.h"
 #include "raster/desc_stream.h"
@@ -141,6 +142,31 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
 }
 
 }  // namespace
+
+TEST(TriangleSetup, SnapsHalfwayCoordinatesAndAttributesToEven) {
+  // Every vertex coordinate and attribute code is rounded half to even, as Fixed::fromDouble
+  // with Quant::RoundHalfEven: at S = 4 a coordinate k/32 is a half subpixel.
+  RasterConfig c = configFor(SpanMode::Serial, 64, 64);
+  c.attr_frac_bits = {0, 1, 12, 28};
+  const std::vector<double> xs = {1 + 1 / 32.0, 1 + 3 / 32.0, 2 - 1 / 32.0, 40.5 + 5 / 32.0};
+  const std::vector<double> as = {2.5, 3.5, -2.5, 0.25, 0.75, 1 + std::ldexp(1.0, -13), std::ldexp(3.0, -29)};
+  for (double x : xs)
+    for (double a : as) {
+      const SetupResult s = setupTriangle({vtx(x, 1, {a, a, a, 0}), vtx(x + 20, 3, {0, 0, 0, a}), vtx(x + 3, 30, {0, 0, 0, 0})}, 1, c);
+      const FixedFormat fx = FixedFormat::s(c.unit.CoordBits, c.subpixel_bits);
+      EXPECT_EQ(s.tri.X[0], Fixed::fromDouble(x, fx, Quant::RoundHalfEven, Overflow::Error).raw()) << x;
+      EXPECT_EQ(s.tri.Y[0], Fixed::fromDouble(1, fx, Quant::RoundHalfEven, Overflow::Error).raw());
+      for (int k = 0; k < 3; ++k) {
+        const int F = c.attr_frac_bits[static_cast<size_t>(k)];
+        const FixedFormat fa = FixedFormat::s(c.unit.AttrBits - F, F);
+        EXPECT_EQ(s.tri.a[static_cast<size_t>(k)][0], Fixed::fromDouble(a, fa, Quant::RoundHalfEven, Overflow::Error).raw())
+            << "attribute " << k << " value " << a;
+      }
+    }
+  // The halfway cases themselves: 1 + 1/32 -> 16.5 subpixels -> 16; 1 + 3/32 -> 17.5 -> 18.
+  EXPECT_EQ(setupTriangle({vtx(1 + 1 / 32.0, 1), vtx(20, 3), vtx(4, 30)}, 1, c).tri.X[0], 16);
+  EXPECT_EQ(setupTriangle({vtx(1 + 3 / 32.0, 1), vtx(20, 3), vtx(4, 30)}, 1, c).tri.X[0], 18);
+}
 
 TEST(TriangleSetup, TopLeftBiasAndPlaneOfAHandTriangle) {
   RasterConfig c = configFor(SpanMode::Serial, 8, 8);

@@ -147,7 +147,8 @@ Fixed Fixed::fromDouble(double x, FixedFormat fmt, Quant q, Overflow o) {
     if (o == Overflow::Saturate) return Fixed(y < 0 ? fmt.rawMin() : fmt.rawMax(), fmt);
     throw std::overflow_error(fmt::format("{} does not fit fixed-point format {}", x, fmt.str()));
   }
-  __int128 quot = static_cast<__int128>(fl);
+  // (through int64_t when it fits: the direct double -> __int128 conversion is a slow libgcc call)
+  __int128 quot = std::fabs(fl) < 0x1p62 ? static_cast<__int128>(static_cast<int64_t>(fl)) : static_cast<__int128>(fl);
   switch (q) {
     case Quant::Trunc: break;
     case Quant::RoundHalfUp: quot += rem >= 0.5 ? 1 : 0; break;

@@ -2,11 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
-#include "fixed/fixed.h"
 
 namespace shd {
 
@@ -14,7 +14,20 @@ namespace {
 
 using i128 = __int128;
 
+// round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven (nearbyint rounds half to even
+// in the default rounding mode), without its format checks: the callers have bounded |v 2^frac|
+// well below 2^62 (the guard band, the attribute range).
+int64_t snapHalfEven(double v, int frac) { return static_cast<int64_t>(std::nearbyint(std::ldexp(v, frac))); }
+
+bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }
+
 int64_t floorDiv(i128 a, i128 b) {  // b > 0
+  if (fitsI64(a) && fitsI64(b)) {  // the common case, without the slow 128-bit division
+    const int64_t a64 = static_cast<int64_t>(a), b64 = static_cast<int64_t>(b);
+    int64_t q = a64 / b64;
+    if ((a64 % b64) != 0 && a64 < 0) --q;
+    return q;
+  }
   i128 q = a / b;
   if ((a % b) != 0 && a < 0) --q;
   return static_cast<int64_t>(q);
@@ -23,7 +36,14 @@ int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
 
 // round-half-even(num / den), den > 0
 i128 roundDiv(i128 num, i128 den) {
-  i128 q = num / den, r = num % den;
+  i128 q, r;
+  if (fitsI64(num) && fitsI64(den)) {
+    q = static_cast<int64_t>(num) / static_cast<int64_t>(den);
+    r = static_cast<int64_t>(num) % static_cast<int64_t>(den);
+  } else {
+    q = num / den;
+    r = num % den;
+  }
   if (r < 0) {
     --q;
     r += den;
@@ -211,8 +231,8 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
                                               tag, i, v[i].x, v[i].y, guard));
     if (static_cast<int>(v[i].attr.size()) != K)
       throw std::invalid_argument(fmt::format("triangle {}: vertex {} has {} attributes, the unit takes {}", tag, i, v[i].attr.size(), K));
-    t.X[i] = Fixed::fromDouble(v[i].x, FixedFormat::s(p.CoordBits, S), Quant::RoundHalfEven, Overflow::Error).raw();
-    t.Y[i] = Fixed::fromDouble(v[i].y, FixedFormat::s(p.CoordBits, S), Quant::RoundHalfEven, Overflow::Error).raw();
+    t.X[i] = snapHalfEven(v[i].x, S);
+    t.Y[i] = snapHalfEven(v[i].y, S);
   }
   t.a.assign(static_cast<size_t>(K), {});
   const int64_t err_bound = (1 + int64_t{cfg.width} + cfg.height) / 2 + 2;  // codes, see header
@@ -225,7 +245,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
         throw std::invalid_argument(fmt::format(
             "triangle {}: attribute {} = {} at vertex {} does not fit AttrBits {} with {} fraction bits", tag, k, val, i,
             p.AttrBits, F));
-      t.a[static_cast<size_t>(k)][i] = Fixed::fromDouble(val, FixedFormat::s(p.AttrBits - F, F), Quant::RoundHalfEven, Overflow::Error).raw();
+      t.a[static_cast<size_t>(k)][i] = snapHalfEven(val, F);
     }
   t.det = (t.X[1] - t.X[0]) * (t.Y[2] - t.Y[0]) - (t.X[2] - t.X[0]) * (t.Y[1] - t.Y[0]);
   if (t.det == 0) {

@@ -20,8 +20,10 @@ const char* toString(SpanMode m) {
   return "?";
 }
 
-std::vector<SpanMode> allSpanModes() {
-  return {SpanMode::Serial, SpanMode::EvenOdd, SpanMode::Seg2, SpanMode::Seg4, SpanMode::Seg8, SpanMode::Sierpinski};
+const std::vector<SpanMode>& allSpanModes() {
+  static const std::vector<SpanMode> modes{SpanMode::Serial, SpanMode::EvenOdd, SpanMode::Seg2,
+                                           SpanMode::Seg4,   SpanMode::Seg8,    SpanMode::Sierpinski};
+  return modes;
 }
 
 SpanMode parseSpanMode(const std::string& s) {
@@ -318,7 +320,32 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFr
         any = true;
       }
     }
-    if (any) {
+    if (any && T == 1) {
+      // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
+      // successive columns, so the fragments come in x order, and lane i of the cycle at xg
+      // shows the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
+      const SpanLaneTri& t = d.tri[0];
+      const int64_t xg0 = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+      walk.span_cycles += static_cast<uint64_t>((xe - xg0) / L + 1);
+      std::array<uint64_t, kMaxAttr> acc{};
+      for (int a = 0; a < K; ++a) {
+        const size_t ai = static_cast<size_t>(a);
+        acc[ai] = u(irow[ai]) + u(d.didx[ai]) * u(lo[0] - d.xref);
+      }
+      const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
+      f.y = static_cast<int32_t>((t.flip ? t.oy - w : w + t.oy) & pix_mask);
+      f.attr.resize(static_cast<size_t>(K));
+      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+        f.x = static_cast<int32_t>((t.flip ? t.ox - x : x + t.ox) & pix_mask);
+        for (int a = 0; a < K; ++a) {
+          const size_t ai = static_cast<size_t>(a);
+          f.attr[ai] = wrapTo(t.flip ? u(t.aoff[ai]) - acc[ai] : acc[ai] + u(t.aoff[ai]), p.AttrBits);
+          acc[ai] += u(d.didx[ai]);
+        }
+        out.push_back(f);
+      }
+      walk.fragments += static_cast<uint64_t>(hi[0] - lo[0] + 1);
+    } else if (any) {
       int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
       for (int a = 0; a < K; ++a) {
         const size_t ai = static_cast<size_t>(a);

@@ -91,7 +91,7 @@ using AttrVec = InlineVec<int64_t, kMaxAttr>;  // attribute codes, held in place
 enum class SpanMode { Serial, EvenOdd, Seg2, Seg4, Seg8, Sierpinski };
 const char* toString(SpanMode m);        // "serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"
 SpanMode parseSpanMode(const std::string& s);  // std::invalid_argument naming the choices
-std::vector<SpanMode> allSpanModes();
+const std::vector<SpanMode>& allSpanModes();
 
 // Parameters of shd_span_unit, named as in the Verilog.
 struct SpanParams {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace shd {
 
@@ -11,6 +12,10 @@ std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, co
   squaredNormsAlongSpan(n0, dn, count, [&](size_t i, uint64_t v) { f[i] = v; });
   return f;
 }
+
+namespace {
+constexpr int kScaleRange = 256;  // |e| of the result's scale 2^(-e/2)
+}  // namespace
 
 double rsqrtFixed(uint64_t v, int frac_bits) {
   if (v == 0) return 0;
@@ -41,10 +46,18 @@ double rsqrtFixed(uint64_t v, int frac_bits) {
   // value = (m / 2^62) * 2^e with e = 62 - 2 shift - frac_bits
   const int e = 62 - 2 * shift - frac_bits;
   // 2^(-e/2): a power of two, times sqrt(2) when e is odd (what pow(2, -e/2) rounds to).
-  static const double kSqrt2 = std::sqrt(2.0);
-  const int h = e >= 0 ? -((e + 1) / 2) : (-e) / 2;  // floor(-e/2)
-  const double scale = (e & 1) != 0 ? std::ldexp(kSqrt2, h) : std::ldexp(1.0, h);
-  return std::ldexp(static_cast<double>(r1), -16) * scale;
+  // (A table of the scales: powers of two, exact, no ldexp call per pixel.)
+  static const std::array<double, 2 * kScaleRange + 1> scales = [] {
+    std::array<double, 2 * kScaleRange + 1> t{};
+    for (int i = 0; i < 2 * kScaleRange + 1; ++i) {
+      const int ee = i - kScaleRange;
+      const int h = ee >= 0 ? -((ee + 1) / 2) : (-ee) / 2;  // floor(-ee/2)
+      t[static_cast<size_t>(i)] = std::ldexp((ee & 1) != 0 ? std::sqrt(2.0) : 1.0, h - 16);
+    }
+    return t;
+  }();
+  if (e < -kScaleRange || e > kScaleRange) throw std::out_of_range("rsqrtFixed: frac_bits out of range");
+  return static_cast<double>(r1) * scales[static_cast<size_t>(e + kScaleRange)];
 }
 
 }  // namespace shd

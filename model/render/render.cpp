@@ -32,6 +32,7 @@ constexpr MethodName kMethods[] = {{Method::Flat, "flat"},
 
 constexpr int kColourFrac = 12;  // colour attributes in LSBs: 0..255 with 12 fraction bits
 constexpr int kUnitFrac = 28;    // normals and depth in [-1, 1]
+constexpr double kUnitLsb = 1.0 / (1 << kUnitFrac);  // 2^-28: code * kUnitLsb == ldexp(code, -28) exactly
 constexpr double kGuard = 2048;  // guard band (px beyond the viewport) before 2D clipping
 
 // A vertex on its way through the pipeline. cam and n are camera space; colour is the Gouraud
@@ -441,8 +442,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           fb.tri[p] = static_cast<int32_t>(tag);
         };
         auto rawNormal = [&](const SpanFragment& f) {
-          return Vec3{std::ldexp(static_cast<double>(f.attr[0]), -kUnitFrac), std::ldexp(static_cast<double>(f.attr[1]), -kUnitFrac),
-                      std::ldexp(static_cast<double>(f.attr[2]), -kUnitFrac)};
+          return Vec3{static_cast<double>(f.attr[0]) * kUnitLsb, static_cast<double>(f.attr[1]) * kUnitLsb,
+                      static_cast<double>(f.attr[2]) * kUnitLsb};
         };
         // Row-major order of the fragments (lane modes emit a row's pixels out of order, and
         // the Sierpinski lanes interleave rows): the incremental methods walk each row in x.
@@ -591,7 +592,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                 // |N|^2 from the recurrence (exact integers), then the fixed-point 1/sqrt.
                 n = rsqrtFixed(sqnorm[fi], 2 * kUnitFrac) * nraw;
               }
-              const Vec3 pc = pixelCam(fr.x, fr.y, std::ldexp(static_cast<double>(wcode), -kUnitFrac));
+              const Vec3 pc = pixelCam(fr.x, fr.y, static_cast<double>(wcode) * kUnitLsb);
               Shade sh = shadePoint(ctx, mat, lobe, n, pc, batched ? &coding : nullptr);
               lsb = sh.lsb;
               if (batched) {

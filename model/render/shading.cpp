@@ -115,9 +115,14 @@ Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, 
 std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb, size_t count) {
   std::array<uint8_t, 3> out{};
   for (size_t k = 0; k < 3; ++k) {
-    double v = std::round(std::clamp(lsb[k], 0.0, 255.0));
+    // round(clamp(lsb, 0, 255)), half away from zero, without a libm call: the fraction of a
+    // value in [0, 255] is exact in double.
+    if (std::isnan(lsb[k])) throw std::logic_error("combine: a NaN colour (a shading bug)");
+    const double c = std::clamp(lsb[k], 0.0, 255.0);
+    uint32_t v = static_cast<uint32_t>(c);
+    if (c - v >= 0.5) ++v;
     for (size_t i = 0; i < count; ++i) v += device_rgb[i][k];
-    out[k] = static_cast<uint8_t>(std::min(255.0, v));
+    out[k] = static_cast<uint8_t>(std::min<uint32_t>(255, v));
   }
   return out;
 }
