@@ -34,6 +34,19 @@ for fmt in mem coe mif csv; do
     -o "$dest/prom/spec_default.$fmt" 2>/dev/null
 done
 
+# Cycle-by-cycle vector files (sim/vector_file.h) of every unit configuration, replayed under
+# Icarus and Verilator by ctest. The span files are long enough for the generator's directed
+# phases (every size class x shape, the wide viewport) to finish in every mode; each file's
+# "# coverage" lines say by which cycle (test_vectors checks it).
+mkdir -p "$dest/cycles"
+for cfg in default narrow wide cubic; do
+  "$shadesim" vectors --unit spec --config "$cfg" --cycles 3000 --seed 1 --prom "$dest/prom/spec_$cfg.hex" \
+    -o "$dest/cycles/spec_$cfg.vec" 2>/dev/null
+done
+for mode in serial evenodd seg2 seg4 seg8 sierpinski; do
+  "$shadesim" vectors --unit span --config "$mode" --cycles 4000 --seed 1 -o "$dest/cycles/span_$mode.vec" 2>/dev/null
+done
+
 if [ "$check" = 1 ]; then
   status=0
   while IFS= read -r f; do
@@ -47,8 +60,8 @@ if [ "$check" = 1 ]; then
   while IFS= read -r f; do
     rel=${f#"$root/vectors"/}
     [ -e "$dest/$rel" ] || { echo "vectors/$rel is not produced by the generator any more" >&2; status=1; }
-  done < <(find "$root/vectors/prom" -type f | sort)
+  done < <(find "$root/vectors/prom" "$root/vectors/cycles" -type f | sort)
   [ "$status" = 0 ] && echo "vectors/: $(find "$dest" -type f | wc -l) generated files equal a fresh regeneration"
   exit "$status"
 fi
-echo "regenerated $(find "$dest/prom" -type f | wc -l) files under vectors/prom"
+echo "regenerated $(find "$dest/prom" -type f | wc -l) files under vectors/prom, $(find "$dest/cycles" -type f | wc -l) under vectors/cycles"

@@ -2,6 +2,8 @@
 //   shadesim prom        coefficient PROM tables for simulators and FPGA tools
 //   shadesim cosim       verilated RTL against the golden model, cycle by cycle
 //   shadesim spec-error  approximation, datapath and total error of the specular unit
+//   shadesim vectors     a vector file of a unit from the golden model (sim/vector_file.h)
+//   shadesim replay      a vector file replayed on the verilated RTL, compared every cycle
 // Every failure prints "shadesim <command>: error: ..." naming the argument and exits non-zero;
 // files are written atomically, so a failed run leaves no partial output.
 #include <algorithm>
@@ -27,6 +29,7 @@
 #include "scene/scene.h"
 #include "report/span_cycles.h"
 #include "scene/sphere.h"
+#include "cli_vectors.h"
 #include "span_cosim.h"
 #include "spec_cosim.h"
 
@@ -232,7 +235,7 @@ struct CosimCmd {
                           {"fragments_per_second", r.seconds > 0 ? r.fragments / r.seconds : 0.0}};
       if (r.first)
         j["first_mismatch"] = {{"cycle", r.first->cycle}, {"triangle", r.first->tag}, {"what", r.first->what},
-                               {"fst", r.fst_path}, {"case", r.case_path}};
+                               {"fst", r.fst_path}, {"case", r.case_path}, {"vectors", r.vector_path}};
       std::cout << j.dump(2) << "\n";
     } else {
       std::printf("cosim span/%s seed %llu: %llu triangles drawn (%llu generated, %llu dropped by setup), %llu fragments, "
@@ -243,9 +246,9 @@ struct CosimCmd {
                   static_cast<unsigned long long>(r.mismatches), r.seconds, r.seconds > 0 ? r.fragments / r.seconds / 1e6 : 0.0);
     }
     if (r.first) {
-      std::fprintf(stderr, "MISMATCH (first of %llu) cycle %llu, triangle %u: %s\nwaveform: %s\ncase:     %s\n",
+      std::fprintf(stderr, "MISMATCH (first of %llu) cycle %llu, triangle %u: %s\nwaveform: %s\nvectors:  %s\ncase:     %s\n",
                    static_cast<unsigned long long>(r.mismatches), static_cast<unsigned long long>(r.first->cycle),
-                   r.first->tag, r.first->what.c_str(), r.fst_path.c_str(), r.case_path.c_str());
+                   r.first->tag, r.first->what.c_str(), r.fst_path.c_str(), r.vector_path.c_str(), r.case_path.c_str());
       return 1;
     }
     return 0;
@@ -689,6 +692,12 @@ int main(int argc, char** argv) {
   prom.add(*prom_app);
   cosim.add(*cosim_app);
   spec_error.add(*err_app);
+  shd::cli::VectorsCmd vectors_cmd;
+  shd::cli::ReplayCmd replay_cmd;
+  CLI::App* vectors_app = app.add_subcommand("vectors", "write a vector file (inputs and the golden model's outputs, cycle by cycle)");
+  CLI::App* replay_app = app.add_subcommand("replay", "replay a vector file on the verilated RTL, comparing every cycle");
+  vectors_cmd.add(*vectors_app);
+  replay_cmd.add(*replay_app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -701,6 +710,8 @@ int main(int argc, char** argv) {
     if (cmd == err_app) return spec_error.run();
     if (cmd == cyc_app) return span_cycles.run();
     if (cmd == render_app) return render_cmd.run();
+    if (cmd == vectors_app) return vectors_cmd.run();
+    if (cmd == replay_app) return replay_cmd.run();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "shadesim %s: error: %s\n", cmd->get_name().c_str(), e.what());
     return 2;

@@ -55,20 +55,26 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   SpanCosimResult res;
   res.mode = mode;
   auto dut = makeSpanDut(mode, "");
-  SpanUnitModel model(opts.model_params ? *opts.model_params : dut->params());
+  const SpanParams model_params = opts.model_params ? *opts.model_params : dut->params();
+  SpanUnitModel model(model_params);
   std::mt19937_64 rng(opts.seed);
   std::bernoulli_distribution ready(opts.ready_prob), gap(opts.desc_gap_prob);
 
   dut->reset();
   model.reset();
   SpanDesc cur, pending;
+  bool have_cur = false;  // a descriptor has been accepted
   bool have_pending = next(pending);
   int wait = have_pending && gap(rng) ? 1 + static_cast<int>(rng() % 3) : 0;
-  std::vector<bool> ready_trace;  // out_ready since the current triangle was accepted
+  // The inputs (desc_valid, out_ready) from the cycle that accepted `cur` (from reset before
+  // the first one) to now: with `cur` and `pending` they reproduce the unit's state, because
+  // the unit loads every register it uses when it accepts a descriptor.
+  std::vector<std::pair<bool, bool>> window;
   SpanOut exp, got;
   bool failed_triangle_saved = false;
-  SpanDesc fail_desc;
-  std::vector<bool> fail_ready;
+  SpanDesc fail_desc, fail_next;
+  bool fail_has_cur = false;
+  std::vector<std::pair<bool, bool>> fail_window;
   const auto t0 = std::chrono::steady_clock::now();
   while (have_pending || !model.idle()) {
     SpanIn in;
@@ -78,7 +84,7 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
     if (wait > 0) --wait;
     model.tick(in, exp);
     dut->tick(in, got);
-    ready_trace.push_back(in.out_ready);
+    window.emplace_back(in.desc_valid, in.out_ready);
     if (exp.out_valid && in.out_ready)
       for (const SpanLaneOut& l : exp.lane) res.fragments += l.valid ? 1 : 0;
     const std::string diff = compareOutputs(exp, got);
@@ -87,14 +93,17 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
       if (!res.first) {
         res.first = SpanMismatch{model.cycle(), cur.tag, diff};
         fail_desc = cur;
-        fail_ready = ready_trace;
+        fail_has_cur = have_cur;
+        fail_next = pending;
+        fail_window = window;
         failed_triangle_saved = true;
       }
       if (res.mismatches >= opts.max_mismatches) break;
     }
     if (in.desc_valid && exp.desc_ready) {  // accepted at this edge
       cur = pending;
-      ready_trace.clear();
+      have_cur = true;
+      window.assign(1, {true, in.out_ready});
       ++res.triangles;
       if (opts.progress && (res.triangles & 4095) == 0) opts.progress(res.triangles);
       have_pending = next(pending);
@@ -106,28 +115,54 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   dut->finish();
 
   if (failed_triangle_saved) {
-    // Replay the failing triangle from reset with its out_ready pattern: the unit re-initialises
-    // everything when it accepts a descriptor, so the triangle reproduces alone.
+    // The failing triangle alone: from reset, the cycle that accepted it, then the run's inputs
+    // up to the failing cycle (the next descriptor too if it was offered meanwhile), into a
+    // traced instance (FST) and, with the model's expected outputs, a vector file that
+    // `shadesim replay` and the Icarus testbench replay.
     std::filesystem::create_directories(opts.fail_dir);
     res.fst_path = fmt::format("{}/span_{}_fail.fst", opts.fail_dir, mode);
     res.case_path = fmt::format("{}/span_{}_fail.json", opts.fail_dir, mode);
+    res.vector_path = fmt::format("{}/span_{}_fail.vec", opts.fail_dir, mode);
+    SpanVectors v;
+    v.config = mode;
+    v.params = dut->params();
+    v.source = fmt::format("shadesim cosim: the failing triangle (tag {}), cycles {}..{} of the run, replayed from reset",
+                           fail_desc.tag, res.first->cycle + 1 - fail_window.size(), res.first->cycle);
+    if (fail_has_cur) v.descs.push_back(fail_desc);
+    bool next_on_ports = false;
+    for (size_t i = 0; i < fail_window.size(); ++i) {
+      SpanVectorCycle c;
+      c.desc_valid = fail_window[i].first;
+      c.out_ready = fail_window[i].second;
+      if (c.desc_valid && !(fail_has_cur && i == 0) && !next_on_ports) {
+        v.descs.push_back(fail_next);
+        next_on_ports = true;
+      }
+      c.desc = static_cast<int>(v.descs.size()) - 1;
+      v.cycles.push_back(std::move(c));
+    }
     auto traced = makeSpanDut(mode, res.fst_path);
+    SpanUnitModel replay(model_params);
     traced->reset();
-    SpanIn in;
-    in.desc_valid = true;
-    in.desc = &fail_desc;
-    in.out_ready = true;
-    traced->tick(in);  // accepted: the unit was idle after reset
-    in.desc_valid = false;
-    for (bool r : fail_ready) {
-      in.out_ready = r;
-      traced->tick(in);
+    replay.reset();
+    SpanOut ignored;
+    for (SpanVectorCycle& c : v.cycles) {
+      SpanIn in;
+      in.desc_valid = c.desc_valid;
+      in.out_ready = c.out_ready;
+      in.desc = c.desc >= 0 ? &v.descs[static_cast<size_t>(c.desc)] : nullptr;
+      replay.tick(in, c.expected);
+      traced->tick(in, ignored);
     }
     traced->finish();
+    writeSpanVectors(res.vector_path, v);
+    std::vector<bool> ready_after_accept;
+    for (size_t i = fail_has_cur ? 1 : 0; i < fail_window.size(); ++i) ready_after_accept.push_back(fail_window[i].second);
     nlohmann::json j = {{"mode", mode},
                         {"mismatch", {{"cycle", res.first->cycle}, {"what", res.first->what}}},
                         {"descriptor", toJson(fail_desc)},
-                        {"out_ready_after_accept", fail_ready}};
+                        {"out_ready_after_accept", ready_after_accept},
+                        {"vectors", res.vector_path}};
     writeFileAtomic(res.case_path, j.dump(1) + "\n");
   }
   return res;

@@ -3,9 +3,11 @@
 // every output is compared on every cycle: desc_ready, out_valid, the tag, each lane's valid
 // bit, and each valid lane's pixel and attributes.
 //
-// On the first mismatch the failing triangle is replayed alone from reset, with the same
-// out_ready pattern, into a traced instance (an FST waveform), and its descriptor and pattern
-// are written as JSON so that the case reproduces by itself.
+// On the first mismatch the failing triangle is replayed alone from reset, with the run's
+// inputs from the cycle that accepted it to the failing one, into a traced instance (an FST
+// waveform), and saved as a vector file (sim/vector_file.h: the descriptor, the inputs and the
+// model's expected outputs, cycle by cycle) that `shadesim replay` and the Icarus testbench
+// replay alone; its descriptor and out_ready pattern are also written as JSON.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +19,7 @@
 
 #include "raster/span_unit.h"
 #include "span_dut.h"
+#include "vector_file.h"
 
 namespace shd {
 
@@ -46,7 +49,7 @@ struct SpanCosimResult {
   uint64_t mismatches = 0;
   double seconds = 0;
   std::optional<SpanMismatch> first;
-  std::string fst_path, case_path;
+  std::string fst_path, case_path, vector_path;
 };
 
 // next(d) fills the next descriptor and returns false at the end of the stream.

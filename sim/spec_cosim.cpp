@@ -3,11 +3,14 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "device/prom_io.h"
+
+namespace fs = std::filesystem;
 
 namespace shd {
 
@@ -85,23 +88,6 @@ void verifyLoadedProm(SpecDut& dut, const std::vector<PromWord>& expected, const
           i, hexWord(got[i], p.promWordBits()), prom_path, hexWord(expected[i], p.promWordBits())));
 }
 
-void writeSpecVectors(const std::string& path, const std::string& config, const SpecUnitParams& p,
-                      const std::string& prom_path, const std::vector<SpecIn>& inputs,
-                      const std::vector<SpecOut>& expected) {
-  std::string text = fmt::format(
-      "# shadesim spec-unit vectors, one line per clock cycle after reset\n"
-      "# config {} {}\n# latency {}\n# prom {}\n"
-      "# columns (hex): valid shin cos light_r light_g light_b exp_valid exp_spec exp_r exp_g exp_b\n",
-      config, p.toJson().dump(), p.latency(), prom_path);
-  for (size_t i = 0; i < inputs.size(); ++i) {
-    const SpecIn& in = inputs[i];
-    const SpecOut& e = expected[i];
-    text += fmt::format("{:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x}\n", in.valid ? 1 : 0, in.shin, in.cos,
-                        in.light[0], in.light[1], in.light[2], e.valid ? 1 : 0, e.spec, e.rgb[0], e.rgb[1], e.rgb[2]);
-  }
-  writeFileAtomic(path, text);
-}
-
 SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, SpecStimulus& stim,
                              const SpecCosimOptions& opts) {
   const SpecUnitParams& p = model.params();
@@ -171,16 +157,30 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
     std::filesystem::create_directories(opts.fail_dir);
     res.fst_path = fmt::format("{}/spec_{}_fail.fst", opts.fail_dir, config);
     res.vector_path = fmt::format("{}/spec_{}_fail.vec", opts.fail_dir, config);
+    res.prom_copy_path = fmt::format("{}/spec_{}_fail.hex", opts.fail_dir, config);
     auto traced = makeSpecDut(config, SpecDutOptions{opts.prom_path, res.fst_path});
     SpecUnitModel replay(p, model.prom());
     traced->reset();
-    std::vector<SpecOut> expected;
+    SpecVectors v;
+    v.config = config;
+    // The header names the verilated configuration's parameters (the model's may differ: that
+    // is what fault injection does), so that the file replays on that configuration.
+    v.params = SpecUnitConfig::load(configPath(config)).rtl;
+    v.prom = fs::path(res.prom_copy_path).filename().string();
+    v.source = fmt::format("shadesim cosim: the failing window, cycles {}..{} of the run, replayed from reset",
+                           res.first->cycle + 1 - fail_window.size(), res.first->cycle);
     for (const SpecIn& w : fail_window) {
       traced->tick(w);
-      expected.push_back(replay.tick(w));
+      v.in.push_back(w);
+      v.expected.push_back(replay.tick(w));
     }
     traced->finish();
-    writeSpecVectors(res.vector_path, config, p, opts.prom_path, fail_window, expected);
+    // The PROM the simulator loaded (the run's file may be a temporary one), then the vectors.
+    std::ifstream prom_in(opts.prom_path, std::ios::binary);
+    if (!prom_in) throw std::runtime_error(fmt::format("cannot read back PROM file {}", opts.prom_path));
+    const std::string prom_text((std::istreambuf_iterator<char>(prom_in)), std::istreambuf_iterator<char>());
+    writeFileAtomic(res.prom_copy_path, prom_text);
+    writeSpecVectors(res.vector_path, v);
   }
   return res;
 }

@@ -7,8 +7,11 @@
 // where such a file fails loudly.
 //
 // On a mismatch the run records the first failing cycle with the input that produced it and
-// both outputs, keeps counting up to max_mismatches, then replays the last few cycles into a
-// traced instance to write an FST waveform and a vector file of the failing window.
+// both outputs, keeps counting up to max_mismatches, then replays the last few cycles from reset
+// into a traced instance to write an FST waveform and a vector file (sim/vector_file.h) of the
+// failing window: the model's expected outputs for the verilated configuration, with a copy of
+// the PROM beside it, so that `shadesim replay` and the Icarus testbench reproduce the mismatch
+// from the file alone.
 #pragma once
 
 #include <cstdint>
@@ -21,6 +24,7 @@
 #include "device/prom.h"
 #include "device/spec_unit.h"
 #include "spec_dut.h"
+#include "vector_file.h"
 
 namespace shd {
 
@@ -87,6 +91,7 @@ struct SpecCosimResult {
   double seconds = 0;
   std::optional<SpecMismatch> first;
   std::string fst_path, vector_path;  // written when mismatches > 0
+  std::string prom_copy_path;         // the PROM beside the vector file (its "# prom")
 };
 
 // Compares the words the simulator loaded with `expected`; throws std::runtime_error naming the
@@ -96,11 +101,5 @@ void verifyLoadedProm(SpecDut& dut, const std::vector<PromWord>& expected, const
 
 SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, SpecStimulus& stim,
                              const SpecCosimOptions& opts);
-
-// The vector file of a window: "#" comment lines, then per cycle, in hex,
-//   valid shin cos light_r light_g light_b  exp_valid exp_spec exp_r exp_g exp_b
-void writeSpecVectors(const std::string& path, const std::string& config, const SpecUnitParams& p,
-                      const std::string& prom_path, const std::vector<SpecIn>& inputs,
-                      const std::vector<SpecOut>& expected);
 
 }  // namespace shd

@@ -8,7 +8,9 @@
 #include <fstream>
 
 #include "raster/desc_stream.h"
+#include "replay.h"
 #include "span_cosim.h"
+#include "vector_gen.h"
 
 using namespace shd;
 namespace fs = std::filesystem;
@@ -61,4 +63,24 @@ TEST(SpanCosim, DetectsAModelOfAnotherLaneLayout) {
   std::string text((std::istreambuf_iterator<char>(c)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"descriptor\""), std::string::npos);
   EXPECT_NE(text.find("out_ready_after_accept"), std::string::npos);
+  // The failing triangle saved as a vector file: replayed alone on the real seg2 RTL it fails
+  // at its last cycle (the run's failing one), and nowhere before.
+  ASSERT_TRUE(fs::exists(r.vector_path));
+  const ReplayResult rr = replayVectorFile(r.vector_path);
+  ASSERT_TRUE(rr.first.has_value()) << "the saved case replays clean: it does not reproduce the mismatch";
+  EXPECT_EQ(rr.first->cycle, rr.cycles);
+  EXPECT_EQ(rr.mismatching_cycles, 1u);
+  std::printf("replayed alone: %llu cycles, first mismatch %s\n", static_cast<unsigned long long>(rr.cycles),
+              rr.first->describe().c_str());
+}
+
+TEST(SpanCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
+  // The counterpart of the saved failing case: the correct model's expectations pass.
+  const fs::path dir = shd::testutil::freshTestDir("span_cosim");
+  const std::string vec = (dir / "seg2.vec").string();
+  writeSpanVectors(vec, generateSpanVectors("seg2", 2000, 5));
+  const ReplayResult rr = replayVectorFile(vec);
+  EXPECT_EQ(rr.cycles, 2000u);
+  EXPECT_GT(rr.results, 1000u);
+  EXPECT_EQ(rr.mismatches, 0u) << (rr.first ? rr.first->describe() : "");
 }

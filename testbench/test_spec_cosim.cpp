@@ -10,7 +10,9 @@
 
 #include "device/prom.h"
 #include "device/prom_io.h"
+#include "replay.h"
 #include "spec_cosim.h"
+#include "vector_gen.h"
 
 using namespace shd;
 namespace fs = std::filesystem;
@@ -109,6 +111,27 @@ TEST(SpecCosim, DetectsADatapathDifferenceAndDumpsTheWindow) {
     if (!line.empty() && line[0] != '#') ++data_lines;
   // The window: the last latency + 8 cycles up to the failing one (fewer if it failed earlier).
   EXPECT_EQ(data_lines, std::min<int>(s.table.unit.latency() + 8, static_cast<int>(r.first->cycle)));
+  // The saved case alone, replayed on the real RTL (with the PROM copied beside it), reproduces
+  // the mismatch: at the window's last cycle, on spec_o, with the run's two values.
+  ASSERT_TRUE(fs::exists(r.prom_copy_path));
+  const ReplayResult rr = replayVectorFile(r.vector_path);
+  EXPECT_EQ(rr.cycles, static_cast<uint64_t>(data_lines));
+  ASSERT_TRUE(rr.first.has_value()) << "the saved window replays clean: it does not reproduce the mismatch";
+  EXPECT_EQ(rr.first->cycle, rr.cycles);
+  EXPECT_EQ(rr.first->signal, "spec_o");
+  EXPECT_EQ(rr.first->expected, r.first->expected.spec);
+  EXPECT_EQ(rr.first->got, r.first->got.spec);
+}
+
+TEST(SpecCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
+  // The counterpart of the saved failing window: the correct model's expectations pass.
+  const CosimSetup s = setup("narrow");
+  const std::string vec = (fs::path(s.prom_path).parent_path() / "narrow.vec").string();
+  writeSpecVectors(vec, generateSpecVectors("narrow", 2000, 5, s.prom_path, fs::path(vec).parent_path().string()));
+  const ReplayResult rr = replayVectorFile(vec);
+  EXPECT_EQ(rr.cycles, 2000u);
+  EXPECT_GT(rr.results, 1000u);
+  EXPECT_EQ(rr.mismatches, 0u) << (rr.first ? rr.first->describe() : "");
 }
 
 TEST(SpecCosim, DetectsALatencyDifference) {
@@ -121,6 +144,11 @@ TEST(SpecCosim, DetectsALatencyDifference) {
   ASSERT_TRUE(r.first.has_value());
   EXPECT_NE(r.first->got.valid, r.first->expected.valid);  // a control mismatch, found at once
   EXPECT_EQ(r.first->cycle, static_cast<uint64_t>(s.table.unit.latency()));
+  // The saved window (from reset to the failing cycle) replays to the same mismatch.
+  const ReplayResult rr = replayVectorFile(r.vector_path);
+  ASSERT_TRUE(rr.first.has_value());
+  EXPECT_EQ(rr.first->cycle, r.first->cycle);
+  EXPECT_EQ(rr.first->signal, "valid_o");
 }
 
 TEST(SpecCosim, CorruptShortOrMissingPromFailsLoudly) {

@@ -1,0 +1,264 @@
+#include "vector_gen.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <random>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "device/prom.h"
+#include "device/prom_io.h"
+#include "raster/desc_stream.h"
+#include "raster/setup.h"
+#include "raster/trigen.h"
+#include "spec_cosim.h"
+
+namespace fs = std::filesystem;
+
+namespace shd {
+
+std::string VectorGenSummary::text() const {
+  if (fragments == 0 && dropped == 0) return fmt::format("{} cycles, {} valid inputs", cycles, valid_inputs);
+  return fmt::format("{} cycles, {} descriptors accepted, {} lane fragments handed over, {} generator triangles dropped "
+                     "by setup, directed phases done: {} of 2",
+                     cycles, valid_inputs, fragments, dropped, phases_done);
+}
+
+// ------------------------------------------------------------------ spec
+
+SpecVectors generateSpecVectors(const std::string& config, uint64_t cycles, uint64_t seed, const std::string& prom_file,
+                                const std::string& out_dir, VectorGenSummary* summary) {
+  const std::vector<std::string> names = builtinConfigNames();
+  if (std::find(names.begin(), names.end(), config) == names.end())
+    throw std::invalid_argument(
+        fmt::format("no specular-unit configuration '{}' (known: {})", config, fmt::join(names, ", ")));
+  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(config));
+  const SpecUnitParams& p = cfg.rtl;
+  const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), p);
+  // The file the vectors refer to must hold this very table: the expected outputs depend on it.
+  const std::vector<PromWord> words = readPromHex(prom_file, p.promWordBits(), p.promDepth());
+  for (size_t i = 0; i < words.size(); ++i)
+    if (words[i] != table.words[i])
+      throw std::runtime_error(fmt::format("PROM file {} holds word {} = 0x{}, configuration {} makes 0x{}: regenerate it "
+                                           "(scripts/regen_vectors.sh)",
+                                           prom_file, i, hexWord(words[i], p.promWordBits()), config,
+                                           hexWord(table.words[i], p.promWordBits())));
+
+  SpecVectors v;
+  v.config = config;
+  v.params = p;
+  v.prom = fs::absolute(prom_file).lexically_normal().lexically_relative(fs::absolute(out_dir).lexically_normal())
+               .generic_string();
+  v.source = fmt::format("shadesim vectors --unit spec --config {} --cycles {} --seed {}", config, cycles, seed);
+
+  // The corners, valid on every cycle.
+  std::vector<SpecIn> corners;
+  const uint32_t depth = static_cast<uint32_t>(p.promDepth());
+  const uint32_t last_entry = static_cast<uint32_t>(std::max<size_t>(table.entries.size(), 1) - 1);
+  const uint32_t one = static_cast<uint32_t>(p.cosOne()), lmax = static_cast<uint32_t>(p.lightMax());
+  for (uint32_t shin : {0u, 1u, depth / 2, last_entry, depth - 1})
+    for (uint32_t cos : {0u, 1u, one / 2, one - 1, one, one + 1, 2 * one - 1})
+      for (const std::array<uint32_t, 3>& light : {std::array<uint32_t, 3>{0, 0, 0}, std::array<uint32_t, 3>{lmax, lmax, lmax},
+                                                   std::array<uint32_t, 3>{1, lmax / 2, lmax - 1}}) {
+        SpecIn in;
+        in.valid = true;
+        in.shin = shin;
+        in.cos = cos;
+        in.light = light;
+        corners.push_back(in);
+      }
+
+  SpecUnitModel model(p, table.words);
+  model.reset();
+  RandomSpecStimulus stim(p, seed, cycles, 0.2);
+  VectorGenSummary s;
+  for (uint64_t c = 0; c < cycles; ++c) {
+    SpecIn in;
+    if (c < corners.size()) in = corners[c];
+    else if (!stim.next(in)) in = SpecIn{};  // cannot happen: the stream holds `cycles` valid vectors
+    s.valid_inputs += in.valid ? 1 : 0;
+    v.in.push_back(in);
+    v.expected.push_back(model.tick(in));
+  }
+  s.cycles = cycles;
+  if (summary) *summary = s;
+  return v;
+}
+
+// ------------------------------------------------------------------ span
+
+namespace {
+
+// The wide viewport: all PixBits of the fragment ports, within the guard band.
+int wide_size(const SpanParams& p) { return static_cast<int>(std::min<int64_t>(int64_t{1} << p.PixBits, 4096)); }
+
+// The descriptors of the three phases (vector_gen.h), one at a time.
+class SpanVectorStimulus {
+ public:
+  SpanVectorStimulus(const SpanParams& p, uint64_t seed) : rng_(seed) {
+    tiny_.width = 16;
+    tiny_.height = 12;
+    tiny_.unit = p;
+    small_.width = 40;
+    small_.height = 30;
+    small_.unit = p;
+    wide_.width = wide_.height = wide_size(p);
+    wide_.unit = p;
+    // Colour with 12 fraction bits, the rest with 24: the codes fit 32-bit attributes on a
+    // 4096-wide viewport, where the default rule would ask 31 bits for depth.
+    for (int k = 0; k < p.NumAttr; ++k) wide_.attr_frac_bits.push_back(k < 3 ? 12 : 24);
+    tiny_.validate();
+    small_.validate();
+    wide_.validate();
+    // Phase 1: every size class x every shape, each from its own generator.
+    for (int c = 0; c < kNumSizeClasses; ++c)
+      for (int sh = 0; sh < kNumStreamShapes; ++sh) {
+        TriGenOptions g = options(tiny_);
+        g.size_weight.fill(0);
+        g.size_weight[static_cast<size_t>(c)] = 1;
+        g.shape_weight.fill(0);
+        g.shape_weight[static_cast<size_t>(sh)] = 1;
+        directed_.push_back(TriangleGenerator(rng_(), g));
+      }
+    TriGenOptions w = options(wide_);
+    w.size_weight = {1, 1, 1, 0, 0};
+    wide_gen_.emplace(rng_(), w);
+    mixed_.emplace(rng_(), options(small_));
+  }
+
+  // The next descriptor and its phase (1, 2 or 3).
+  bool next(SpanDesc& d, int& phase) {
+    for (;;) {
+      std::optional<SpanDesc> got;
+      if (directed_next_ < directed_.size()) {
+        // Up to 8 draws, so that an off-screen draw without pixels is replaced; zero-area
+        // triangles never give a descriptor.
+        phase = 1;
+        TriangleGenerator& g = directed_[directed_next_++];
+        for (int attempt = 0; attempt < 8 && !got; ++attempt) got = setup(g.next(), tiny_);
+      } else if (wide_count_ < kWideTriangles) {
+        phase = 2;
+        ++wide_count_;
+        got = setup(wide_gen_->next(), wide_);
+      } else {
+        phase = 3;
+        got = setup(mixed_->next(), small_);
+      }
+      if (got) {
+        ++made_[phase];
+        d = std::move(*got);
+        return true;
+      }
+    }
+  }
+  uint64_t dropped() const { return dropped_; }
+  // Descriptors of a phase made so far (phases 1 and 2 are complete once phase 3 has begun).
+  uint64_t made(int phase) const { return made_[phase]; }
+  static constexpr int kWideTriangles = 24;
+
+ private:
+  static TriGenOptions options(const RasterConfig& rc) {
+    TriGenOptions g;
+    g.width = rc.width;
+    g.height = rc.height;
+    g.subpixel_bits = rc.subpixel_bits;
+    g.num_attr = rc.unit.NumAttr;
+    return g;
+  }
+  std::optional<SpanDesc> setup(const GenTriangle& t, const RasterConfig& rc) {
+    SetupResult s = setupTriangle(toSetupVertices(t, rc.unit.NumAttr), tag_++, rc);
+    if (!s.desc) {
+      ++dropped_;
+      return std::nullopt;
+    }
+    return std::move(*s.desc);
+  }
+
+  std::mt19937_64 rng_;
+  RasterConfig tiny_, small_, wide_;
+  std::vector<TriangleGenerator> directed_;
+  size_t directed_next_ = 0;
+  std::optional<TriangleGenerator> wide_gen_, mixed_;
+  int wide_count_ = 0;
+  uint32_t tag_ = 0;
+  uint64_t dropped_ = 0;
+  uint64_t made_[4] = {0, 0, 0, 0};
+};
+
+}  // namespace
+
+SpanVectors generateSpanVectors(const std::string& config, uint64_t cycles, uint64_t seed, VectorGenSummary* summary) {
+  SpanVectors v;
+  v.config = config;
+  v.params = spanConfigParams(config);
+  v.source = fmt::format("shadesim vectors --unit span --config {} --cycles {} --seed {}", config, cycles, seed);
+  SpanVectorStimulus stim(v.params, seed);
+  SpanUnitModel model(v.params);
+  model.reset();
+  std::mt19937_64 rng(seed ^ 0x5eed5eed5eed5eedULL);
+  const double ready_choices[] = {1.0, 0.75, 0.3};
+  auto draw_ready = [&] { return ready_choices[rng() % 3]; };
+  auto draw_wait = [&] { return std::bernoulli_distribution(0.3)(rng) ? 1 + static_cast<int>(rng() % 3) : 0; };
+
+  VectorGenSummary s;
+  SpanDesc pending;
+  int phase = 0;
+  stim.next(pending, phase);
+  int wait = draw_wait();
+  double ready_prob = draw_ready();
+  bool on_ports = false;  // `pending` is in v.descs (it has been offered)
+  uint64_t accepted[4] = {0, 0, 0, 0}, phase_done_at[3] = {0, 0, 0};  // [phase]
+  for (uint64_t c = 0; c < cycles; ++c) {
+    SpanVectorCycle cyc;
+    cyc.out_ready = std::bernoulli_distribution(ready_prob)(rng);
+    // A gap counts idle cycles: the unit waits, idle, with nothing offered.
+    cyc.desc_valid = wait == 0;
+    if (wait > 0 && model.idle()) --wait;
+    if (cyc.desc_valid && !on_ports) {
+      v.descs.push_back(pending);
+      on_ports = true;
+    }
+    cyc.desc = static_cast<int>(v.descs.size()) - 1;
+    SpanIn in;
+    in.desc_valid = cyc.desc_valid;
+    in.desc = &pending;
+    in.out_ready = cyc.out_ready;
+    model.tick(in, cyc.expected);
+    if (cyc.expected.out_valid && cyc.out_ready)
+      for (const SpanLaneOut& l : cyc.expected.lane) s.fragments += l.valid ? 1 : 0;
+    if (cyc.desc_valid && cyc.expected.desc_ready) {  // accepted at this edge
+      ++s.valid_inputs;
+      ++accepted[phase];
+      // The unit accepts only when idle: the first triangle of a phase accepted means the
+      // previous phase is done.
+      if (phase >= 2 && phase_done_at[phase - 1] == 0) phase_done_at[phase - 1] = c + 1;
+      stim.next(pending, phase);
+      on_ports = false;
+      wait = draw_wait();
+      ready_prob = draw_ready();
+    }
+    v.cycles.push_back(std::move(cyc));
+  }
+  auto done = [&](int ph) {
+    return phase_done_at[ph] ? fmt::format("all done by cycle {}", phase_done_at[ph]) : std::string("NOT all done");
+  };
+  v.notes.push_back(fmt::format("coverage: phase 1, one triangle of every size class x shape (16x12 viewport): {} of {} "
+                                "descriptors accepted, {}",
+                                accepted[1], stim.made(1), done(1)));
+  v.notes.push_back(fmt::format("coverage: phase 2, {} pixel- to mesh-sized generator triangles in a {}x{} viewport: "
+                                "{} of the {} descriptors setup made accepted, {}",
+                                SpanVectorStimulus::kWideTriangles, wide_size(v.params), wide_size(v.params),
+                                accepted[2], stim.made(2), done(2)));
+  v.notes.push_back(fmt::format("coverage: phase 3, the generator's mix (40x30 viewport): {} descriptors accepted",
+                                accepted[3]));
+  s.phases_done = (phase_done_at[1] != 0) + (phase_done_at[2] != 0);
+  s.cycles = cycles;
+  s.dropped = stim.dropped();
+  if (summary) *summary = s;
+  return v;
+}
+
+}  // namespace shd

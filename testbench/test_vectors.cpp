@@ -1,0 +1,259 @@
+// Vector files (sim/vector_file.h): generation from the model, the strict readers, and the replay
+// on the verilated configurations, which passes on a correct file and fails on a wrong one.
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "device/prom.h"
+#include "device/prom_io.h"
+#include "replay.h"
+#include "vector_file.h"
+#include "vector_gen.h"
+
+using namespace shd;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void spit(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// A spec-unit vector file of `config` in dir, with its PROM beside it.
+fs::path specFile(const fs::path& dir, const std::string& config, uint64_t cycles, uint64_t seed) {
+  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(config));
+  const PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
+  writeFileAtomic((dir / (config + ".hex")).string(), renderProm(t, PromFormat::Hex));
+  const fs::path vec = dir / ("spec_" + config + ".vec");
+  writeSpecVectors(vec.string(), generateSpecVectors(config, cycles, seed, (dir / (config + ".hex")).string(), dir.string()));
+  return vec;
+}
+
+fs::path spanFile(const fs::path& dir, const std::string& config, uint64_t cycles, uint64_t seed,
+                  VectorGenSummary* summary = nullptr) {
+  const fs::path vec = dir / ("span_" + config + ".vec");
+  writeSpanVectors(vec.string(), generateSpanVectors(config, cycles, seed, summary));
+  return vec;
+}
+
+// The message of the exception `f` throws ("" if none).
+template <class F>
+std::string errorOf(F f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST(VectorFile, SpecRoundTripsExactly) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  const fs::path vec = specFile(dir, "cubic", 500, 7);
+  const SpecVectors v = loadSpecVectors(vec.string());
+  EXPECT_EQ(v.config, "cubic");
+  EXPECT_EQ(v.prom, "cubic.hex");  // relative to the file's directory
+  ASSERT_EQ(v.in.size(), 500u);
+  // Rendering what was read gives the file back, byte for byte (notes are not read back; the
+  // spec files have none).
+  EXPECT_EQ(renderSpecVectors(v), slurp(vec));
+}
+
+TEST(VectorFile, SpanRoundTripsExactly) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  for (const std::string& mode : builtinSpanConfigNames()) {
+    const fs::path vec = spanFile(dir, mode, 1500, 3);
+    SpanVectors v = loadSpanVectors(vec.string());
+    EXPECT_EQ(v.config, mode);
+    ASSERT_EQ(v.cycles.size(), 1500u);
+    EXPECT_GT(v.descs.size(), 10u) << mode;
+    // Re-render with the generator's notes: identical text (every field survives the trip,
+    // signed ones through their port width).
+    v.notes = generateSpanVectors(mode, 1500, 3).notes;
+    EXPECT_EQ(renderSpanVectors(v), slurp(vec)) << mode;
+  }
+}
+
+TEST(VectorFile, SpanStimulusCoversEveryClassAndShapeAndBackPressure) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  VectorGenSummary s;
+  const fs::path vec = spanFile(dir, "serial", 4000, 1, &s);
+  EXPECT_EQ(s.phases_done, 2) << s.text();
+  const SpanVectors v = loadSpanVectors(vec.string());
+  uint64_t stalled = 0, waiting_offer = 0, gaps = 0;
+  for (size_t i = 0; i < v.cycles.size(); ++i) {
+    const SpanVectorCycle& c = v.cycles[i];
+    stalled += c.expected.out_valid && !c.out_ready;
+    waiting_offer += c.desc_valid && !c.expected.desc_ready;
+    gaps += !c.desc_valid && c.expected.desc_ready;
+  }
+  EXPECT_GT(stalled, 100u);        // out_ready back-pressure on valid outputs
+  EXPECT_GT(waiting_offer, 100u);  // descriptors offered while the unit is busy
+  EXPECT_GT(gaps, 10u);            // an idle unit with no descriptor offered
+  const std::string text = slurp(vec);
+  EXPECT_NE(text.find("25 of 25 descriptors accepted"), std::string::npos);  // 5 classes x 5 drawable shapes
+}
+
+TEST(VectorFile, CheckedInSpanFilesCompleteTheDirectedPhases) {
+  // vectors_fresh proves the checked-in files are what the generator makes; this proves the
+  // cycle counts chosen in scripts/regen_vectors.sh are long enough for phases 1 and 2.
+  for (const std::string& mode : builtinSpanConfigNames()) {
+    const std::string text = slurp(fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("span_" + mode + ".vec"));
+    ASSERT_FALSE(text.empty()) << mode;
+    const std::regex done("# coverage: phase [12],.*all done by cycle [0-9]+\n");
+    EXPECT_EQ(std::distance(std::sregex_iterator(text.begin(), text.end(), done), std::sregex_iterator()), 2) << mode;
+  }
+}
+
+TEST(VectorFile, ReadersRejectMalformedFilesNamingTheLine) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  const std::string spec = slurp(specFile(dir, "narrow", 50, 1));
+  const std::string span = slurp(spanFile(dir, "seg2", 200, 1));
+  auto withLine = [](const std::string& text, const std::string& from, const std::string& to) {
+    const size_t at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.substr(0, at) + to + text.substr(at + from.size());
+  };
+  // Span: lines inserted before the first D record (the first record of a generated file).
+  const size_t d_at = span.find("\nD ") + 1;
+  const std::string first_d = span.substr(d_at, span.find('\n', d_at) - d_at);
+  auto before = [&](const std::string& lines) { return span.substr(0, d_at) + lines + span.substr(d_at); };
+  struct Case {
+    std::string name, text, needle;
+    bool spec;
+  };
+  // The first cycle line of the spec file is "1 0 0 0 0 0  0 0 0 0 0" (the corners).
+  const std::vector<Case> cases = {
+      {"not hex", withLine(spec, "\n1 0 0 0 0 0  0 0 0 0 0\n", "\n1 0 0 0 0 g  0 0 0 0 0\n"), "not a hex value", true},
+      {"too wide", withLine(spec, "\n1 0 0 0 0 0  0 0 0 0 0\n", "\n1 0 0 100 0 0  0 0 0 0 0\n"), "does not fit its 8-bit port", true},
+      {"short", withLine(spec, "\n1 0 0 0 0 0  0 0 0 0 0\n", "\n1 0 0 0 0 0  0 0 0 0\n"), "before field exp_b", true},
+      {"long", withLine(spec, "\n1 0 0 0 0 0  0 0 0 0 0\n", "\n1 0 0 0 0 0  0 0 0 0 0 0\n"), "12 fields, 11 expected", true},
+      {"params", withLine(spec, "# params 2 10", "# params 2 11"), "differ from the rtl object", true},
+      {"latency", withLine(spec, "# latency 2", "# latency 3"), "latency 3, the parameters give 2", true},
+      {"no prom", withLine(spec, "# prom ", "# from "), "no '# prom ...' header line", true},
+      {"unit", withLine(spec, "# unit spec", "# unit span"), "unit 'span', a spec-unit file expected", true},
+      {"record", before("X 1\n"), "unknown record 'X'", false},
+      {"offer", before(first_d + "\nC 1 1  0 0 0 0\n"), "while the previous descriptor is offered", false},
+      {"first offer", before("C 1 1  1 0 0 0\n"), "desc_valid is 1 before any D record", false},
+      {"lane mask", before("C 0 1  1 0 0 4\n"), "does not fit its 2-bit port", false},
+      {"or", before("C 0 1  1 1 0 0\n"), "exp_out_valid 1 with exp_lane_valid 0", false},
+      {"short D", before(first_d.substr(0, first_d.rfind(' ')) + "\n"), "the record ends before field", false},
+  };
+  for (const Case& c : cases) {
+    const fs::path p = dir / ("bad_" + std::to_string(&c - cases.data()) + ".vec");
+    spit(p, c.text);
+    const std::string err =
+        errorOf([&] { c.spec ? (void)loadSpecVectors(p.string()) : (void)loadSpanVectors(p.string()); });
+    EXPECT_NE(err.find(c.needle), std::string::npos) << c.name << ": " << err;
+    EXPECT_NE(err.find(p.string() + ":"), std::string::npos) << c.name << ": " << err;  // path:line
+  }
+  EXPECT_NE(errorOf([&] { vectorFileUnit((dir / "missing.vec").string()); }).find("cannot open"), std::string::npos);
+  spit(dir / "plain.txt", "1 0 0\n");
+  EXPECT_NE(errorOf([&] { vectorFileUnit((dir / "plain.txt").string()); }).find("not a shadesim vector file"),
+            std::string::npos);
+}
+
+TEST(Replay, CorrectFilesPassAndOneWrongValueFailsThere) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  for (const char* unit : {"spec", "span"}) {
+    const fs::path vec = std::string(unit) == "spec" ? specFile(dir, "wide", 800, 11) : spanFile(dir, "evenodd", 800, 11);
+    const ReplayResult ok = replayVectorFile(vec.string());
+    EXPECT_EQ(ok.cycles, 800u);
+    EXPECT_EQ(ok.mismatches, 0u) << (ok.first ? ok.first->describe() : "");
+    EXPECT_GT(ok.results, 100u);
+    // One expected value wrong at a known cycle: the replay must name that cycle and signal.
+    uint64_t cycle = 0;
+    std::string signal;
+    if (std::string(unit) == "spec") {
+      SpecVectors v = loadSpecVectors(vec.string());
+      for (size_t i = 400; i < v.in.size() && !cycle; ++i)
+        if (v.expected[i].valid && v.expected[i].rgb[1] > 0) {
+          v.expected[i].rgb[1] ^= 1;
+          cycle = i + 1;
+          signal = "spec_g_o";
+        }
+      writeSpecVectors(vec.string(), v);
+    } else {
+      SpanVectors v = loadSpanVectors(vec.string());
+      v.notes = generateSpanVectors("evenodd", 800, 11).notes;
+      for (size_t i = 400; i < v.cycles.size() && !cycle; ++i)
+        if (v.cycles[i].expected.lane[1].valid) {
+          v.cycles[i].expected.lane[1].y ^= 1;
+          cycle = i + 1;
+          signal = "out_y_o[lane 1]";
+        }
+      writeSpanVectors(vec.string(), v);
+    }
+    ASSERT_NE(cycle, 0u) << unit;
+    const ReplayResult bad = replayVectorFile(vec.string());
+    EXPECT_EQ(bad.mismatches, 1u) << unit;
+    ASSERT_TRUE(bad.first.has_value()) << unit;
+    EXPECT_EQ(bad.first->cycle, cycle) << unit;
+    EXPECT_EQ(bad.first->signal, signal) << unit;
+    EXPECT_EQ(bad.first->expected, bad.first->got ^ 1) << unit;  // the flipped bit, nothing else
+  }
+}
+
+TEST(Replay, WritesAnFstWaveform) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  ReplayOptions o;
+  o.fst_path = (dir / "wave.fst").string();
+  const ReplayResult r = replayVectorFile(spanFile(dir, "seg4", 300, 2).string(), o);
+  EXPECT_EQ(r.mismatches, 0u);
+  ASSERT_TRUE(fs::exists(o.fst_path));
+  EXPECT_GT(fs::file_size(o.fst_path), 1000u);
+}
+
+TEST(Replay, RefusesFilesItCannotReplayFaithfully) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  const fs::path spec = specFile(dir, "default", 50, 1);
+  const std::string text = slurp(spec);
+  // Parameters other than the verilated configuration's (consistent within the file).
+  std::string other = std::regex_replace(text, std::regex("\"PipeStages\":1"), "\"PipeStages\":2");
+  other = std::regex_replace(other, std::regex("# params 2 15 10 10 14 28 14 16 8 1"), "# params 2 15 10 10 14 28 14 16 8 2");
+  other = std::regex_replace(other, std::regex("# latency 3"), "# latency 4");
+  spit(dir / "other.vec", other);
+  EXPECT_NE(errorOf([&] { replayVectorFile((dir / "other.vec").string()); }).find("made for parameters"),
+            std::string::npos);
+  // A configuration that is not verilated.
+  spit(dir / "unknown.vec", std::regex_replace(text, std::regex("# config default"), "# config nosuch"));
+  EXPECT_NE(errorOf([&] { replayVectorFile((dir / "unknown.vec").string()); }).find("not verilated"), std::string::npos);
+  // A PROM that is missing, or holds another configuration's table.
+  fs::remove(dir / "default.hex");
+  EXPECT_NE(errorOf([&] { replayVectorFile(spec.string()); }).find("cannot open PROM file"), std::string::npos);
+  const SpecUnitConfig narrow = SpecUnitConfig::load(configPath("narrow"));
+  writeFileAtomic((dir / "default.hex").string(),
+                  renderProm(buildPromTable(PromRequest::fromContent(narrow.prom), narrow.rtl), PromFormat::Hex));
+  // It parses (16-bit words fit the 24-bit ones), loads, and must not pass.
+  EXPECT_GT(replayVectorFile(spec.string()).mismatches, 0u);
+}
+
+TEST(VectorGen, RefusesAStalePromAndUnknownConfigurations) {
+  const fs::path dir = testutil::freshTestDir("vectors");
+  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath("default"));
+  PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
+  t.words[17] ^= 1;
+  writeFileAtomic((dir / "stale.hex").string(), renderProm(t, PromFormat::Hex));
+  EXPECT_NE(errorOf([&] { generateSpecVectors("default", 10, 1, (dir / "stale.hex").string(), dir.string()); })
+                .find("word 17"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { generateSpecVectors("nosuch", 10, 1, (dir / "stale.hex").string(), dir.string()); })
+                .find("known: default, narrow, wide, cubic"),
+            std::string::npos);
+  EXPECT_NE(errorOf([&] { generateSpanVectors("nosuch", 10, 1); }).find("no span configuration 'nosuch'"),
+            std::string::npos);
+}
