@@ -93,7 +93,7 @@ struct ReplayCmd {
     } else {
       std::printf("replay %s: %s/%s, %llu cycles, %llu %s, %llu output values compared, %llu mismatches\n", file.c_str(),
                   r.unit.c_str(), r.config.c_str(), static_cast<unsigned long long>(r.cycles),
-                  static_cast<unsigned long long>(r.results), r.unit == "spec" ? "valid results" : "lane fragments",
+                  static_cast<unsigned long long>(r.results), r.unit == "spec" ? "valid results" : "valid lane outputs",
                   static_cast<unsigned long long>(r.compared), static_cast<unsigned long long>(r.mismatches));
     }
     if (r.first) {

@@ -33,7 +33,8 @@ struct ReplayResult {
   uint64_t compared = 0;             // output values compared
   uint64_t mismatching_cycles = 0;   // cycles with at least one differing output
   uint64_t mismatches = 0;           // differing output values
-  uint64_t results = 0;              // spec: valid results; span: expected lane fragments
+  uint64_t results = 0;  // spec: valid results; span: expected-valid lanes, summed over cycles
+                         // (a fragment stalled by out_ready counts on every cycle it is shown)
   std::optional<ReplayMismatch> first;
   std::vector<ReplayMismatch> listed;  // the first max_listed mismatches, in order
   std::string fst_path;

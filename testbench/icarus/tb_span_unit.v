@@ -298,8 +298,9 @@ module tb_span_unit #(
           if (hp[0] !== NumTri || hp[1] !== LanesPerTri || hp[2] !== AlignLanes || hp[3] !== NumAttr ||
               hp[4] !== AttrBits || hp[5] !== CoordBits || hp[6] !== RemBits || hp[7] !== PixBits ||
               hp[8] !== TagBits || hp[9] !== 32'bx) begin
-            $display("tb_span_unit: error: %0s, line %0d: the file is for parameters%0s", path, lineno, line);
-            $display("  compiled with: %0d %0d %0d %0d %0d %0d %0d %0d %0d (NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits)",
+            if (line[7:0] == "\n") line = line >> 8;
+            $display("tb_span_unit: error: %0s, line %0d: '#%0s' differs from the parameters compiled in:", path, lineno, line);
+            $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d (NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits)",
                      NumTri, LanesPerTri, AlignLanes, NumAttr, AttrBits, CoordBits, RemBits, PixBits, TagBits);
             $fatal(1);
           end
@@ -338,7 +339,7 @@ module tb_span_unit #(
                compared, bad_cycles, cycle);
       $fatal(1);
     end
-    $display("tb_span_unit: PASS %0s: %0d cycles, %0d descriptors, %0d lane fragments, %0d output values compared, 0 mismatches",
+    $display("tb_span_unit: PASS %0s: %0d cycles, %0d descriptors, %0d valid lane outputs, %0d output values compared, 0 mismatches",
              path, cycle, descs, fragments, compared);
     $finish;
   end

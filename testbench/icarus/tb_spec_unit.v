@@ -142,8 +142,9 @@ module tb_spec_unit #(
             if (hp[0] !== Degree || hp[1] !== CosFracBits || hp[2] !== ShinBits || hp[3] !== CoefIntBits ||
                 hp[4] !== CoefFracBits || hp[5] !== DiffFracBits || hp[6] !== HornerFracBits ||
                 hp[7] !== SpecFracBits || hp[8] !== LightBits || hp[9] !== PipeStages || hp[10] !== 32'bx) begin
-              $display("tb_spec_unit: error: %0s, line %0d: the file is for parameters %0s", path, lineno, line);
-              $display("  compiled with: %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits SpecFracBits LightBits PipeStages)",
+              if (line[7:0] == "\n") line = line >> 8;
+              $display("tb_spec_unit: error: %0s, line %0d: '%0s' differs from the parameters compiled in:", path, lineno, line);
+              $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits SpecFracBits LightBits PipeStages)",
                        Degree, CosFracBits, ShinBits, CoefIntBits, CoefFracBits, DiffFracBits, HornerFracBits,
                        SpecFracBits, LightBits, PipeStages);
               $fatal(1);
