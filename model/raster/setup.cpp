@@ -17,7 +17,10 @@ using i128 = __int128;
 // round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven (nearbyint rounds half to even
 // in the default rounding mode), without its format checks: the callers have bounded |v 2^frac|
 // well below 2^62 (the guard band, the attribute range).
-int64_t snapHalfEven(double v, int frac) { return static_cast<int64_t>(std::nearbyint(std::ldexp(v, frac))); }
+// (2^frac as a double multiplier: exact, like ldexp, and no libm call.)
+int64_t snapHalfEven(double v, int frac) {
+  return static_cast<int64_t>(std::nearbyint(v * static_cast<double>(int64_t{1} << frac)));
+}
 
 bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }
 
@@ -282,8 +285,9 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
     pl.iref.push_back(static_cast<int64_t>(roundDiv(2 * det * a[0] + nx * (cx - xu[0]) + ny * (cy - yu[0]), 2 * det)));
   }
 
-  // Lane-triangles in the walker frame.
-  InlineVec<SpanLaneTri, kMaxLaneTri> lanes;
+  // Lane-triangles in the walker frame, built in place in the descriptor.
+  SpanDesc& d = res.desc.emplace();
+  auto& lanes = d.tri;
   const SpanMode mode = p.mode();
   if (mode != SpanMode::Sierpinski) {
     lanes.push_back(buildLaneTri(whole, false, 0, 0, cfg));
@@ -317,10 +321,10 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
     any = true;
   }
   if (!any) {
+    res.desc.reset();
     res.dropped = "outside the viewport";
     return res;
   }
-  SpanDesc d;
   d.tag = tag;
   d.row_first = static_cast<int32_t>(row_first);
   d.row_last = static_cast<int32_t>(row_last);
@@ -344,8 +348,6 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
                               : wrap(dx * l.ox + dy * l.oy));
     }
   }
-  d.tri = lanes;
-  res.desc = std::move(d);
   return res;
 }
 

@@ -8,8 +8,12 @@ namespace shd {
 
 std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn,
                                             size_t count) {
-  std::vector<uint64_t> f(count);
-  squaredNormsAlongSpan(n0, dn, count, [&](size_t i, uint64_t v) { f[i] = v; });
+  std::vector<uint64_t> f;
+  if (count == 0) return f;
+  f.reserve(count);
+  SquaredNormRecurrence r;
+  f.push_back(r.start(n0, dn));
+  while (f.size() < count) f.push_back(r.next());
   return f;
 }
 

@@ -19,25 +19,34 @@
 
 namespace shd {
 
-// out(i, F_i) for i = 0 .. count-1.
-template <class Out>
-void squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn, size_t count, Out out) {
-  if (count == 0) return;
-  uint64_t A = 0, B = 0, C = 0;
-  for (size_t k = 0; k < 3; ++k) {
-    const uint64_t a = static_cast<uint64_t>(n0[k]), d = static_cast<uint64_t>(dn[k]);
-    A += a * a;
-    B += a * d;
-    C += d * d;
+// The recurrence along one span: start() at its first pixel returns F_0 = A, each next() the
+// following pixel's F_i (two additions).
+class SquaredNormRecurrence {
+ public:
+  uint64_t start(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn) {
+    uint64_t A = 0, B = 0, C = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      const uint64_t a = static_cast<uint64_t>(n0[k]), d = static_cast<uint64_t>(dn[k]);
+      A += a * a;
+      B += a * d;
+      C += d * d;
+    }
+    F_ = A;
+    two_b_ = 2 * B;
+    two_c_ = 2 * C;
+    ci_ = C;  // C_1 = C
+    return F_;
   }
-  uint64_t F = A, Ci = C;  // F_0 = A, C_1 = C
-  out(size_t{0}, F);
-  for (size_t i = 1; i < count; ++i) {
-    F += 2 * B + Ci;  // F_i = F_{i-1} + 2B + C_i
-    Ci += 2 * C;      // C_{i+1} = C_i + 2C
-    out(i, F);
+  uint64_t next() {
+    F_ += two_b_ + ci_;  // F_i = F_{i-1} + 2B + C_i
+    ci_ += two_c_;       // C_{i+1} = C_i + 2C
+    return F_;
   }
-}
+
+ private:
+  uint64_t F_ = 0, two_b_ = 0, two_c_ = 0, ci_ = 0;
+};
+
 std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn,
                                             size_t count);
 

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "approx/brdf.h"
+#include "raster/span_walk.h"
 #include "render/normalize.h"
 
 namespace shd {
@@ -147,6 +148,61 @@ bool adaptiveChoice(const std::array<PVertex, 3>& t, const ShadeContext& ctx, co
   return true;
 }
 
+// normal-bisection (see render.h): the normal used at each fragment, row by row in x order.
+void bisectNormals(const std::vector<SpanFragment>& frags, double threshold, std::vector<size_t>& order,
+                   std::vector<Vec3>& bisected, uint64_t& normalisations) {
+  auto rawNormal = [](const SpanFragment& f) {
+    return Vec3{static_cast<double>(f.attr[0]) * kUnitLsb, static_cast<double>(f.attr[1]) * kUnitLsb,
+                static_cast<double>(f.attr[2]) * kUnitLsb};
+  };
+  order.resize(frags.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return frags[a].y != frags[b].y ? frags[a].y < frags[b].y : frags[a].x < frags[b].x;
+  });
+  bisected.assign(frags.size(), Vec3{0, 0, 0});
+  std::vector<Vec3> n;
+  std::vector<bool> node;
+  for (size_t i = 0; i < order.size();) {
+    size_t j = i;
+    while (j < order.size() && frags[order[j]].y == frags[order[i]].y) ++j;
+    // Nodes at the ends, then recursive bisection (positions within the row i..j-1).
+    n.assign(j - i, Vec3{0, 0, 0});
+    node.assign(j - i, false);
+    auto exact = [&](size_t k) {
+      n[k] = normalize(rawNormal(frags[order[i + k]]));
+      node[k] = true;
+      ++normalisations;
+    };
+    exact(0);
+    if (j - i > 1) exact(j - i - 1);
+    std::function<void(size_t, size_t)> bisect = [&](size_t a, size_t b) {
+      if (b - a < 2) return;
+      const double err = 1 - length(0.5 * (n[a] + n[b]));  // 1 - cos(W/2)
+      if (err <= threshold) return;
+      const size_t mid = (a + b) / 2;
+      exact(mid);
+      bisect(a, mid);
+      bisect(mid, b);
+    };
+    bisect(0, j - i - 1);
+    // Between nodes: linear interpolation, not normalised.
+    size_t a = 0;
+    for (size_t k = 0; k < j - i; ++k) {
+      if (node[k]) {
+        a = k;
+        bisected[order[i + k]] = n[k];
+        continue;
+      }
+      size_t b = k;
+      while (!node[b]) ++b;
+      const double t = static_cast<double>(k - a) / static_cast<double>(b - a);
+      bisected[order[i + k]] = n[a] + t * (n[b] - n[a]);
+    }
+    i = j;
+  }
+}
+
 }  // namespace
 
 double edgeMaximumT(Vec3 na, Vec3 nb, Vec3 h) {
@@ -238,31 +294,32 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   rc.attr_frac_bits = {kColourFrac, kColourFrac, kColourFrac, kUnitFrac};  // per triangle below
   rc.validate();
 
-  // The coding of a device lobe's requests for its specular unit.
-  auto codingFor = [](SpecEngine* e) {
+  // The coding of a device lobe's requests for the specular unit of a material.
+  auto codingFor = [](SpecEngine* e, const Material& m) {
     DeviceCoding c;
     if (e == nullptr) return c;
-    c.cos_frac_bits = e->table().unit.CosFracBits;
-    c.shin_code = [t = &e->table()](double n) {
-      const int a = t->addressOf(std::round(n));
-      if (a < 0)
-        throw std::invalid_argument(
-            fmt::format("shininess {} is not in the specular unit's PROM (n = {})", n, t->request.n.text));
-      return static_cast<uint32_t>(a);
-    };
+    const PromTable& t = e->table();
+    c.cos_frac_bits = t.unit.CosFracBits;
+    const int a = t.addressOf(std::round(m.shininess));
+    if (a < 0)
+      throw std::invalid_argument(
+          fmt::format("shininess {} is not in the specular unit's PROM (n = {})", m.shininess, t.request.n.text));
+    c.shin = static_cast<uint32_t>(a);
     return c;
   };
   std::vector<std::array<uint32_t, 3>> device_out;
+  std::vector<SpecRequest> point_requests;
   SpecEngine* spec = nullptr;  // the current object's
   DeviceCoding coding;
 
   // A point's shade, with its device-lobe evaluations done by the specular unit right away
   // (vertices: few; pixels are batched per triangle below).
   auto shadeNow = [&](const Material& m, Lobe lobe, Vec3 n, Vec3 p) {
-    Shade s = shadePoint(ctx, m, lobe, n, p, isDeviceLobe(lobe) ? &coding : nullptr);
-    if (!s.device.empty()) {
-      st.spec_cycles += spec->evaluate(s.device, device_out);
-      st.spec_evaluations += s.device.size();
+    point_requests.clear();
+    Shade s = shadePoint(ctx, m, lobe, n, p, &coding, &point_requests);
+    if (!point_requests.empty()) {
+      st.spec_cycles += spec->evaluate(point_requests, device_out);
+      st.spec_evaluations += point_requests.size();
       for (const auto& d : device_out)
         for (size_t k = 0; k < 3; ++k) s.lsb[k] += d[k];
     }
@@ -294,7 +351,6 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   std::vector<Pending> pend;
   std::vector<SpecRequest> requests;
   std::vector<size_t> order;
-  std::vector<uint64_t> sqnorm;
   std::vector<Vec3> bisected;
   std::vector<uint8_t> row_divided(static_cast<size_t>(H), 0);
   std::vector<int32_t> divided_rows;
@@ -309,7 +365,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     spec = engines.forLobe(lobe);
     if (isDeviceLobe(lobe) && spec == nullptr && !reference)
       throw std::invalid_argument(fmt::format("object '{}': brdf {} needs the specular unit", obj.name, toString(lobe)));
-    coding = codingFor(spec);
+    coding = codingFor(spec, mat);
     // Object -> camera space, the projection of the vertices in front of the near plane, and
     // the Gouraud vertex colours.
     std::vector<PVertex> verts(obj.mesh.positions.size());
@@ -421,16 +477,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         ++st.drawn;
         if (opt.method == Method::Adaptive) ++(m == Method::Gouraud ? st.adaptive_gouraud : st.adaptive_phong);
 
-        // Fragments: the reference walks the same pixel set by direct edge evaluation.
-        frags.clear();
-        if (reference) {
-          frags = rasterizeReference(s, rcm);
-        } else {
-          st.span_cycles += span.run(*s.desc, frags).cycles;
-        }
-        st.fragments += frags.size();
-
-        // A fragment's colour, written at once, or (per-pixel device lobes) once the specular
+        // A fragment's colour is written at once, or (per-pixel device lobes) once the specular
         // unit has evaluated the triangle's batch of requests.
         const bool batched =
             !reference && isDeviceLobe(lobe) && (m == Method::Phong || m == Method::PhongIncremental || m == Method::NormalBisection);
@@ -441,77 +488,16 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           fb.depth[p] = static_cast<int32_t>(w);
           fb.tri[p] = static_cast<int32_t>(tag);
         };
-        auto rawNormal = [&](const SpanFragment& f) {
-          return Vec3{static_cast<double>(f.attr[0]) * kUnitLsb, static_cast<double>(f.attr[1]) * kUnitLsb,
-                      static_cast<double>(f.attr[2]) * kUnitLsb};
+        auto rawNormal = [&](const int64_t* attr) {
+          return Vec3{static_cast<double>(attr[0]) * kUnitLsb, static_cast<double>(attr[1]) * kUnitLsb,
+                      static_cast<double>(attr[2]) * kUnitLsb};
         };
-        // Row-major order of the fragments (lane modes emit a row's pixels out of order, and
-        // the Sierpinski lanes interleave rows): the incremental methods walk each row in x.
-        auto rowOrder = [&] {
-          order.resize(frags.size());
-          for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-          auto before = [&](size_t a, size_t b) {
-            return frags[a].y != frags[b].y ? frags[a].y < frags[b].y : frags[a].x < frags[b].x;
-          };
-          if (!std::is_sorted(order.begin(), order.end(), before)) std::sort(order.begin(), order.end(), before);
-        };
-        if (m == Method::NormalBisection) {
-          rowOrder();
-          bisected.assign(frags.size(), Vec3{0, 0, 0});
-          for (size_t i = 0; i < order.size();) {
-            size_t j = i;
-            while (j < order.size() && frags[order[j]].y == frags[order[i]].y) ++j;
-            // Nodes at the ends, then recursive bisection (positions within the row i..j-1).
-            std::vector<Vec3> n(j - i);
-            std::vector<bool> node(j - i, false);
-            auto exact = [&](size_t k) {
-              n[k] = normalize(rawNormal(frags[order[i + k]]));
-              node[k] = true;
-              ++st.normalisations;
-            };
-            exact(0);
-            if (j - i > 1) exact(j - i - 1);
-            std::function<void(size_t, size_t)> bisect = [&](size_t a, size_t b) {
-              if (b - a < 2) return;
-              const double err = 1 - length(0.5 * (n[a] + n[b]));  // 1 - cos(W/2)
-              if (err <= opt.bisection_threshold) return;
-              const size_t mid = (a + b) / 2;
-              exact(mid);
-              bisect(a, mid);
-              bisect(mid, b);
-            };
-            bisect(0, j - i - 1);
-            // Between nodes: linear interpolation, not normalised.
-            size_t a = 0;
-            for (size_t k = 0; k < j - i; ++k) {
-              if (node[k]) {
-                a = k;
-                bisected[order[i + k]] = n[k];
-                continue;
-              }
-              size_t b = k;
-              while (!node[b]) ++b;
-              const double t = static_cast<double>(k - a) / static_cast<double>(b - a);
-              bisected[order[i + k]] = n[a] + t * (n[b] - n[a]);
-            }
-            i = j;
-          }
-        }
-        if (m == Method::PhongIncremental) {
-          // |N|^2 of every fragment by the span recurrence, row by row in x order.
-          rowOrder();
-          sqnorm.resize(frags.size());
-          const std::array<int64_t, 3> dn{s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]};
-          for (size_t i = 0; i < order.size();) {
-            size_t j = i;
-            while (j < order.size() && frags[order[j]].y == frags[order[i]].y) ++j;
-            const SpanFragment& first = frags[order[i]];
-            squaredNormsAlongSpan({first.attr[0], first.attr[1], first.attr[2]}, dn, j - i, [&](size_t k, uint64_t f) {
-              sqnorm[order[i + k]] = f;
-            });
-            i = j;
-          }
-        }
+        // phong-incremental: |N|^2 along each run of consecutive pixels of a row by the
+        // recurrence, restarted (three products) where the stream is not the next pixel. The
+        // recurrence is exact, so the values do not depend on where it restarts.
+        SquaredNormRecurrence sqn;
+        int32_t run_y = -1, run_next_x = 0;
+        const std::array<int64_t, 3> dn{s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]};
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
         if (m == Method::Biquadratic)
@@ -520,30 +506,38 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             mid_colour[e] = shadeNow(mat, lobe, normalize(mv.n), pixelCam(mv.x - 0.5, mv.y - 0.5, mv.w));
           }
         // Barycentric coordinates of a pixel centre on the unsnapped screen triangle.
-        auto barycentric = [&](const SpanFragment& f) {
-          const double px = f.x + 0.5, py = f.y + 0.5;
+        auto barycentric = [&](int32_t x, int32_t y) {
+          const double px = x + 0.5, py = y + 0.5;
           const double d = area2(*tv[0], *tv[1], *tv[2]);
           const double l1 = ((px - tv[0]->x) * (tv[2]->y - tv[0]->y) - (tv[2]->x - tv[0]->x) * (py - tv[0]->y)) / d;
           const double l2 = ((tv[1]->x - tv[0]->x) * (py - tv[0]->y) - (px - tv[0]->x) * (tv[1]->y - tv[0]->y)) / d;
           return std::array<double, 3>{1 - l1 - l2, l1, l2};
         };
-        for (size_t fi = 0; fi < frags.size(); ++fi) {
-          const SpanFragment& fr = frags[fi];
-          const size_t p = static_cast<size_t>(fr.y) * W + fr.x;
-          const int64_t wcode = fr.attr[3];
-          // Z-test against the triangles drawn before this one.
-          if (wcode <= fb.depth[p]) continue;
+
+        // One fragment: z-test against the triangles drawn before this one, shade, write.
+        // (bisected: normal-bisection's normal of this fragment.)
+        auto shadeFragment = [&](int32_t x, int32_t y, const int64_t* attr, const Vec3* bisected_n) {
+          uint64_t sqnorm = 0;
+          if (m == Method::PhongIncremental) {
+            if (y == run_y && x == run_next_x) sqnorm = sqn.next();
+            else sqnorm = sqn.start({attr[0], attr[1], attr[2]}, dn);
+            run_y = y;
+            run_next_x = x + 1;
+          }
+          const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x);
+          const int64_t wcode = attr[3];
+          if (wcode <= fb.depth[p]) return;
           std::array<double, 3> lsb{};
           switch (m) {
             case Method::Flat:
             case Method::Gouraud:
               // The interpolated colour codes straight to unorm8 (what combine() gives them).
-              write(p, wcode, {unorm8FromCode(fr.attr[0], kColourFrac), unorm8FromCode(fr.attr[1], kColourFrac),
-                               unorm8FromCode(fr.attr[2], kColourFrac)});
-              continue;
+              write(p, wcode, {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
+                               unorm8FromCode(attr[2], kColourFrac)});
+              return;
             case Method::GouraudClassical: {
               // The classical loop: along both edges, then one division per raster line (float).
-              const float yc = static_cast<float>(fr.y) + 0.5f;
+              const float yc = static_cast<float>(y) + 0.5f;
               float xl = 1e30f, xr = -1e30f;
               std::array<float, 3> cl{}, cr{};
               for (size_t e = 0; e < 3; ++e) {
@@ -567,38 +561,37 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                 }
               }
               const float len = xr - xl;
-              const size_t row = static_cast<size_t>(fr.y);
+              const size_t row = static_cast<size_t>(y);
               if (len > 0 && !row_divided[row]) {
                 row_divided[row] = 1;
-                divided_rows.push_back(fr.y);
+                divided_rows.push_back(y);
                 ++st.divisions;
               }
               for (size_t k = 0; k < 3; ++k) {
                 const float step = len > 0 ? (cr[k] - cl[k]) / len : 0.0f;
-                lsb[k] = cl[k] + step * (static_cast<float>(fr.x) + 0.5f - xl);
+                lsb[k] = cl[k] + step * (static_cast<float>(x) + 0.5f - xl);
               }
               break;
             }
             case Method::Phong:
             case Method::PhongIncremental:
             case Method::NormalBisection: {
-              const Vec3 nraw = rawNormal(fr);
+              const Vec3 nraw = rawNormal(attr);
               Vec3 n;
               if (m == Method::Phong) {
                 n = normalize(nraw);
               } else if (m == Method::NormalBisection) {
-                n = bisected[fi];
+                n = *bisected_n;
               } else {
                 // |N|^2 from the recurrence (exact integers), then the fixed-point 1/sqrt.
-                n = rsqrtFixed(sqnorm[fi], 2 * kUnitFrac) * nraw;
+                n = rsqrtFixed(sqnorm, 2 * kUnitFrac) * nraw;
               }
-              const Vec3 pc = pixelCam(fr.x, fr.y, static_cast<double>(wcode) * kUnitLsb);
-              Shade sh = shadePoint(ctx, mat, lobe, n, pc, batched ? &coding : nullptr);
-              lsb = sh.lsb;
+              const Vec3 pc = pixelCam(x, y, static_cast<double>(wcode) * kUnitLsb);
+              const size_t first = requests.size();
+              lsb = shadePoint(ctx, mat, lobe, n, pc, &coding, &requests).lsb;
               if (batched) {
-                pend.push_back({p, wcode, lsb, requests.size(), sh.device.size()});
-                requests.insert(requests.end(), sh.device.begin(), sh.device.end());
-                continue;
+                pend.push_back({p, wcode, lsb, first, requests.size() - first});
+                return;
               }
               break;
             }
@@ -607,7 +600,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
               throw std::logic_error("render: split and adaptive triangles are drawn as gouraud or phong");
             case Method::Biquadratic: {
               // The quadratic Lagrange basis: vertices c_i, edge midpoints c_ij (edge e = i..i+1).
-              const auto l = barycentric(fr);
+              const auto l = barycentric(x, y);
               for (size_t k = 0; k < 3; ++k) {
                 double v = 0;
                 for (size_t i = 0; i < 3; ++i) v += std::clamp(tv[i]->colour[k], 0.0, 255.0) * l[i] * (2 * l[i] - 1);
@@ -617,18 +610,18 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
               break;
             }
             case Method::Reference: {
-              const auto lb = barycentric(fr);
+              const auto lb = barycentric(x, y);
               const double l0 = lb[0], l1 = lb[1], l2 = lb[2];
               const Vec3 n = normalize(l0 * tv[0]->n + l1 * tv[1]->n + l2 * tv[2]->n);
               const double w = l0 * tv[0]->w + l1 * tv[1]->w + l2 * tv[2]->w;
-              const Vec3 pc = pixelCam(fr.x, fr.y, w);
+              const Vec3 pc = pixelCam(x, y, w);
               const Lobe ref_lobe = isDeviceLobe(lobe) ? Lobe::Blinn : lobe;
-              const Shade sh = shadePoint(ctx, mat, ref_lobe, n, pc, nullptr);
+              const Shade sh = shadePoint(ctx, mat, ref_lobe, n, pc, nullptr, nullptr);
               lsb = sh.lsb;
               // The specular part alone, for highlight masks.
               Material nospec = mat;
               nospec.ks = 0;
-              const Shade dif = shadePoint(ctx, nospec, ref_lobe, n, pc, nullptr);
+              const Shade dif = shadePoint(ctx, nospec, ref_lobe, n, pc, nullptr, nullptr);
               for (size_t k = 0; k < 3; ++k) {
                 fb.lsb[p * 3 + k] = sh.lsb[k];
                 fb.spec_lsb[p * 3 + k] = sh.lsb[k] - dif.lsb[k];
@@ -637,6 +630,27 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             }
           }
           write(p, wcode, combine(lsb, nullptr, 0));
+        };
+
+        // The fragments: shaded as the model's walk produces them, or collected first (the
+        // reference walks the same pixel set by direct edge evaluation; the RTL's stream;
+        // normal-bisection needs whole rows).
+        const SpanParams* walker = span.walker();
+        if (!reference && walker != nullptr && m != Method::NormalBisection) {
+          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, [&](int32_t x, int32_t y, const int64_t* attr) {
+            shadeFragment(x, y, attr, nullptr);
+          });
+          st.span_cycles += wk.cycles;
+          st.fragments += wk.fragments;
+        } else {
+          frags.clear();
+          if (reference) frags = rasterizeReference(s, rcm);
+          else st.span_cycles += span.run(*s.desc, frags).cycles;
+          st.fragments += frags.size();
+          if (m == Method::NormalBisection) bisectNormals(frags, opt.bisection_threshold, order, bisected, st.normalisations);
+          for (size_t fi = 0; fi < frags.size(); ++fi)
+            shadeFragment(frags[fi].x, frags[fi].y, frags[fi].attr.data(),
+                          m == Method::NormalBisection ? &bisected[fi] : nullptr);
         }
         for (int32_t row : divided_rows) row_divided[static_cast<size_t>(row)] = 0;
         divided_rows.clear();

@@ -93,6 +93,9 @@ class SpanEngine {
   virtual ~SpanEngine() = default;
   virtual const SpanParams& params() const = 0;
   virtual SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) = 0;
+  // Non-null when the engine is the model's walk (walkSpanUnit) with these parameters: the
+  // renderer may then walk descriptors itself and shade each fragment as it is produced.
+  virtual const SpanParams* walker() const { return nullptr; }
 };
 
 // The model: walkSpanUnit, bit- and cycle-exact to the cycle-by-cycle SpanUnitModel.
@@ -101,6 +104,7 @@ class ModelSpanEngine final : public SpanEngine {
   explicit ModelSpanEngine(SpanParams p) : p_(p) { p_.validate(); }
   const SpanParams& params() const override { return p_; }
   SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override { return walkSpanUnit(p_, d, out); }
+  const SpanParams* walker() const override { return &p_; }
 
  private:
   SpanParams p_;

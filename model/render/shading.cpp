@@ -19,6 +19,7 @@ ShadeContext makeShadeContext(const Scene& s) {
     cl.colour = l.colour;
     if (l.kind == Light::Kind::Directional) {
       cl.dir = normalize(toCameraDirection(b, l.direction));
+      cl.half = normalize(cl.dir + c.view);
     } else {
       cl.point = true;
       cl.pos = toCameraSpace(b, s.camera, l.position);
@@ -61,8 +62,9 @@ Vec3 lightDirection(const CameraLight& l, Vec3 p_cam) {
   return len > 0 ? (1.0 / len) * d : Vec3{0, 0, -1};
 }
 
-double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v) {
-  const Vec3 h = normalize(l + v);
+double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v) { return lobeValue(lobe, m, n, l, v, normalize(l + v)); }
+
+double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v, Vec3 h) {
   const double nh = dot(n, h), nl = dot(n, l), nv = dot(n, v);
   switch (lobe) {
     case Lobe::Phong: {
@@ -81,7 +83,8 @@ double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v) {
   throw std::logic_error("lobeValue: device lobes are evaluated by the specular unit");
 }
 
-Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, Vec3 p_cam, const DeviceCoding* coding) {
+Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, Vec3 p_cam, const DeviceCoding* coding,
+                 std::vector<SpecRequest>* device) {
   Shade s;
   for (int k = 0; k < 3; ++k) {
     const double base = k == 0 ? m.colour.x : (k == 1 ? m.colour.y : m.colour.z);
@@ -96,16 +99,17 @@ Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, 
     const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
     for (size_t k = 0; k < 3; ++k) s.lsb[k] += 255.0 * m.kd * base[k] * lc[k] * nl;
     if (isDeviceLobe(lobe)) {
-      if (coding == nullptr) throw std::logic_error("shadePoint: a device lobe needs the specular unit's coding");
-      const double nh = std::clamp(dot(n, normalize(ld + ctx.view)), 0.0, 1.0);
+      if (coding == nullptr || device == nullptr)
+        throw std::logic_error("shadePoint: a device lobe needs the specular unit's coding and a request list");
+      const double nh = std::clamp(dot(n, l.point ? normalize(ld + ctx.view) : l.half), 0.0, 1.0);
       SpecRequest r;
       r.cos = static_cast<uint32_t>(std::lround(std::ldexp(nh, coding->cos_frac_bits)));
-      r.shin = coding->shin_code(m.shininess);
+      r.shin = coding->shin;
       for (size_t k = 0; k < 3; ++k)
         r.light[k] = static_cast<uint32_t>(std::lround(255.0 * std::clamp(m.ks * lc[k], 0.0, 1.0)));
-      s.device.push_back(r);
+      device->push_back(r);
     } else {
-      const double f = lobeValue(lobe, m, n, ld, ctx.view);
+      const double f = lobeValue(lobe, m, n, ld, ctx.view, l.point ? normalize(ld + ctx.view) : l.half);
       for (size_t k = 0; k < 3; ++k) s.lsb[k] += 255.0 * m.ks * lc[k] * f;
     }
   }

@@ -13,7 +13,6 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
@@ -24,6 +23,7 @@ namespace shd {
 struct CameraLight {
   bool point = false;
   Vec3 dir{0, 0, -1};  // directional: toward the light, camera space, unit
+  Vec3 half{0, 0, 1};  // directional: normalize(dir + view), the same at every point
   Vec3 pos{0, 0, 0};   // point: camera space
   Vec3 colour{1, 1, 1};
 };
@@ -47,6 +47,8 @@ Vec3 lightDirection(const CameraLight& l, Vec3 p_cam);
 // (N.H)^n, normalized blinn (n+2)/(2 pi) (N.H)^n, schlick, Cook-Torrance with Beckmann
 // roughness from the material.
 double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v);
+// The same with the half vector h = normalize(l + v) given (constant for a directional light).
+double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v, Vec3 h);
 
 // One specular-unit evaluation: shininess code, N.H as a uQ1.Wc code, light*k_s as unorm8.
 struct SpecRequest {
@@ -55,19 +57,18 @@ struct SpecRequest {
 };
 
 // Colour of a point in output LSBs (0..255 scale, unclamped, double): ambient + diffuse + the
-// analytic specular lobes. Device lobes add nothing here; for them `device` receives one
-// request per light (N.H, shininess code, light colour), to be added by combine().
+// analytic specular lobes. Device lobes add nothing here; for them one request per lit light
+// (N.H, shininess code, light colour) is appended to *device, to be added by combine().
 struct DeviceCoding {
   int cos_frac_bits = 15;
-  // Shininess code of a material: the PROM address of its n (rounded to the table's grid).
-  std::function<uint32_t(double n)> shin_code;
+  uint32_t shin = 0;  // the PROM address of the material's shininess
 };
 struct Shade {
-  std::array<double, 3> lsb{};           // ambient + diffuse + analytic specular, 0..255 scale
-  std::vector<SpecRequest> device;       // device-lobe evaluations still to add
+  std::array<double, 3> lsb{};  // ambient + diffuse + analytic specular, 0..255 scale
 };
+// coding and device may be null unless the lobe is a device lobe (std::logic_error then).
 Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n_unit, Vec3 p_cam,
-                 const DeviceCoding* coding);
+                 const DeviceCoding* coding, std::vector<SpecRequest>* device);
 
 // Final unorm8: round(lsb) plus the device outputs, clamped to 0..255.
 // device_rgb points at `count` specular-unit results (may be null when count is 0).

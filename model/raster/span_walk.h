@@ -1,0 +1,179 @@
+// The span unit's functional walk (raster/span_unit.h: walkSpanUnit), as a template over the
+// consumer of the fragments, so that a renderer can shade each fragment as the walk produces
+// it; and the ROW logic it shares with the cycle-by-cycle SpanUnitModel.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+
+#include "raster/span_unit.h"
+
+namespace shd {
+
+namespace span_detail {
+
+// Two's complement wrap to `bits` (< 64) bits: the value mod 2^bits, sign-extended. The
+// callers form sums and products in uint64_t, which is exact mod 2^64 and so mod 2^bits.
+inline int64_t wrapTo(uint64_t v, int bits) {
+  const int sh = 64 - bits;
+  return static_cast<int64_t>(v << sh) >> sh;  // arithmetic shift: defined on GCC/Clang, C++20
+}
+
+inline uint64_t u(int64_t v) { return static_cast<uint64_t>(v); }
+
+// The ROW cycle, combinational part, for one lane-triangle at walker row w with its edges'
+// current quotients: the span [lo, hi]; returns ne (the lane-triangle has pixels on the row).
+inline bool laneRowBounds(const SpanLaneTri& t, int64_t w, const SpanDdaState* e, int64_t& lo, int64_t& hi) {
+  lo = t.clip_x0;
+  hi = t.clip_x1;
+  for (int s = 0; s < 3; ++s) {
+    const SpanEdge& g = t.edge[s];
+    if (w < g.row_first || w > g.row_last) continue;
+    if (g.right) hi = std::min(hi, -e[s].q);
+    else lo = std::max(lo, e[s].q);
+  }
+  return t.row_first <= w && w <= t.row_last && lo <= hi;
+}
+
+// The ROW cycle's register update of one lane-triangle's edges: the DDA step of every edge
+// active at w that stays active at w + 1.
+inline void stepEdges(const SpanLaneTri& t, int64_t w, SpanDdaState* e, int coord_bits) {
+  for (int s = 0; s < 3; ++s) {
+    const SpanEdge& g = t.edge[s];
+    if (w < g.row_first || w >= g.row_last) continue;
+    SpanDdaState& st = e[s];
+    const int64_t r = st.r - g.m;
+    if (r < 0) {
+      st.r = r + g.div;
+      st.q = wrapTo(u(st.q + g.k + 1), coord_bits);
+    } else {
+      st.r = r;
+      st.q = wrapTo(u(st.q + g.k), coord_bits);
+    }
+  }
+}
+
+inline void checkDescriptor(const SpanParams& p, const SpanDesc& d) {
+  if (static_cast<int>(d.tri.size()) != p.NumTri || static_cast<int>(d.iref.size()) != p.NumAttr)
+    throw std::invalid_argument("span descriptor does not match the unit's NumTri/NumAttr");
+  if (d.row_first > d.row_last)  // the RTL would walk until w wraps
+    throw std::invalid_argument("span descriptor without rows: setup drops such triangles");
+}
+
+// The lane fragment at walker column x of row wspan, attribute base icur + i*didx (lane i).
+inline void laneFragment(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t x, int64_t wspan,
+                         const int64_t* icur, int i, int32_t& px_out, int32_t& py_out, int64_t* attr) {
+  const int64_t px = t.flip ? t.ox - x : x + t.ox;
+  const int64_t py = t.flip ? t.oy - wspan : wspan + t.oy;
+  const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
+  px_out = static_cast<int32_t>(px & pix_mask);
+  py_out = static_cast<int32_t>(py & pix_mask);
+  for (int a = 0; a < p.NumAttr; ++a) {
+    const size_t ai = static_cast<size_t>(a);
+    const uint64_t v = u(icur[ai]) + static_cast<uint64_t>(i) * u(d.didx[ai]);
+    attr[ai] = wrapTo(t.flip ? u(t.aoff[ai]) - v : v + u(t.aoff[ai]), p.AttrBits);
+  }
+}
+
+}  // namespace span_detail
+
+// The fragments of one descriptor, in the order SpanUnitModel hands them over with out_ready
+// always 1, each passed to emit(x, y, attr) (attr: NumAttr codes, valid during the call), and
+// the cycles counted as runSpanUnit counts them. See walkSpanUnit in raster/span_unit.h.
+template <class Sink>
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& emit) {
+  using namespace span_detail;
+  checkDescriptor(p, d);
+  const int L = p.LanesPerTri, T = p.NumTri, K = p.NumAttr;
+  SpanWalk walk;
+  walk.cycles = 1;  // IDLE, accepting the descriptor
+  std::array<SpanDdaState, kMaxLaneTri * 3> e{};
+  for (int j = 0; j < T; ++j)
+    for (int s = 0; s < 3; ++s) {
+      const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];
+      e[static_cast<size_t>(j * 3 + s)] = {g.q, g.r};
+    }
+  std::array<int64_t, kMaxAttr> irow{}, icur{};
+  std::copy(d.iref.begin(), d.iref.end(), irow.begin());
+  std::array<int64_t, kMaxLaneTri> lo{}, hi{};
+  std::array<bool, kMaxLaneTri> ne{};
+  std::array<int64_t, kMaxAttr> attr{};
+  for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
+    ++walk.row_cycles;
+    bool any = false;
+    int64_t xs = 0, xe = 0;
+    for (int j = 0; j < T; ++j) {
+      const size_t ju = static_cast<size_t>(j);
+      ne[ju] = laneRowBounds(d.tri[ju], w, &e[ju * 3], lo[ju], hi[ju]);
+      if (ne[ju]) {
+        xs = any ? std::min(xs, lo[ju]) : lo[ju];
+        xe = any ? std::max(xe, hi[ju]) : hi[ju];
+        any = true;
+      }
+    }
+    if (any && T == 1) {
+      // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
+      // successive columns, so the fragments come in x order, and lane i of the cycle at xg
+      // shows the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
+      const SpanLaneTri& t = d.tri[0];
+      const int64_t xg0 = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+      walk.span_cycles += static_cast<uint64_t>((xe - xg0) / L + 1);
+      std::array<uint64_t, kMaxAttr> acc{};
+      for (int a = 0; a < K; ++a) {
+        const size_t ai = static_cast<size_t>(a);
+        acc[ai] = u(irow[ai]) + u(d.didx[ai]) * u(lo[0] - d.xref);
+      }
+      const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
+      const int32_t py = static_cast<int32_t>((t.flip ? t.oy - w : w + t.oy) & pix_mask);
+      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+        for (int a = 0; a < K; ++a) {
+          const size_t ai = static_cast<size_t>(a);
+          attr[ai] = wrapTo(t.flip ? u(t.aoff[ai]) - acc[ai] : acc[ai] + u(t.aoff[ai]), p.AttrBits);
+          acc[ai] += u(d.didx[ai]);
+        }
+        emit(static_cast<int32_t>((t.flip ? t.ox - x : x + t.ox) & pix_mask), py, attr.data());
+      }
+      walk.fragments += static_cast<uint64_t>(hi[0] - lo[0] + 1);
+    } else if (any) {
+      int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+      for (int a = 0; a < K; ++a) {
+        const size_t ai = static_cast<size_t>(a);
+        icur[ai] = wrapTo(u(irow[ai]) + u(d.didx[ai]) * u(xg - d.xref), p.AttrBits);
+      }
+      for (;;) {  // SPAN cycles
+        ++walk.span_cycles;
+        for (int j = 0; j < T; ++j) {
+          const size_t ju = static_cast<size_t>(j);
+          if (!ne[ju]) continue;
+          for (int i = 0; i < L; ++i) {
+            const int64_t x = xg + i;
+            if (x < lo[ju] || x > hi[ju]) continue;
+            int32_t px = 0, py = 0;
+            laneFragment(p, d, d.tri[ju], x, w, icur.data(), i, px, py, attr.data());
+            emit(px, py, static_cast<const int64_t*>(attr.data()));
+            ++walk.fragments;
+          }
+        }
+        if (xg + L > xe) break;
+        xg += L;
+        for (int a = 0; a < K; ++a) {
+          const size_t ai = static_cast<size_t>(a);
+          icur[ai] = wrapTo(u(icur[ai]) + static_cast<uint64_t>(L) * u(d.didx[ai]), p.AttrBits);
+        }
+      }
+    }
+    for (int j = 0; j < T; ++j)
+      stepEdges(d.tri[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
+    for (int a = 0; a < K; ++a) {
+      const size_t ai = static_cast<size_t>(a);
+      irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
+    }
+    if (w == d.row_last) break;
+  }
+  walk.cycles += walk.row_cycles + walk.span_cycles;
+  return walk;
+}
+
+}  // namespace shd

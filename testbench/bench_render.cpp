@@ -1,0 +1,59 @@
+// Frame time of the golden model on builtin:sphere (512 x 512, the idx3d sphere), per shading
+// method, with the frame buffers reused from frame to frame as a renderer does. Figures, not
+// pass/fail. The peer: idx3d III renders this sphere in about 1.3 ms (flat) and 1.8 ms (its
+// lookup-table "Phong") per frame; the targets are constant-increment Gouraud and the
+// fixed-point Phong (phong-incremental) at least as fast. The RTL-in-the-loop frame time is
+// printed by `shadesim render --rtl`.
+//   build/testbench/bench_render [--benchmark_filter=...]
+#include <benchmark/benchmark.h>
+
+#include "device/prom.h"
+#include "device/spec_params.h"
+#include "render/render.h"
+#include "scene/scene.h"
+
+using namespace shd;
+
+namespace {
+
+// brdf "": the sphere's own material (Blinn, exact pow per pixel); "quadratic": the specular
+// unit's polynomial from its PROM (the paper's device: no pow), evaluated by its model.
+void BM_Frame(benchmark::State& state, Method method, SpanMode mode, const char* brdf) {
+  const Scene scene = loadScene("builtin:sphere");
+  RenderOptions opt;
+  opt.method = method;
+  opt.span_mode = mode;
+  opt.brdf = brdf;
+  ModelSpanEngine span(SpanParams::forMode(mode));
+  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath("default"));
+  ModelSpecEngine quadratic(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl));
+  SpecEngines spec;
+  spec.quadratic = &quadratic;
+  RenderResult frame;
+  render(scene, opt, span, spec, frame);  // the buffers' first growth is not a frame
+  for (auto _ : state) {
+    render(scene, opt, span, spec, frame);
+    benchmark::DoNotOptimize(frame.fb.rgb.data());
+  }
+  state.counters["fragments"] = static_cast<double>(frame.stats.fragments);
+  state.counters["span_cycles"] = static_cast<double>(frame.stats.span_cycles);
+  state.counters["frag/s"] = benchmark::Counter(static_cast<double>(frame.stats.fragments),
+                                                benchmark::Counter::kIsIterationInvariantRate);
+}
+
+}  // namespace
+
+BENCHMARK_CAPTURE(BM_Frame, flat, Method::Flat, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud, Method::Gouraud, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud_classical, Method::GouraudClassical, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong, Method::Phong, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong_incremental, Method::PhongIncremental, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud_sierpinski, Method::Gouraud, SpanMode::Sierpinski, "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong_incremental_sierpinski, Method::PhongIncremental, SpanMode::Sierpinski, "")
+    ->Unit(benchmark::kMillisecond);
+
+BENCHMARK_CAPTURE(BM_Frame, phong_incremental_device, Method::PhongIncremental, SpanMode::Serial, "quadratic")
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud_device, Method::Gouraud, SpanMode::Serial, "quadratic")->Unit(benchmark::kMillisecond);
+
+BENCHMARK_MAIN();
