@@ -23,7 +23,7 @@ namespace shd {
 std::string VectorGenSummary::text() const {
   if (fragments == 0 && dropped == 0) return fmt::format("{} cycles, {} valid inputs", cycles, valid_inputs);
   return fmt::format("{} cycles, {} descriptors accepted, {} lane fragments handed over, {} generator triangles dropped "
-                     "by setup, directed phases done: {} of 2",
+                     "by setup, directed phases done: {} of 3",
                      cycles, valid_inputs, fragments, dropped, phases_done);
 }
 
@@ -71,6 +71,22 @@ SpecVectors generateSpecVectors(const std::string& config, uint64_t cycles, uint
         corners.push_back(in);
       }
 
+  // Degree 3: the cut-off boundary, cos one code below, at and above the cut of every eighth
+  // table entry and the last (the exact boundary is one code in 2^(Wc+1): random cosines miss it).
+  if (p.Degree == 3)
+    for (uint32_t shin = 0; shin <= last_entry; shin = shin + 8 > last_entry && shin != last_entry ? last_entry : shin + 8) {
+      const int64_t cut = decodePromWord(table.words[shin], p).cut;
+      for (int64_t cos = cut - 1; cos <= cut + 1; ++cos) {
+        if (cos < 0 || cos > 2 * int64_t{one} - 1) continue;
+        SpecIn in;
+        in.valid = true;
+        in.shin = shin;
+        in.cos = static_cast<uint32_t>(cos);
+        in.light = {lmax, lmax / 2, 1};
+        corners.push_back(in);
+      }
+    }
+
   SpecUnitModel model(p, table.words);
   model.reset();
   RandomSpecStimulus stim(p, seed, cycles, 0.2);
@@ -98,7 +114,7 @@ int wide_size(const SpanParams& p) { return static_cast<int>(std::min<int64_t>(i
 // The descriptors of the three phases (vector_gen.h), one at a time.
 class SpanVectorStimulus {
  public:
-  SpanVectorStimulus(const SpanParams& p, uint64_t seed) : rng_(seed) {
+  SpanVectorStimulus(const SpanParams& p, uint64_t seed) : rng_(seed), hunting_(p.NumTri > 1) {
     tiny_.width = 16;
     tiny_.height = 12;
     tiny_.unit = p;
@@ -123,13 +139,20 @@ class SpanVectorStimulus {
         g.shape_weight[static_cast<size_t>(sh)] = 1;
         directed_.push_back(TriangleGenerator(rng_(), g));
       }
+    // Phase 2 (more than one lane-triangle): large and screen-filling off-screen triangles and
+    // slivers, the shapes whose lane-triangles' spans most often leave a lane group without a
+    // valid lane.
+    TriGenOptions h = options(tiny_);
+    h.size_weight = {0, 0, 0, 1, 1};
+    h.shape_weight = {0, 1, 0, 0, 1, 0};
+    hunt_gen_.emplace(rng_(), h);
     TriGenOptions w = options(wide_);
     w.size_weight = {1, 1, 1, 0, 0};
     wide_gen_.emplace(rng_(), w);
     mixed_.emplace(rng_(), options(small_));
   }
 
-  // The next descriptor and its phase (1, 2 or 3).
+  // The next descriptor and its phase (1 to 4).
   bool next(SpanDesc& d, int& phase) {
     for (;;) {
       std::optional<SpanDesc> got;
@@ -139,12 +162,22 @@ class SpanVectorStimulus {
         phase = 1;
         TriangleGenerator& g = directed_[directed_next_++];
         for (int attempt = 0; attempt < 8 && !got; ++attempt) got = setup(g.next(), tiny_);
-      } else if (wide_count_ < kWideTriangles) {
+      } else if (hunting_ && hunt_count_ < kHuntTriangles) {
+        // Only triangles that the model, run alone, shows with an empty lane group (about one
+        // draw in six); up to 256 draws.
         phase = 2;
+        ++hunt_count_;
+        for (int attempt = 0; attempt < 256 && !got; ++attempt) {
+          got = setup(hunt_gen_->next(), tiny_);
+          if (got && !hasEmptyLaneGroup(*got)) got.reset();
+        }
+        if (!got) hunting_ = false;
+      } else if (wide_count_ < kWideTriangles) {
+        phase = 3;
         ++wide_count_;
         got = setup(wide_gen_->next(), wide_);
       } else {
-        phase = 3;
+        phase = 4;
         got = setup(mixed_->next(), small_);
       }
       if (got) {
@@ -155,8 +188,11 @@ class SpanVectorStimulus {
     }
   }
   uint64_t dropped() const { return dropped_; }
-  // Descriptors of a phase made so far (phases 1 and 2 are complete once phase 3 has begun).
+  // Descriptors of a phase made so far.
   uint64_t made(int phase) const { return made_[phase]; }
+  // Ends phase 2: the corner it hunts for has been seen.
+  void stopHunting() { hunting_ = false; }
+  static constexpr int kHuntTriangles = 8;
   static constexpr int kWideTriangles = 24;
 
  private:
@@ -167,6 +203,23 @@ class SpanVectorStimulus {
     g.subpixel_bits = rc.subpixel_bits;
     g.num_attr = rc.unit.NumAttr;
     return g;
+  }
+  // A SPAN cycle without a valid lane when the descriptor runs alone, consumer always ready.
+  bool hasEmptyLaneGroup(const SpanDesc& d) const {
+    SpanUnitModel m(tiny_.unit);
+    m.reset();
+    SpanIn in;
+    in.desc_valid = true;
+    in.desc = &d;
+    SpanOut o;
+    m.tick(in, o);
+    in.desc_valid = false;
+    while (!m.idle()) {
+      const uint64_t before = m.spanCycles();
+      m.tick(in, o);
+      if (m.spanCycles() > before && !o.out_valid) return true;
+    }
+    return false;
   }
   std::optional<SpanDesc> setup(const GenTriangle& t, const RasterConfig& rc) {
     SetupResult s = setupTriangle(toSetupVertices(t, rc.unit.NumAttr), tag_++, rc);
@@ -181,11 +234,12 @@ class SpanVectorStimulus {
   RasterConfig tiny_, small_, wide_;
   std::vector<TriangleGenerator> directed_;
   size_t directed_next_ = 0;
-  std::optional<TriangleGenerator> wide_gen_, mixed_;
-  int wide_count_ = 0;
+  std::optional<TriangleGenerator> hunt_gen_, wide_gen_, mixed_;
+  bool hunting_;
+  int hunt_count_ = 0, wide_count_ = 0;
   uint32_t tag_ = 0;
   uint64_t dropped_ = 0;
-  uint64_t made_[4] = {0, 0, 0, 0};
+  uint64_t made_[5] = {0, 0, 0, 0, 0};  // [phase]
 };
 
 }  // namespace
@@ -205,12 +259,15 @@ SpanVectors generateSpanVectors(const std::string& config, uint64_t cycles, uint
 
   VectorGenSummary s;
   SpanDesc pending;
-  int phase = 0;
+  int phase = 0, busy_phase = 0;  // of the pending descriptor; of the one being processed
   stim.next(pending, phase);
   int wait = draw_wait();
   double ready_prob = draw_ready();
   bool on_ports = false;  // `pending` is in v.descs (it has been offered)
-  uint64_t accepted[4] = {0, 0, 0, 0}, phase_done_at[3] = {0, 0, 0};  // [phase]
+  uint64_t accepted[5] = {0, 0, 0, 0, 0}, done_at[5] = {0, 0, 0, 0, 0};  // [phase]
+  // Control corners met, counted from the model (the vector file cannot tell a ROW cycle from
+  // a SPAN cycle without a valid lane).
+  uint64_t stalled = 0, waiting = 0, idle_gap = 0, empty_groups = 0, empty_stalled = 0;
   for (uint64_t c = 0; c < cycles; ++c) {
     SpanVectorCycle cyc;
     cyc.out_ready = std::bernoulli_distribution(ready_prob)(rng);
@@ -226,35 +283,60 @@ SpanVectors generateSpanVectors(const std::string& config, uint64_t cycles, uint
     in.desc_valid = cyc.desc_valid;
     in.desc = &pending;
     in.out_ready = cyc.out_ready;
+    const uint64_t span_before = model.spanCycles();
     model.tick(in, cyc.expected);
-    if (cyc.expected.out_valid && cyc.out_ready)
-      for (const SpanLaneOut& l : cyc.expected.lane) s.fragments += l.valid ? 1 : 0;
-    if (cyc.desc_valid && cyc.expected.desc_ready) {  // accepted at this edge
+    const SpanOut& o = cyc.expected;
+    if (o.out_valid && cyc.out_ready)
+      for (const SpanLaneOut& l : o.lane) s.fragments += l.valid ? 1 : 0;
+    stalled += o.out_valid && !cyc.out_ready;
+    waiting += cyc.desc_valid && !o.desc_ready;
+    idle_gap += !cyc.desc_valid && o.desc_ready;
+    if (model.spanCycles() > span_before && !o.out_valid) {
+      ++empty_groups;
+      if (!cyc.out_ready) {
+        ++empty_stalled;
+        stim.stopHunting();
+      }
+    }
+    if (cyc.desc_valid && o.desc_ready) {  // accepted at this edge
       ++s.valid_inputs;
       ++accepted[phase];
-      // The unit accepts only when idle: the first triangle of a phase accepted means the
-      // previous phase is done.
-      if (phase >= 2 && phase_done_at[phase - 1] == 0) phase_done_at[phase - 1] = c + 1;
+      // The unit accepts only when idle: a triangle of a later phase accepted means the
+      // earlier phases are done.
+      for (int k = 1; k < phase; ++k)
+        if (done_at[k] == 0) done_at[k] = c + 1;
+      busy_phase = phase;
       stim.next(pending, phase);
       on_ports = false;
       wait = draw_wait();
-      ready_prob = draw_ready();
+      // Phase 2 hunts for a lane group without a valid lane while out_ready is low.
+      ready_prob = busy_phase == 2 ? 0.3 : draw_ready();
     }
     v.cycles.push_back(std::move(cyc));
   }
   auto done = [&](int ph) {
-    return phase_done_at[ph] ? fmt::format("all done by cycle {}", phase_done_at[ph]) : std::string("NOT all done");
+    return done_at[ph] ? fmt::format("all done by cycle {}", done_at[ph]) : std::string("NOT all done");
   };
   v.notes.push_back(fmt::format("coverage: phase 1, one triangle of every size class x shape (16x12 viewport): {} of {} "
                                 "descriptors accepted, {}",
                                 accepted[1], stim.made(1), done(1)));
-  v.notes.push_back(fmt::format("coverage: phase 2, {} pixel- to mesh-sized generator triangles in a {}x{} viewport: "
+  v.notes.push_back(
+      v.params.NumTri > 1
+          ? fmt::format("coverage: phase 2, large off-screen triangles and slivers that have a lane group without a "
+                        "valid lane, out_ready 30 %, until such a group met out_ready low: {} descriptors accepted, {}",
+                        accepted[2], done(2))
+          : std::string("coverage: phase 2, not needed: with one lane-triangle every lane group holds a valid lane"));
+  v.notes.push_back(fmt::format("coverage: phase 3, {} pixel- to mesh-sized generator triangles in a {}x{} viewport: "
                                 "{} of the {} descriptors setup made accepted, {}",
                                 SpanVectorStimulus::kWideTriangles, wide_size(v.params), wide_size(v.params),
-                                accepted[2], stim.made(2), done(2)));
-  v.notes.push_back(fmt::format("coverage: phase 3, the generator's mix (40x30 viewport): {} descriptors accepted",
-                                accepted[3]));
-  s.phases_done = (phase_done_at[1] != 0) + (phase_done_at[2] != 0);
+                                accepted[3], stim.made(3), done(3)));
+  v.notes.push_back(fmt::format("coverage: phase 4, the generator's mix (40x30 viewport): {} descriptors accepted",
+                                accepted[4]));
+  v.notes.push_back(fmt::format("coverage: cycles with a valid output stalled by out_ready {}, a descriptor offered "
+                                "while the unit is busy {}, the unit idle with nothing offered {}, a lane group "
+                                "without a valid lane {} (with out_ready low {})",
+                                stalled, waiting, idle_gap, empty_groups, empty_stalled));
+  s.phases_done = (done_at[1] != 0) + (done_at[3] != 0) + (v.params.NumTri > 1 ? done_at[2] != 0 : 1);
   s.cycles = cycles;
   s.dropped = stim.dropped();
   if (summary) *summary = s;

@@ -4,21 +4,27 @@
 // spec: first the corners, valid on every cycle: shininess codes {0, 1, depth/2, last table
 //   entry, depth-1 (padding: the all-zero word)} x cos codes {0, 1, 1.0/2, 1.0 - 1 LSB, 1.0,
 //   1.0 + 1 LSB, the largest code (saturates to 1.0)} x light {0, full scale, (1, mid, max-1)};
-//   then RandomSpecStimulus (sim/spec_cosim.h: near-1 and above-1 cosines, valid dropped for
+//   degree 3: cos one code below, at and above the cut-off code of every eighth table entry and
+//   the last; then RandomSpecStimulus (sim/spec_cosim.h: near-1 and above-1 cosines, valid dropped for
 //   1..3 cycles with probability 0.2, inputs changing on idle cycles) up to the cycle count.
 // span: descriptors from triangle setup of generator triangles (model/raster/trigen.h):
 //   1. one triangle of every size class x every shape (5 x 6; zero-area ones are dropped by
 //      setup and never reach the unit) in a 16 x 12 viewport, small enough that a large or
 //      screen-filling triangle (clipped to it) takes about a hundred cycles, not 10^5;
-//   2. 24 pixel-to-mesh-sized triangles in a 4096 x 4096 viewport (pixel coordinates using all
+//   2. with more than one lane-triangle (sierpinski) only: large and screen-sized off-screen
+//      triangles and slivers that have a lane group with no valid lane (pre-screened on a
+//      scratch model), with out_ready high 30 % of the cycles, until such a group has met
+//      out_ready low (the unit must not stall on it), at most 8;
+//   3. 24 pixel-to-mesh-sized triangles in a 4096 x 4096 viewport (pixel coordinates using all
 //      12 bits of the fragment ports, attributes with other fraction bits);
-//   3. the default generator mix in the 40 x 30 viewport until the cycle count is reached.
+//   4. the default generator mix in a 40 x 30 viewport until the cycle count is reached.
 //   Per triangle the consumer's readiness is drawn from {always, 75 %, 30 %} (out_ready
 //   back-pressure), and a descriptor is offered after 1..3 idle cycles of the unit with
 //   probability 0.3, else at once (so it also waits, offered, while the unit is busy). The file ends after
 //   exactly `cycles` cycles, possibly inside a triangle; its header states ("# coverage: ...")
-//   how many descriptors of each phase were accepted and the cycle by which phases 1 and 2 were
-//   done.
+//   how many descriptors of each phase were accepted, the cycle by which phases 1 to 3 were
+//   done, and how often the control corners occurred (stalled outputs, offers waiting, idle
+//   gaps, lane groups without a valid lane, counted from the model).
 #pragma once
 
 #include <cstdint>
@@ -33,7 +39,7 @@ struct VectorGenSummary {
   uint64_t valid_inputs = 0;  // spec: valid vectors; span: descriptors accepted
   uint64_t fragments = 0;     // span: lane fragments handed over (valid lane, out_valid, out_ready)
   uint64_t dropped = 0;       // span: generator triangles setup dropped (zero area, off-screen)
-  int phases_done = 0;        // span: of the directed phases 1 and 2, how many the file completes
+  int phases_done = 0;        // span: of the directed phases 1 to 3, how many the file completes
   std::string text() const;
 };
 

@@ -92,7 +92,7 @@ TEST(VectorFile, SpanStimulusCoversEveryClassAndShapeAndBackPressure) {
   const fs::path dir = testutil::freshTestDir("vectors");
   VectorGenSummary s;
   const fs::path vec = spanFile(dir, "serial", 4000, 1, &s);
-  EXPECT_EQ(s.phases_done, 2) << s.text();
+  EXPECT_EQ(s.phases_done, 3) << s.text();
   const SpanVectors v = loadSpanVectors(vec.string());
   uint64_t stalled = 0, waiting_offer = 0, gaps = 0;
   for (size_t i = 0; i < v.cycles.size(); ++i) {
@@ -108,14 +108,81 @@ TEST(VectorFile, SpanStimulusCoversEveryClassAndShapeAndBackPressure) {
   EXPECT_NE(text.find("25 of 25 descriptors accepted"), std::string::npos);  // 5 classes x 5 drawable shapes
 }
 
-TEST(VectorFile, CheckedInSpanFilesCompleteTheDirectedPhases) {
-  // vectors_fresh proves the checked-in files are what the generator makes; this proves the
-  // cycle counts chosen in scripts/regen_vectors.sh are long enough for phases 1 and 2.
+TEST(VectorFile, CheckedInSpanFilesCoverTheDirectedPhasesAndTheControlCorners) {
+  // vectors_fresh proves the checked-in files are what the generator makes; this proves that
+  // the cycle counts of scripts/regen_vectors.sh are long enough for the directed phases, and
+  // counts the control corners again by running the model on each file's inputs (the file alone
+  // cannot tell a ROW cycle from a SPAN cycle without a valid lane).
   for (const std::string& mode : builtinSpanConfigNames()) {
-    const std::string text = slurp(fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("span_" + mode + ".vec"));
+    const fs::path path = fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("span_" + mode + ".vec");
+    const std::string text = slurp(path);
     ASSERT_FALSE(text.empty()) << mode;
-    const std::regex done("# coverage: phase [12],.*all done by cycle [0-9]+\n");
-    EXPECT_EQ(std::distance(std::sregex_iterator(text.begin(), text.end(), done), std::sregex_iterator()), 2) << mode;
+    const SpanVectors v = loadSpanVectors(path.string());
+    const std::regex done("# coverage: phase [123],.*all done by cycle [0-9]+\n");
+    const long directed = v.params.NumTri > 1 ? 3 : 2;  // phase 2 exists with several lane-triangles
+    EXPECT_EQ(std::distance(std::sregex_iterator(text.begin(), text.end(), done), std::sregex_iterator()), directed)
+        << mode;
+    SpanUnitModel model(v.params);
+    model.reset();
+    SpanOut o;
+    uint64_t stalled = 0, waiting = 0, idle_gap = 0, empty_stalled = 0, differ = 0;
+    for (const SpanVectorCycle& c : v.cycles) {
+      SpanIn in;
+      in.desc_valid = c.desc_valid;
+      in.out_ready = c.out_ready;
+      in.desc = c.desc >= 0 ? &v.descs[static_cast<size_t>(c.desc)] : nullptr;
+      const uint64_t span_before = model.spanCycles();
+      model.tick(in, o);
+      differ += o.desc_ready != c.expected.desc_ready || o.out_valid != c.expected.out_valid;
+      stalled += o.out_valid && !c.out_ready;
+      waiting += c.desc_valid && !o.desc_ready;
+      idle_gap += !c.desc_valid && o.desc_ready;
+      empty_stalled += model.spanCycles() > span_before && !o.out_valid && !c.out_ready;
+    }
+    EXPECT_EQ(differ, 0u) << mode;
+    EXPECT_GT(stalled, 500u) << mode;   // valid outputs held by out_ready low
+    EXPECT_GT(waiting, 500u) << mode;   // descriptors offered while the unit is busy
+    EXPECT_GT(idle_gap, 10u) << mode;   // the unit idle with nothing offered
+    if (v.params.NumTri > 1) {
+      EXPECT_GT(empty_stalled, 0u) << mode;  // a lane group without a valid lane, out_ready low
+    }
+  }
+}
+
+TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
+  for (const std::string& config : builtinConfigNames()) {
+    const fs::path path = fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("spec_" + config + ".vec");
+    const SpecVectors v = loadSpecVectors(path.string());
+    const SpecUnitParams& p = v.params;
+    const std::vector<PromWord> words =
+        readPromHex((path.parent_path() / v.prom).string(), p.promWordBits(), p.promDepth());
+    const uint32_t one = static_cast<uint32_t>(p.cosOne()), lmax = static_cast<uint32_t>(p.lightMax());
+    uint64_t shin0 = 0, shin_max = 0, cos0 = 0, cos_one = 0, cos_above = 0, cos_max = 0, dark = 0, full = 0;
+    uint64_t gaps = 0, below_cut = 0, at_cut = 0;
+    for (size_t i = 0; i < v.in.size(); ++i) {
+      const SpecIn& in = v.in[i];
+      if (!in.valid) {
+        gaps += i > 0 && v.in[i - 1].valid;
+        continue;
+      }
+      shin0 += in.shin == 0;
+      shin_max += in.shin == static_cast<uint32_t>(p.promDepth() - 1);
+      cos0 += in.cos == 0;
+      cos_one += in.cos == one;
+      cos_above += in.cos > one;
+      cos_max += in.cos == 2 * one - 1;
+      dark += in.light == std::array<uint32_t, 3>{0, 0, 0};
+      full += in.light == std::array<uint32_t, 3>{lmax, lmax, lmax};
+      const int64_t cut = decodePromWord(words[in.shin], p).cut;
+      below_cut += p.Degree == 3 && cut > 0 && in.cos + 1 == cut;
+      at_cut += p.Degree == 3 && cut > 0 && in.cos == cut;
+    }
+    for (uint64_t n : {shin0, shin_max, cos0, cos_one, cos_above, cos_max, dark, full}) EXPECT_GT(n, 0u) << config;
+    EXPECT_GT(gaps, 100u) << config;  // valid dropped between valid inputs
+    if (p.Degree == 3) {
+      EXPECT_GT(below_cut, 10u) << config;  // f cut to 0 one code below the cut-off ...
+      EXPECT_GT(at_cut, 10u) << config;     // ... and not at it
+    }
   }
 }
 
