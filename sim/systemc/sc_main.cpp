@@ -1,0 +1,177 @@
+// shadesim_systemc: SystemC co-simulation of the verilated specular unit or span unit against
+// the golden model. One run per process (a SystemC simulation elaborates once):
+//
+//   shadesim_systemc --unit spec --config default --vectors 100000 --seed 1
+//   shadesim_systemc --unit spec --config wide --vector-file vectors/cycles/spec_wide.vec
+//   shadesim_systemc --unit span --config sierpinski --triangles 2000 --seed 3
+//   shadesim_systemc --unit span --config serial --scene builtin:sphere [--fst span.fst] [--json]
+//
+// sc_main builds the sc_clock (10 ns) and the reset generator; the unit's runner
+// (sc_run_spec.cpp, sc_run_span.cpp) adds the verilated unit (chosen by --config), the driver,
+// the golden-model module and the scoreboard (spec_tb.h, span_tb.h), runs until the driver has
+// drained the stimulus (or the scoreboard has seen --max-mismatches), and reports the counts,
+// the simulated cycles and the wall time. Exit status: 0 every sample and every result/fragment
+// equal in value and cycle; 1 a mismatch (the first one printed with its time, signal and both
+// values); 2 bad input.
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+#include <systemc>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "sc_run.h"
+
+using namespace shd;
+
+namespace {
+
+struct OptionRefs {
+  CLI::Option *vectors = nullptr, *triangles = nullptr, *gap = nullptr, *ready = nullptr, *desc_gap = nullptr;
+};
+
+// Cross-option checks CLI11 cannot express.
+void checkOptions(const ScOptions& o, const OptionRefs& given) {
+  auto only = [&](bool is_given, const char* opt, const char* unit) {
+    if (is_given) throw ArgError(fmt::format("{} applies to --unit {} only", opt, unit));
+  };
+  const bool spec = o.unit == "spec";
+  only(!spec && given.vectors->count() > 0, "--vectors", "spec");
+  only(!spec && !o.prom.empty(), "--prom", "spec");
+  only(!spec && given.gap->count() > 0, "--gap", "spec");
+  only(spec && given.triangles->count() > 0, "--triangles", "span");
+  only(spec && !o.scene.empty(), "--scene", "span");
+  only(spec && given.ready->count() > 0, "--ready", "span");
+  only(spec && given.desc_gap->count() > 0, "--desc-gap", "span");
+  if (!o.vector_file.empty()) {
+    for (auto [opt, name] : {std::pair{given.vectors, "--vectors"}, {given.gap, "--gap"}, {given.triangles, "--triangles"},
+                             {given.ready, "--ready"}, {given.desc_gap, "--desc-gap"}})
+      if (opt->count() > 0) throw ArgError(fmt::format("{} and --vector-file exclude each other (the file is the stimulus)", name));
+    if (!o.scene.empty()) throw ArgError("--scene and --vector-file exclude each other");
+  }
+}
+
+nlohmann::json toJson(const ScReport::Value& v) {
+  return std::visit([](const auto& x) { return nlohmann::json(x); }, v);
+}
+
+}  // namespace
+
+int sc_main(int argc, char* argv[]) {
+  ScOptions o;
+  OptionRefs given;
+  bool json = false;
+  CLI::App app{"shadesim_systemc: the verilated specular or span unit in a SystemC testbench (clock, reset, driver, "
+               "golden-model module, scoreboard), checked value by value and cycle by cycle"};
+  app.add_option("--unit", o.unit, "spec (specular unit) or span (span unit)")
+      ->required()
+      ->check(CLI::IsMember({"spec", "span"}));
+  app.add_option("--config", o.config,
+                 "configuration (vectors/config/<unit>_<name>.json); default: default (spec), serial (span)");
+  given.vectors = app.add_option("--vectors", o.vectors, "spec: seeded random vectors (default 20000)")
+                      ->check(CLI::PositiveNumber);
+  app.add_option("--vector-file", o.vector_file,
+                 "replay a vector file (sim/vector_file.h, e.g. vectors/cycles/<unit>_<config>.vec): its inputs, and "
+                 "its expected outputs checked as well")
+      ->check(CLI::ExistingFile);
+  app.add_option("--save-vectors", o.save_vectors,
+                 "write the run as a vector file: the inputs on the ports every cycle and the golden model's outputs");
+  given.gap = app.add_option("--gap", o.gap, "spec: probability of dropping valid_i for 1..3 cycles (default 0.2)")
+                  ->check(CLI::Range(0.0, 0.9));
+  app.add_option("--prom", o.prom,
+                 "spec: PROM hex file (default: the vector file's, else vectors/prom/spec_<config>.hex); it must hold "
+                 "the configuration's table");
+  given.triangles = app.add_option("--triangles", o.triangles,
+                                   "span: seeded generator triangles (default 1000); with --scene: at most this many of "
+                                   "the scene's descriptors")
+                        ->check(CLI::PositiveNumber);
+  app.add_option("--scene", o.scene, "span: the descriptors of a scene's frame, e.g. builtin:sphere");
+  given.ready = app.add_option("--ready", o.ready, "span: probability that out_ready is high on a cycle (default 0.8)")
+                    ->check(CLI::Range(0.05, 1.0));
+  given.desc_gap = app.add_option("--desc-gap", o.desc_gap,
+                                  "span: probability that a descriptor waits 1..3 cycles before it is offered "
+                                  "(default 0.1)")
+                       ->check(CLI::Range(0.0, 0.9));
+  app.add_option("--seed", o.seed, "random seed (stimulus and back-pressure)");
+  app.add_option("--fst", o.fst, "write an FST waveform of the unit (every signal) to this file");
+  app.add_option("--fault", o.fault,
+                 "fault injection in the golden-model module, to see the scoreboard fail: latency (predictions one "
+                 "cycle late) or value (spec: one bit less of c^2 - c; span: attribute 0 one code off)")
+      ->check(CLI::IsMember({"none", "latency", "value"}));
+  app.add_option("--max-mismatches", o.max_mismatches, "stop after this many mismatches (default 16)")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--json", json, "print the result as one JSON object on stdout");
+  app.add_flag("--quiet", o.quiet, "no progress on stderr");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (o.config.empty()) o.config = o.unit == "spec" ? "default" : "serial";
+  o.triangles_given = given.triangles->count() > 0;
+
+  ScReport r;
+  try {
+    checkOptions(o, given);
+    // 10 ns clock, rising edges at 10, 20, ... ns (sc_common.h); rst_n low from time 0.
+    sc_core::sc_clock clk("clk", scPeriod(), 0.5, scPeriod(), true);
+    sc_core::sc_signal<bool> rst_n("rst_n", false);
+    ScResetGen reset("reset");
+    reset.clk(clk);
+    reset.rst_n(rst_n);
+    r = o.unit == "spec" ? runSpecSc(o, clk, rst_n) : runSpanSc(o, clk, rst_n);
+  } catch (const std::exception& e) {  // ArgError, files, configurations, SystemC elaboration errors
+    std::fprintf(stderr, "shadesim_systemc: error: %s\n", e.what());
+    return 2;
+  }
+
+  const ScScore& s = r.score;
+  const bool ok = s.passed() && r.complete;
+  if (json) {
+    nlohmann::json j = {{"unit", o.unit}, {"config", o.config}, {"fault", o.fault}};
+    for (const auto& [key, value] : r.fields) j[key] = toJson(value);
+    j["samples"] = s.samples;
+    j["sample_mismatches"] = s.sample_mismatches;
+    j["item_mismatches"] = s.item_mismatches;
+    j["passed"] = ok;
+    if (!s.first.empty()) j["first_mismatch"] = s.first;
+    if (!s.first_item.empty()) j["first_item_mismatch"] = s.first_item;
+    if (!r.complete) j["incomplete"] = r.incomplete;
+    if (!o.fst.empty()) j["fst"] = o.fst;
+    std::cout << j.dump(2) << std::endl;
+  } else {
+    std::cout << r.summary << std::endl;
+  }
+  if (ok) return 0;
+  const char* items = o.unit == "spec" ? "results" : "fragments";
+  if (!s.first.empty())
+    std::fprintf(stderr, "MISMATCH (first of %llu samples) %s\n", static_cast<unsigned long long>(s.sample_mismatches),
+                 s.first.c_str());
+  if (!s.first_item.empty())
+    std::fprintf(stderr, "MISMATCH (first of %llu %s) %s\n", static_cast<unsigned long long>(s.item_mismatches), items,
+                 s.first_item.c_str());
+  if (s.mismatches() == 0 && s.expected_items != s.observed_items)
+    std::fprintf(stderr, "MISMATCH the model predicts %llu %s, the RTL delivered %llu\n",
+                 static_cast<unsigned long long>(s.expected_items), items,
+                 static_cast<unsigned long long>(s.observed_items));
+  if (!r.complete) std::fprintf(stderr, "INCOMPLETE %s\n", r.incomplete.c_str());
+  if (!o.fst.empty()) std::fprintf(stderr, "waveform: %s\n", o.fst.c_str());
+  if (o.save_vectors.empty())
+    std::fprintf(stderr, "to keep this case: the same command with --save-vectors <file.vec> --fst <file.fst> (the "
+                         "run is deterministic); the file replays alone (--vector-file, shadesim replay, Icarus)\n");
+  else
+    std::fprintf(stderr, "vectors:  %s\n", o.save_vectors.c_str());
+  return 1;
+}
+
+// Our own main (IEEE 1666 lets an application call sc_elab_and_sim itself), only to keep the
+// SystemC banner off the console: stdout carries the result (--json), stderr the progress and
+// failures. libsystemc prints the banner before sc_main runs unless this variable is set.
+int main(int argc, char* argv[]) {
+  setenv("SYSTEMC_DISABLE_COPYRIGHT_MESSAGE", "1", 0);
+  return sc_core::sc_elab_and_sim(argc, argv);
+}

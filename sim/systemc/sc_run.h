@@ -1,0 +1,60 @@
+// One shadesim_systemc run: the options of the command line (sc_main.cpp) and what a run of
+// either unit reports (sc_run_spec.cpp, sc_run_span.cpp). Kept free of CLI11 and JSON headers so
+// that the runners, the heavy SystemC translation units, compile in parallel with sc_main.cpp.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include <systemc>
+
+#include "progress.h"
+#include "sc_common.h"
+
+namespace shd {
+
+// Bad input (an argument, a file, a configuration): a message naming it, exit status 2.
+struct ArgError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ScOptions {
+  std::string unit, config, vector_file, save_vectors, scene, prom, fst, fault = "none";
+  uint64_t vectors = 20000, triangles = 1000, seed = 1, max_mismatches = 16;
+  bool triangles_given = false;
+  double gap = 0.2, ready = 0.8, desc_gap = 0.1;
+  bool quiet = false;
+};
+
+struct ScReport {
+  using Value = std::variant<uint64_t, double, bool, std::string>;
+  std::vector<std::pair<std::string, Value>> fields;  // unit-specific counts, in print order
+  std::string summary;                                // one line
+  ScScore score;
+  bool complete = true;    // every stimulus item went through
+  std::string incomplete;  // why not
+  void add(std::string key, Value v) { fields.emplace_back(std::move(key), std::move(v)); }
+};
+
+// Each builds the unit's testbench around clk and rst_n (already bound to the reset generator),
+// runs it to the end and returns the report. ArgError for bad input.
+ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n);
+ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n);
+
+// sc_start() in slices of 20000 cycles until ctl.done, progress on stderr (unless quiet) as
+// done() of total.
+inline void scSimulate(ScRunControl& ctl, bool quiet, const std::string& what, const char* unit, double total,
+                       const std::function<double()>& done) {
+  Progress progress(what, !quiet);
+  while (!ctl.done) {
+    sc_core::sc_start(20000 * scPeriod());
+    progress.update(done(), total, unit);
+  }
+}
+
+}  // namespace shd

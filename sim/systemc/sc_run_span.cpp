@@ -1,0 +1,263 @@
+// The span unit's SystemC run: sc_clock and reset from sc_main, the verilated configuration
+// (SpanRtl), a driver (SpanDriver for generator triangles or a scene's descriptors,
+// SpanFileDriver for a vector file), SpanGolden and SpanScoreboard (span_tb.h).
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include <fmt/format.h>
+#include <verilated.h>
+#include <verilated_fst_sc.h>
+
+#include "raster/desc_stream.h"
+#include "sc_run.h"
+#include "scene_descs.h"
+#include "span_rtl.h"
+#include "span_tb.h"
+#include "vector_file.h"
+
+namespace fs = std::filesystem;
+
+namespace shd {
+
+namespace {
+
+std::string describe(const SpanParams& p) {
+  return fmt::format("NumTri={} LanesPerTri={} AlignLanes={} NumAttr={} AttrBits={} CoordBits={} RemBits={} PixBits={} "
+                     "TagBits={}",
+                     p.NumTri, p.LanesPerTri, p.AlignLanes, p.NumAttr, p.AttrBits, p.CoordBits, p.RemBits, p.PixBits,
+                     p.TagBits);
+}
+
+}  // namespace
+
+ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n) {
+  const std::vector<std::string> built = scSpanRtlConfigs();
+  if (std::find(built.begin(), built.end(), o.config) == built.end())
+    throw ArgError(fmt::format("--config {}: no SystemC model of the span unit by that name (built: {})", o.config,
+                               fmt::join(built, ", ")));
+  if (!o.fst.empty()) Verilated::traceEverOn(true);  // before the model (TOOLCHAIN pitfall 4)
+  std::unique_ptr<SpanRtl> rtl = makeSpanRtl(o.config, "span_rtl");
+  const SpanParams p = rtl->params();
+  const SpanParams json_params = spanConfigParams(o.config);
+  if (describe(json_params) != describe(p))
+    throw ArgError(fmt::format("--config {}: vectors/config/span_{}.json now holds {}, the SystemC model was verilated "
+                               "with {}: rebuild",
+                               o.config, o.config, describe(json_params), describe(p)));
+  if (!o.save_vectors.empty()) {  // before the run: a path that cannot be written fails now
+    const fs::path dir = fs::absolute(o.save_vectors).parent_path();
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec)
+      throw ArgError(fmt::format("--save-vectors {}: cannot create {}: {}", o.save_vectors, dir.string(), ec.message()));
+  }
+
+  // The stimulus: a vector file, the scene's descriptors, or seeded generator triangles.
+  std::unique_ptr<SpanVectors> file;
+  std::unique_ptr<DescriptorStream> stream;
+  std::optional<SceneDescriptors> scene;
+  size_t scene_next = 0;
+  uint64_t total = 0;  // descriptors (scene, generator triangles) or cycles (file)
+  std::function<bool(SpanDesc&)> next;
+  if (!o.vector_file.empty()) {
+    try {
+      file = std::make_unique<SpanVectors>(loadSpanVectors(o.vector_file));
+    } catch (const std::exception& e) {
+      throw ArgError(fmt::format("--vector-file: {}", e.what()));
+    }
+    if (describe(file->params) != describe(p))
+      throw ArgError(fmt::format("--vector-file {}: made for configuration {} ({}), not for {} ({})", o.vector_file,
+                                 file->config, describe(file->params), o.config, describe(p)));
+    total = file->cycles.size();
+  } else if (!o.scene.empty()) {
+    try {
+      scene = recordSceneDescriptors(o.scene, p);
+    } catch (const std::exception& e) {
+      throw ArgError(fmt::format("--scene {}: {}", o.scene, e.what()));
+    }
+    total = scene->descs.size();
+    if (o.triangles_given) total = std::min<uint64_t>(total, o.triangles);
+    next = [&](SpanDesc& d) {
+      if (scene_next >= total) return false;
+      d = scene->descs[scene_next++];
+      return true;
+    };
+  } else {
+    RasterConfig rc;
+    rc.unit = p;
+    stream = std::make_unique<DescriptorStream>(o.seed, o.triangles, rc);
+    total = o.triangles;  // generator triangles; setup drops some
+    next = [&](SpanDesc& d) { return stream->next(d); };
+  }
+
+  ScRunControl ctl;
+  ctl.max_mismatches = o.max_mismatches;
+  sc_core::sc_signal<bool> desc_valid_i{"desc_valid_i"}, desc_ready_o{"desc_ready_o"}, out_valid_o{"out_valid_o"},
+      out_ready_i{"out_ready_i"}, model_idle{"model_idle"};
+  sc_core::sc_fifo<DescToken> desc_fifo{"desc_fifo", 16};
+  sc_core::sc_fifo<SpanExpect> expect_fifo{"expect_fifo", 16}, file_fifo{"file_fifo", 16};
+
+  rtl->clk_i(clk);
+  rtl->rst_ni(rst_n);
+  rtl->desc_valid_i(desc_valid_i);
+  rtl->desc_ready_o(desc_ready_o);
+  rtl->out_valid_o(out_valid_o);
+  rtl->out_ready_i(out_ready_i);
+
+  std::unique_ptr<SpanDriver> driver;
+  std::unique_ptr<SpanFileDriver> file_driver;
+  if (file) {
+    file_driver = std::make_unique<SpanFileDriver>("driver", *file, ctl);
+    file_driver->clk(clk);
+    file_driver->rst_n(rst_n);
+    file_driver->desc_valid_i(desc_valid_i);
+    file_driver->out_ready_i(out_ready_i);
+    file_driver->pins(*rtl);
+    file_driver->offered(desc_fifo);
+    file_driver->file_expect(file_fifo);
+  } else {
+    SpanDriverOptions dopt;
+    dopt.seed = o.seed;
+    dopt.ready_prob = o.ready;
+    dopt.desc_gap_prob = o.desc_gap;
+    driver = std::make_unique<SpanDriver>("driver", next, dopt, ctl);
+    driver->clk(clk);
+    driver->rst_n(rst_n);
+    driver->desc_ready_o(desc_ready_o);
+    driver->model_idle(model_idle);
+    driver->desc_valid_i(desc_valid_i);
+    driver->out_ready_i(out_ready_i);
+    driver->pins(*rtl);
+    driver->offered(desc_fifo);
+  }
+
+  const SpanFault fault = o.fault == "latency" ? SpanFault::Latency : o.fault == "value" ? SpanFault::Value : SpanFault::None;
+  SpanGolden golden("golden", p, fault, !o.save_vectors.empty());
+  golden.clk(clk);
+  golden.rst_n(rst_n);
+  golden.desc_valid_i(desc_valid_i);
+  golden.out_ready_i(out_ready_i);
+  golden.offered(desc_fifo);
+  golden.expect(expect_fifo);
+  golden.model_idle(model_idle);
+
+  SpanScoreboard board("scoreboard", ctl);
+  board.clk(clk);
+  board.rst_n(rst_n);
+  board.out_ready_i(out_ready_i);
+  board.rtl(*rtl);
+  board.expect(expect_fifo);
+  board.file_expect(file_fifo);
+
+  sc_core::sc_start(sc_core::SC_ZERO_TIME);
+  // Tracing starts after elaboration (VerilatedFstSc::open requires it). The kernel keeps the
+  // trace file in its list until the process ends, so it is not deleted here.
+  VerilatedFstSc* tfp = nullptr;
+  if (!o.fst.empty()) {
+    tfp = new VerilatedFstSc;
+    rtl->traceFst(*tfp, 99);
+    tfp->open(o.fst.c_str());
+  }
+
+  const auto t0 = std::chrono::steady_clock::now();
+  if (file)
+    scSimulate(ctl, o.quiet, fmt::format("systemc span/{}", o.config), "cycles", static_cast<double>(total),
+               [&] { return static_cast<double>(file_driver->cyclesDriven()); });
+  else
+    scSimulate(ctl, o.quiet, fmt::format("systemc span/{}", o.config), "triangles", static_cast<double>(total),
+               [&] { return static_cast<double>(driver->acceptedByRtl()); });
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const uint64_t cycles = scCycle(sc_core::sc_time_stamp());
+  rtl->finalize();
+  if (tfp) tfp->close();
+  board.finish();
+
+  if (!o.save_vectors.empty()) {
+    SpanVectors v = golden.recorded();
+    v.config = o.config;
+    v.source = fmt::format("shadesim_systemc --unit span --config {} {} (the golden-model module's predictions{})",
+                           o.config,
+                           file ? "--vector-file " + o.vector_file
+                                : scene ? "--scene " + o.scene
+                                        : fmt::format("--seed {} --triangles {}", o.seed, o.triangles),
+                           o.fault == "none" ? "" : ", fault " + o.fault);
+    writeSpanVectors(o.save_vectors, v);
+  }
+
+  ScReport r;
+  r.score = board.score();
+  const ScScore& s = r.score;
+  std::string what;
+  uint64_t descs = 0;
+  if (file) {
+    descs = file_driver->offeredCount();
+    if (file_driver->cyclesDriven() != file->cycles.size() || board.fileChecks() != file->cycles.size()) {
+      r.complete = false;
+      r.incomplete = fmt::format("{} of the file's {} cycles driven, {} compared with its expected outputs",
+                                 file_driver->cyclesDriven(), file->cycles.size(), board.fileChecks());
+    }
+    what = fmt::format("vector file {} ({} cycles, {} descriptors offered)", o.vector_file, file->cycles.size(), descs);
+  } else {
+    descs = scene ? total : stream->generated() - stream->dropped();
+    if (driver->acceptedByRtl() != descs || golden.accepted() != descs) {
+      r.complete = false;
+      r.incomplete = fmt::format("of {} descriptors the RTL accepted {}, the model {}", descs, driver->acceptedByRtl(),
+                                 golden.accepted());
+    }
+    if (scene && total == scene->descs.size() && r.complete && s.matched_items != scene->frame_fragments) {
+      // The whole frame went through: the unit must have handed over exactly the fragments the
+      // render counted for it.
+      r.complete = false;
+      r.incomplete = fmt::format("the render of {} counted {} fragments, the co-simulation handed over {}", o.scene,
+                                 scene->frame_fragments, s.matched_items);
+    }
+    what = scene ? fmt::format("scene {} ({} scene triangles, {} culled, {} drawn, {} fragments in the frame{})", o.scene,
+                               scene->scene_triangles, scene->culled, scene->descs.size(), scene->frame_fragments,
+                               total < scene->descs.size() ? fmt::format(", the first {} simulated", total) : std::string())
+                 : fmt::format("seed {}: {} generator triangles ({} dropped by setup)", o.seed, stream->generated(),
+                               stream->dropped());
+  }
+  r.summary = fmt::format(
+      "systemc span/{} {}: descriptors accepted by {}the model {}, {} fragments (model {}, rtl {}, {} equal in value "
+      "and cycle), {} samples compared{}, {} mismatches; {} cycles simulated in {:.2f} s wall ({:.0f} cycles/s)",
+      o.config, what, driver ? fmt::format("the RTL {}, ", driver->acceptedByRtl()) : std::string(), golden.accepted(),
+      s.matched_items, s.expected_items,
+      s.observed_items, s.matched_items, s.samples,
+      file ? fmt::format(" ({} also against the file's expected outputs)", board.fileChecks()) : std::string(),
+      s.mismatches(), cycles, secs, secs > 0 ? cycles / secs : 0.0);
+  r.add("stimulus", std::string(file ? "vector-file" : scene ? "scene" : "random"));
+  if (file) {
+    r.add("vector_file", o.vector_file);
+    r.add("file_cycles", static_cast<uint64_t>(file->cycles.size()));
+    r.add("file_checks", board.fileChecks());
+  } else {
+    r.add("seed", o.seed);
+    r.add("ready_prob", o.ready);
+    r.add("desc_gap_prob", o.desc_gap);
+  }
+  if (scene) {
+    r.add("scene", o.scene);
+    r.add("scene_triangles", scene->scene_triangles);
+    r.add("drawn", static_cast<uint64_t>(scene->descs.size()));
+    r.add("frame_fragments", scene->frame_fragments);
+    r.add("frame_cycles_always_ready", scene->frame_cycles);
+  }
+  if (stream) {
+    r.add("generated", stream->generated());
+    r.add("dropped_at_setup", stream->dropped());
+  }
+  r.add("descriptors", descs);
+  if (driver) r.add("accepted_rtl", driver->acceptedByRtl());
+  r.add("accepted_model", golden.accepted());
+  r.add("fragments_expected", s.expected_items);
+  r.add("fragments_observed", s.observed_items);
+  r.add("fragments_matched", s.matched_items);
+  r.add("cycles", cycles);
+  r.add("seconds", secs);
+  if (!o.save_vectors.empty()) r.add("saved_vectors", o.save_vectors);
+  return r;
+}
+
+}  // namespace shd

@@ -1,0 +1,189 @@
+// The SystemC testbench of the span unit: a driver, a module wrapping the cycle-accurate golden
+// model (SpanUnitModel) that predicts every output and the time it must be on the ports, and a
+// scoreboard. Clock and sampling convention: sc_common.h.
+//
+//   SpanDriver ──desc_valid_i, out_ready_i, descriptor pins (SpanPinsIf)──> SpanRtl (verilated)
+//      │  └─sc_fifo<DescToken>: each descriptor as it is offered──┐          │ desc_ready_o,
+//      │                                                          v          │ out_valid_o, fragments
+//      │   desc_valid_i, out_ready_i (the same signals) ──> SpanGolden       v
+//      └── model_idle <───────────────────────────────────────┘ └─sc_fifo<SpanExpect>─> SpanScoreboard
+//
+// The driver offers descriptors with random gaps (valid/ready: an offered descriptor stays until
+// the RTL's desc_ready accepts it) and drives out_ready randomly (back-pressure). SpanGolden
+// gets each descriptor as a transaction (not by reading the pins back, so a packing error in the
+// pin adapter shows as a mismatch), reads desc_valid_i and out_ready_i at each rising edge t
+// and ticks the model, whose outputs before the edge are the sample at t. The scoreboard
+// compares every output on every active cycle (desc_ready, out_valid, the tag while out_valid,
+// each lane's valid bit, each valid lane's pixel and attributes), and pairs the fragments handed
+// over (valid lane, out_valid and out_ready at the same edge) in order, checking each one's
+// value and time.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+
+#include <systemc>
+
+#include "raster/span_unit.h"
+#include "sc_common.h"
+#include "span_rtl.h"
+#include "vector_file.h"
+
+namespace shd {
+
+struct DescToken {
+  std::shared_ptr<const SpanDesc> desc;
+};
+std::ostream& operator<<(std::ostream& os, const DescToken& t);
+
+struct SpanExpect {
+  sc_core::sc_time time;  // the rising edge at which the scoreboard samples it
+  SpanOut out;
+  bool out_ready = false;  // the out_ready the model took at that edge
+  int64_t cycle = -1;      // vector-file expectations: the file's cycle index
+};
+std::ostream& operator<<(std::ostream& os, const SpanExpect& e);
+
+struct SpanDriverOptions {
+  uint64_t seed = 1;
+  double ready_prob = 0.8;     // out_ready high on a cycle with this probability
+  double desc_gap_prob = 0.1;  // a descriptor waits 1..3 cycles before being offered
+};
+
+class SpanDriver : public sc_core::sc_module {
+ public:
+  sc_core::sc_in<bool> clk{"clk"}, rst_n{"rst_n"}, desc_ready_o{"desc_ready_o"}, model_idle{"model_idle"};
+  sc_core::sc_out<bool> desc_valid_i{"desc_valid_i"}, out_ready_i{"out_ready_i"};
+  sc_core::sc_port<SpanPinsIf> pins{"pins"};
+  sc_core::sc_fifo_out<DescToken> offered{"offered"};
+
+  // next(d) fills the next descriptor, false at the end. The first step runs when rst_n rises
+  // (the first active rising edge samples it), then one per rising edge. The run ends two cycles
+  // after the last descriptor was accepted and the golden model is idle again.
+  SpanDriver(const sc_core::sc_module_name& name, std::function<bool(SpanDesc&)> next, const SpanDriverOptions& opt,
+             ScRunControl& ctl);
+  SC_HAS_PROCESS(SpanDriver);
+  uint64_t offeredCount() const { return offered_; }
+  uint64_t acceptedByRtl() const { return accepted_; }
+
+ private:
+  void onEdge();
+  bool fetch();
+  std::function<bool(SpanDesc&)> next_;
+  std::mt19937_64 rng_;
+  std::bernoulli_distribution ready_, gap_;
+  ScRunControl& ctl_;
+  std::shared_ptr<SpanDesc> pending_;
+  bool have_pending_ = false, offering_ = false;
+  int wait_ = 0, idle_edges_ = 0;
+  uint64_t offered_ = 0, accepted_ = 0;
+};
+
+// Replays a vector file's cycles (sim/vector_file.h): desc_valid, out_ready and the descriptor
+// on the ports as the file gives them (not following desc_ready: the file's own expectations
+// say when a descriptor is taken), and the file's expected outputs to the scoreboard. Each
+// descriptor goes to the golden model as a transaction when the file starts offering it. The
+// run ends two cycles after the file's last cycle.
+class SpanFileDriver : public sc_core::sc_module {
+ public:
+  sc_core::sc_in<bool> clk{"clk"}, rst_n{"rst_n"};
+  sc_core::sc_out<bool> desc_valid_i{"desc_valid_i"}, out_ready_i{"out_ready_i"};
+  sc_core::sc_port<SpanPinsIf> pins{"pins"};
+  sc_core::sc_fifo_out<DescToken> offered{"offered"};
+  sc_core::sc_fifo_out<SpanExpect> file_expect{"file_expect"};
+
+  SpanFileDriver(const sc_core::sc_module_name& name, const SpanVectors& v, ScRunControl& ctl);
+  SC_HAS_PROCESS(SpanFileDriver);
+  uint64_t cyclesDriven() const { return next_; }
+  uint64_t offeredCount() const { return offered_; }
+
+ private:
+  void onEdge();
+  const SpanVectors& v_;
+  std::vector<std::shared_ptr<const SpanDesc>> descs_;
+  ScRunControl& ctl_;
+  size_t next_ = 0;
+  int on_pins_ = -1;
+  bool offering_ = false;
+  int tail_ = 0;
+  uint64_t offered_ = 0;
+};
+
+enum class SpanFault { None, Latency, Value };
+
+class SpanGolden : public sc_core::sc_module {
+ public:
+  sc_core::sc_in<bool> clk{"clk"}, rst_n{"rst_n"}, desc_valid_i{"desc_valid_i"}, out_ready_i{"out_ready_i"};
+  sc_core::sc_fifo_in<DescToken> offered{"offered"};
+  sc_core::sc_fifo_out<SpanExpect> expect{"expect"};
+  sc_core::sc_out<bool> model_idle{"model_idle"};
+
+  // Fault injection, to prove the scoreboard can fail: Latency puts one register in front of
+  // the model's inputs (its predictions come a cycle late); Value gives the model every
+  // descriptor with attribute 0's reference value one code higher.
+  // record: keep every active cycle's inputs (as on the ports) and the model's outputs, and the
+  // descriptors, as a vector file's cycles (--save-vectors).
+  SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record);
+  SC_HAS_PROCESS(SpanGolden);
+  uint64_t accepted() const { return accepted_; }
+  const SpanUnitModel& model() const { return model_; }
+  // The recorded cycles as a vector file's content (config, params and source left to the caller).
+  SpanVectors recorded() const;
+
+ private:
+  void onEdge();
+  SpanUnitModel model_;
+  SpanFault fault_;
+  bool record_;
+  std::vector<SpanDesc> rec_descs_;  // as offered (before the Value fault)
+  std::vector<SpanVectorCycle> rec_cycles_;
+  std::deque<std::shared_ptr<const SpanDesc>> queue_;  // offered, not yet taken by the model
+  bool delayed_valid_ = false, delayed_ready_ = false;  // the Latency fault's register
+  SpanOut out_;
+  uint64_t accepted_ = 0;
+};
+
+class SpanScoreboard : public sc_core::sc_module {
+ public:
+  sc_core::sc_in<bool> clk{"clk"}, rst_n{"rst_n"}, out_ready_i{"out_ready_i"};
+  sc_core::sc_port<SpanPinsIf> rtl{"rtl"};
+  sc_core::sc_fifo_in<SpanExpect> expect{"expect"}, file_expect{"file_expect"};
+
+  SpanScoreboard(const sc_core::sc_module_name& name, ScRunControl& ctl);
+  SC_HAS_PROCESS(SpanScoreboard);
+  void finish();  // fragments only one side produced count as mismatches
+  const ScScore& score() const { return s_; }
+  uint64_t fileChecks() const { return file_checks_; }
+
+ private:
+  struct Sample {
+    sc_core::sc_time time;
+    SpanOut out;
+    bool out_ready = false;
+  };
+  struct Fragment {
+    sc_core::sc_time time;
+    uint32_t tag;
+    size_t lane;
+    SpanLaneOut px;
+  };
+  void sample();
+  void compare();
+  void check(const Sample& got, const SpanExpect& exp, const char* who);
+  void pairFragments();
+  static void handedOver(const sc_core::sc_time& t, const SpanOut& o, bool ready, std::deque<Fragment>& q, uint64_t& n);
+  static std::string show(const Fragment& f);
+
+  ScRunControl& ctl_;
+  ScScore s_;
+  std::deque<Sample> samples_;
+  std::deque<SpanExpect> expected_, file_expected_;
+  std::deque<Fragment> exp_frags_, got_frags_;
+  uint64_t file_checks_ = 0;
+};
+
+}  // namespace shd
