@@ -2,7 +2,7 @@
 # A replay of a corrupted vector file must fail exactly there: copies <file.vec> with one
 # expected output wrong (testbench/icarus/corrupt_vectors.py, which prints the cycle, 1-based,
 # and the port), replays the copy with shadesim_systemc and passes only if it exits 1 with one
-# mismatching sample, at that cycle (0-based in our message) on that port, against the file.
+# mismatching sample, at that cycle on that port, against the file.
 #   detects_corruption.sh <shadesim_systemc> <corrupt_vectors.py> <unit> <config> <file.vec> <work dir>
 set -uo pipefail
 sc=$1 corrupt=$2 unit=$3 config=$4 vec=$5 work=$6
@@ -14,9 +14,9 @@ port=${port%%[*}
 "$sc" --unit "$unit" --config "$config" --vector-file "$work/bad.vec" --quiet 2>"$work/stderr"
 rc=$?
 cat "$work/stderr" >&2
-want="^MISMATCH \(first of 1 samples\) at [0-9]+ ns \(cycle [0-9]+\), vector file cycle $((cycle - 1)): $port.*: vector file "
+want="^MISMATCH \(first of 1 samples\) at [0-9]+ ns \(cycle [0-9]+\), vector file cycle $cycle: $port.*: vector file "
 if [ "$rc" -ne 1 ] || ! grep -Eq "$want" "$work/stderr"; then
   echo "detects_corruption: expected exit 1 and a line matching '$want' (corrupted: cycle $cycle, $port); got exit $rc" >&2
   exit 1
 fi
-echo "detects_corruption: $unit/$config fails at file cycle $((cycle - 1)) on $port, as it must"
+echo "detects_corruption: $unit/$config fails at file cycle $cycle on $port, as it must"

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -12,6 +14,8 @@
 #include <vector>
 
 #include <systemc>
+
+#include <fmt/format.h>
 
 #include "progress.h"
 #include "sc_common.h"
@@ -45,6 +49,18 @@ struct ScReport {
 // runs it to the end and returns the report. ArgError for bad input.
 ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n);
 ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n);
+
+// An output file named by `option`: its directory is created and the file opened for writing
+// now, so that a path that cannot be written fails before the run (ArgError), not after it.
+inline void prepareOutput(const std::string& path, const char* option) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::absolute(path).parent_path();
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw ArgError(fmt::format("{} {}: cannot create {}: {}", option, path, dir.string(), ec.message()));
+  std::ofstream probe(path, std::ios::app);
+  if (!probe) throw ArgError(fmt::format("{} {}: cannot write it", option, path));
+}
 
 // sc_start() in slices of 20000 cycles until ctl.done, progress on stderr (unless quiet) as
 // done() of total.

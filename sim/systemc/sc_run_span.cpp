@@ -3,7 +3,6 @@
 // SpanFileDriver for a vector file), SpanGolden and SpanScoreboard (span_tb.h).
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -18,7 +17,6 @@
 #include "span_tb.h"
 #include "vector_file.h"
 
-namespace fs = std::filesystem;
 
 namespace shd {
 
@@ -46,13 +44,8 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
     throw ArgError(fmt::format("--config {}: vectors/config/span_{}.json now holds {}, the SystemC model was verilated "
                                "with {}: rebuild",
                                o.config, o.config, describe(json_params), describe(p)));
-  if (!o.save_vectors.empty()) {  // before the run: a path that cannot be written fails now
-    const fs::path dir = fs::absolute(o.save_vectors).parent_path();
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec)
-      throw ArgError(fmt::format("--save-vectors {}: cannot create {}: {}", o.save_vectors, dir.string(), ec.message()));
-  }
+  if (!o.save_vectors.empty()) prepareOutput(o.save_vectors, "--save-vectors");
+  if (!o.fst.empty()) prepareOutput(o.fst, "--fst");
 
   // The stimulus: a vector file, the scene's descriptors, or seeded generator triangles.
   std::unique_ptr<SpanVectors> file;

@@ -76,13 +76,8 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
       throw ArgError(fmt::format("PROM {}: word {} is 0x{}, the table of configuration {} ({}) holds 0x{}", prom, i,
                                  hexWord(file_words[i], cfg.rtl.promWordBits()), o.config, table.request.describe(),
                                  hexWord(table.words[i], cfg.rtl.promWordBits())));
-  if (!o.save_vectors.empty()) {  // before the run: a path that cannot be written fails now
-    const fs::path dir = fs::absolute(o.save_vectors).parent_path();
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec)
-      throw ArgError(fmt::format("--save-vectors {}: cannot create {}: {}", o.save_vectors, dir.string(), ec.message()));
-  }
+  if (!o.save_vectors.empty()) prepareOutput(o.save_vectors, "--save-vectors");
+  if (!o.fst.empty()) prepareOutput(o.fst, "--fst");
 
   // Plusargs reach $value$plusargs through the default context: set before the model exists.
   const std::string prom_arg = "+prom=" + prom;
@@ -191,7 +186,7 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   if (!o.save_vectors.empty()) {
     SpecVectors v;
     v.config = o.config;
-    v.params = model_params;  // with --fault value, the model's (so that the file says what it holds)
+    v.params = cfg.rtl;  // the unit's: the file replays on it (a fault shows in the source line)
     v.prom = prom;
     v.source = fmt::format("shadesim_systemc --unit spec --config {} {} (the golden-model module's predictions{})",
                            o.config, file ? "--vector-file " + o.vector_file : fmt::format("--seed {} --vectors {}", o.seed, o.vectors),

@@ -258,7 +258,7 @@ void SpanScoreboard::check(const Sample& got, const SpanExpect& exp, const char*
   ++s_.sample_mismatches;
   if (s_.first.empty())
     s_.first = fmt::format("at {}{}: {} (the current triangle: {})", scWhen(got.time),
-                           exp.cycle >= 0 ? fmt::format(", vector file cycle {}", exp.cycle) : std::string(), diff,
+                           exp.cycle >= 0 ? fmt::format(", vector file cycle {}", exp.cycle + 1) : std::string(), diff,
                            exp.out.tag);
 }
 

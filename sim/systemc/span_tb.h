@@ -44,7 +44,8 @@ struct SpanExpect {
   sc_core::sc_time time;  // the rising edge at which the scoreboard samples it
   SpanOut out;
   bool out_ready = false;  // the out_ready the model took at that edge
-  int64_t cycle = -1;      // vector-file expectations: the file's cycle index
+  int64_t cycle = -1;      // vector-file expectations: the file's cycle index (0-based; messages
+                           // count from 1, as shadesim replay and the Icarus testbenches do)
 };
 std::ostream& operator<<(std::ostream& os, const SpanExpect& e);
 

@@ -199,7 +199,7 @@ void SpecScoreboard::check(const Sample& got, const SpecExpect& exp, const char*
   ++s_.sample_mismatches;
   if (s_.first.empty())
     s_.first = fmt::format("at {}{}: {}{}", scWhen(got.time),
-                           exp.cycle >= 0 ? fmt::format(", vector file cycle {}", exp.cycle) : std::string(), diff,
+                           exp.cycle >= 0 ? fmt::format(", vector file cycle {}", exp.cycle + 1) : std::string(), diff,
                            describe(exp));
 }
 

@@ -38,7 +38,8 @@ struct SpecExpect {
   SpecOut out;
   std::optional<SpecIn> src;  // the input this result comes from (valid results)
   sc_core::sc_time src_time;  // when it was sampled
-  int64_t cycle = -1;         // vector-file expectations: the file's cycle (line) index
+  int64_t cycle = -1;         // vector-file expectations: the file's cycle index (0-based; messages
+                              // count from 1, as shadesim replay and the Icarus testbenches do)
 };
 std::ostream& operator<<(std::ostream& os, const SpecExpect& e);  // sc_fifo needs it
 
