@@ -203,6 +203,12 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
     r.complete = false;
     r.incomplete = fmt::format("the run stopped after {} of {} valid vectors", driver.driven(), src->total());
   }
+  if (r.complete && s.expected_items != driver.driven()) {
+    // One result per valid input (the unit never stalls): fewer means the stimulus did not
+    // reach the ports the model and the RTL read.
+    r.complete = false;
+    r.incomplete = fmt::format("{} valid vectors driven, the model predicts {} results", driver.driven(), s.expected_items);
+  }
   if (file && board.fileChecks() != file->in.size()) {
     r.complete = false;
     r.incomplete = fmt::format("{} of the file's {} expected outputs were compared", board.fileChecks(), file->in.size());
