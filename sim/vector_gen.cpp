@@ -222,7 +222,9 @@ class SpanVectorStimulus {
     return false;
   }
   std::optional<SpanDesc> setup(const GenTriangle& t, const RasterConfig& rc) {
-    SetupResult s = setupTriangle(toSetupVertices(t, rc.unit.NumAttr), tag_++, rc);
+    // Tags spread over all 32 bits (a multiplicative hash of the count), so that every bit of
+    // the tag path toggles (the coverage run found its upper bits never did with tags 0, 1, ...).
+    SetupResult s = setupTriangle(toSetupVertices(t, rc.unit.NumAttr), 0x9E3779B1u * tag_++, rc);
     if (!s.desc) {
       ++dropped_;
       return std::nullopt;

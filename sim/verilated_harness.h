@@ -5,12 +5,19 @@
 // its context current before it evaluates or destroys its model (verilator issue #8265).
 #pragma once
 
+#include <atomic>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <verilated.h>
 #include <verilated_fst_c.h>
+#if VM_COVERAGE
+#include <verilated_cov.h>
+#endif
 
 namespace shd {
 
@@ -60,13 +67,23 @@ class VerilatedHarness {
   }
   uint64_t cycle() const { return cycle_; }
 
-  // Runs final blocks and closes the waveform; called by the destructor too.
+  // Runs final blocks and closes the waveform; called by the destructor too. In a coverage
+  // build (cmake -DSHD_COVERAGE=ON) it writes this model's coverage points to
+  // $SHD_COVERAGE_DIR/cov_<pid>_<n>.dat when that variable is set (scripts/coverage.sh).
   void finish() {
     if (finished_) return;
     finished_ = true;
     makeCurrent();
     dut_->final();
     if (fst_) fst_->close();
+#if VM_COVERAGE
+    if (const char* dir = std::getenv("SHD_COVERAGE_DIR")) {
+      static std::atomic<unsigned> seq{0};
+      const std::string path =
+          std::string(dir) + "/cov_" + std::to_string(getpid()) + "_" + std::to_string(seq++) + ".dat";
+      ctx_->coveragep()->write(path.c_str());
+    }
+#endif
   }
 
  private:
