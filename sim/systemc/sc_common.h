@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 
 #include <systemc>
 
@@ -75,7 +76,17 @@ struct ScScore {
   uint64_t matched_items = 0;      // pairs equal in value and in time
   uint64_t item_mismatches = 0;    // pairs differing in value or time, plus unpaired items
   std::string first;               // first differing sample: time, signal, both values
+  sc_core::sc_time first_time;     // ... the rising edge it was sampled at
+  int64_t first_file_cycle = -1;   // the first sample differing from a vector file's expectation:
+                                   // the file's cycle (0-based), -1 none
   std::string first_item;          // first differing item
+  // Records the first differing sample (later ones only count: the caller counts them).
+  bool firstSample(const sc_core::sc_time& t, std::string what) {
+    if (!first.empty()) return false;
+    first = std::move(what);
+    first_time = t;
+    return true;
+  }
   uint64_t mismatches() const { return sample_mismatches + item_mismatches; }
   bool passed() const { return mismatches() == 0 && expected_items == observed_items && matched_items == expected_items; }
 };

@@ -13,6 +13,11 @@
 // the simulated cycles and the wall time. Exit status: 0 every sample and every result/fragment
 // equal in value and cycle; 1 a mismatch (the first one printed with its time, signal and both
 // values); 2 bad input.
+//
+// On the first mismatching sample the runner saves the failing case alone, from reset, as a
+// vector file <fail-dir>/<unit>_<config>_fail.vec (sc_run.h, ScFailCase); sc_main then replays
+// it in a child process of this program, which writes its FST waveform and must fail at the
+// file's last cycle (sc_fail_case.h), and reports both paths.
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
@@ -24,6 +29,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "sc_fail_case.h"
 #include "sc_run.h"
 
 using namespace shd;
@@ -104,6 +110,12 @@ int sc_main(int argc, char* argv[]) {
       ->check(CLI::IsMember({"none", "latency", "value"}));
   app.add_option("--max-mismatches", o.max_mismatches, "stop after this many mismatches (default 16)")
       ->check(CLI::PositiveNumber);
+  app.add_option("--fail-dir", o.fail_dir,
+                 "on a mismatch, save the failing case alone here: <unit>_<config>_fail.vec (from reset, the failing "
+                 "cycle last; spec: and the PROM copy .hex) and the FST waveform of its replay, "
+                 "<unit>_<config>_fail.fst (default: the current directory)");
+  bool no_fail_save = false;
+  app.add_flag("--no-fail-save", no_fail_save, "do not save the failing case (the replay of a saved case runs so)");
   app.add_flag("--json", json, "print the result as one JSON object on stdout");
   app.add_flag("--quiet", o.quiet, "no progress on stderr");
   try {
@@ -112,6 +124,8 @@ int sc_main(int argc, char* argv[]) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   if (o.config.empty()) o.config = o.unit == "spec" ? "default" : "serial";
+  o.argv0 = argv[0];
+  o.save_fail = !no_fail_save;
   o.triangles_given = given.triangles->count() > 0;
 
   ScReport r;
@@ -131,6 +145,10 @@ int sc_main(int argc, char* argv[]) {
 
   const ScScore& s = r.score;
   const bool ok = s.passed() && r.complete;
+  const ScFailCase& fc = r.fail;
+  ScFailReplay replay;
+  if (!fc.vec.empty()) replay = replayFailCase(o, fc);
+  const bool reproduced = !fc.vec.empty() && replay.failsAtLastCycle(fc.cycles);
   if (json) {
     nlohmann::json j = {{"unit", o.unit}, {"config", o.config}, {"fault", o.fault}};
     for (const auto& [key, value] : r.fields) j[key] = toJson(value);
@@ -142,6 +160,27 @@ int sc_main(int argc, char* argv[]) {
     if (!s.first_item.empty()) j["first_item_mismatch"] = s.first_item;
     if (!r.complete) j["incomplete"] = r.incomplete;
     if (!o.fst.empty()) j["fst"] = o.fst;
+    if (fc.attempted) {
+      nlohmann::json f = {{"saved", !fc.vec.empty()}};
+      if (fc.vec.empty()) {
+        f["not_saved"] = fc.not_saved;
+      } else {
+        f["vectors"] = fc.vec;
+        if (!fc.prom.empty()) f["prom"] = fc.prom;
+        f["fst"] = fc.fst;
+        f["cycles"] = fc.cycles;
+        f["run_cycles"] = {fc.run_first, fc.run_first + fc.cycles - 1};
+        f["replay"] = {{"command", replay.command()},
+                       {"status", replay.status},
+                       {"mismatch_file_cycle", replay.mismatch_cycle},
+                       {"file_mismatch_cycle", replay.file_mismatch_cycle},
+                       {"first_mismatch", replay.first},
+                       {"fst_written", replay.fst_written},
+                       {"fails_at_last_cycle", reproduced}};
+        if (!replay.error.empty()) f["replay"]["error"] = replay.error;
+      }
+      j["fail_case"] = f;
+    }
     std::cout << j.dump(2) << std::endl;
   } else {
     std::cout << r.summary << std::endl;
@@ -160,11 +199,38 @@ int sc_main(int argc, char* argv[]) {
                  static_cast<unsigned long long>(s.observed_items));
   if (!r.complete) std::fprintf(stderr, "INCOMPLETE %s\n", r.incomplete.c_str());
   if (!o.fst.empty()) std::fprintf(stderr, "waveform: %s\n", o.fst.c_str());
-  if (o.save_vectors.empty())
-    std::fprintf(stderr, "to keep this case: the same command with --save-vectors <file.vec> --fst <file.fst> (the "
-                         "run is deterministic); the file replays alone (--vector-file, shadesim replay, Icarus)\n");
-  else
-    std::fprintf(stderr, "vectors:  %s\n", o.save_vectors.c_str());
+  if (!o.save_vectors.empty()) std::fprintf(stderr, "vectors:  %s\n", o.save_vectors.c_str());
+  if (!fc.vec.empty()) {
+    std::string saved = fmt::format("failing case: {} ({} cycles from reset, the run's cycles {}..{} after reset, the "
+                                    "failing one last{})",
+                                    fc.vec, fc.cycles, fc.run_first, fc.run_first + fc.cycles - 1,
+                                    fc.prom.empty() ? std::string() : "; PROM " + fc.prom);
+    std::fprintf(stderr, "%s\n", saved.c_str());
+    if (replay.fst_written)
+      std::fprintf(stderr, "failing case waveform: %s (gtkwave %s)\n", fc.fst.c_str(), fc.fst.c_str());
+    else
+      std::fprintf(stderr, "failing case waveform: NOT WRITTEN (%s)\n", fc.fst.c_str());
+    if (reproduced) {
+      std::fprintf(stderr, "replayed alone (%s): fails at its last cycle %llu, as the run did: %s\n",
+                   replay.command().c_str(), static_cast<unsigned long long>(fc.cycles), replay.first.c_str());
+    } else {
+      // Both sides, so that the difference can be judged.
+      std::string why = !replay.error.empty() ? replay.error
+                        : replay.status == 0 ? std::string("it passes")
+                                             : fmt::format("exit status {}, first mismatch at file cycle {} (against "
+                                                           "the file: cycle {}): {}",
+                                                           replay.status, replay.mismatch_cycle,
+                                                           replay.file_mismatch_cycle, replay.first);
+      std::fprintf(stderr,
+                   "REPLAY DOES NOT REPRODUCE the failure at the file's last cycle %llu (%s): %s; the run: %s\n",
+                   static_cast<unsigned long long>(fc.cycles), replay.command().c_str(), why.c_str(), fc.what.c_str());
+    }
+  } else {
+    if (fc.attempted) std::fprintf(stderr, "failing case not saved: %s\n", fc.not_saved.c_str());
+    if (o.save_vectors.empty())
+      std::fprintf(stderr, "to keep this case: the same command with --save-vectors <file.vec> --fst <file.fst> (the "
+                           "run is deterministic); the file replays alone (--vector-file, shadesim replay, Icarus)\n");
+  }
   return 1;
 }
 

@@ -33,6 +33,24 @@ struct ScOptions {
   bool triangles_given = false;
   double gap = 0.2, ready = 0.8, desc_gap = 0.1;
   bool quiet = false;
+  std::string fail_dir = ".";  // where the failing case is saved (sc_fail_case.h)
+  bool save_fail = true;       // --no-fail-save: not (the replay of a saved case runs so)
+  std::string argv0;           // to run this program again if /proc/self/exe is unavailable
+};
+
+// The failing case a run saved at its first mismatch: a vector file that holds it alone, from
+// reset, its failing cycle last (bounded: the specular unit's last latency + 8 cycles, the span
+// unit's current triangle from the cycle that accepted it). sc_main then replays it in a child
+// process that writes the FST (sc_fail_case.h).
+struct ScFailCase {
+  bool attempted = false;       // the run had a first mismatching sample
+  std::string vec;              // the vector file; empty: not saved (why: not_saved)
+  std::string prom;             // spec: the PROM copy the file names
+  std::string fst;              // the waveform the replay writes
+  uint64_t cycles = 0;          // cycles in the file, the failing one last
+  uint64_t run_first = 0;       // the run's cycle (1-based from reset) of the file's first one
+  std::string what;             // the run's first mismatch (the scoreboard's line)
+  std::string not_saved;
 };
 
 struct ScReport {
@@ -42,6 +60,7 @@ struct ScReport {
   ScScore score;
   bool complete = true;    // every stimulus item went through
   std::string incomplete;  // why not
+  ScFailCase fail;
   void add(std::string key, Value v) { fields.emplace_back(std::move(key), std::move(v)); }
 };
 
@@ -61,6 +80,21 @@ inline void prepareOutput(const std::string& path, const char* option) {
   std::ofstream probe(path, std::ios::app);
   if (!probe) throw ArgError(fmt::format("{} {}: cannot write it", option, path));
 }
+
+// The paths of a failing case: <fail-dir>/<unit>_<config>_fail.<ext>.
+inline std::string failPath(const ScOptions& o, const char* ext) {
+  const std::string name = fmt::format("{}_{}_fail.{}", o.unit, o.config, ext);
+  if (o.fail_dir.empty() || o.fail_dir == ".") return name;
+  return (std::filesystem::path(o.fail_dir) / name).string();
+}
+
+// The run's first mismatching sample, as the runners capture it for the failing case.
+template <class Out>
+struct ScFirstMismatch {
+  sc_core::sc_time sample;  // its rising edge
+  Out expected;             // the expectation it failed
+  bool from_file = false;   // ... the vector file's (else the golden model's)
+};
 
 // sc_start() in slices of 20000 cycles until ctl.done, progress on stderr (unless quiet) as
 // done() of total.

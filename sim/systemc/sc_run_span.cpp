@@ -3,6 +3,7 @@
 // SpanFileDriver for a vector file), SpanGolden and SpanScoreboard (span_tb.h).
 #include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -27,6 +28,51 @@ std::string describe(const SpanParams& p) {
                      "TagBits={}",
                      p.NumTri, p.LanesPerTri, p.AlignLanes, p.NumAttr, p.AttrBits, p.CoordBits, p.RemBits, p.PixBits,
                      p.TagBits);
+}
+
+// The failing case (sc_run.h, ScFailCase): the captured cycles (the current triangle from the
+// cycle that accepted it, and what the ports carried up to the failing cycle), from reset, with
+// the golden module's predictions replayed on them (the fault included); the last cycle carries
+// the expectation the run failed when that was the vector file's.
+ScFailCase saveSpanFail(const ScOptions& o, const ScFirstMismatch<SpanOut>& first, SpanVectors v, uint64_t run_first,
+                        bool from_accept, SpanFault fault, const std::string& what) {
+  ScFailCase f;
+  f.attempted = true;
+  f.what = what;
+  if (v.cycles.empty()) {
+    f.not_saved = "no captured cycle up to the failing sample";
+    return f;
+  }
+  try {
+    if (!o.fail_dir.empty()) std::filesystem::create_directories(o.fail_dir);
+    const std::string vec = failPath(o, "vec");
+    v.config = o.config;
+    spanGoldenReplay(v, v.params, fault);
+    if (first.from_file) v.cycles.back().expected = first.expected;
+    const uint64_t run_last = run_first + v.cycles.size() - 1;
+    v.source = fmt::format(
+        "shadesim_systemc --unit span --config {} {}{}: the failing case, the run's cycles {}..{} after reset replayed "
+        "from reset",
+        o.config,
+        !o.vector_file.empty() ? "--vector-file " + o.vector_file
+        : !o.scene.empty()     ? "--scene " + o.scene
+                               : fmt::format("--seed {} --triangles {}", o.seed, o.triangles),
+        o.fault == "none" ? "" : " --fault " + o.fault, run_first, run_last);
+    v.notes = {from_accept ? "the failing triangle alone: from the cycle that accepted it to the failing cycle"
+                           : "from the run's first cycle (no triangle accepted before) to the failing cycle",
+               fmt::format("expected outputs: the golden-model module{} replayed on these inputs from reset{}",
+                           o.fault == "none" ? "" : " (fault " + o.fault + ")",
+                           first.from_file ? "; the last cycle: the run's vector file's expectation, which it failed" : ""),
+               fmt::format("the run's first mismatch (the outputs during the last cycle): {}", what)};
+    writeSpanVectors(vec, v);
+    f.vec = vec;
+    f.fst = failPath(o, "fst");
+    f.cycles = v.cycles.size();
+    f.run_first = run_first;
+  } catch (const std::exception& e) {
+    f.not_saved = e.what();
+  }
+  return f;
 }
 
 }  // namespace
@@ -127,7 +173,7 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   }
 
   const SpanFault fault = o.fault == "latency" ? SpanFault::Latency : o.fault == "value" ? SpanFault::Value : SpanFault::None;
-  SpanGolden golden("golden", p, fault, !o.save_vectors.empty());
+  SpanGolden golden("golden", p, fault, !o.save_vectors.empty(), o.save_fail);
   golden.clk(clk);
   golden.rst_n(rst_n);
   golden.desc_valid_i(desc_valid_i);
@@ -143,6 +189,15 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   board.rtl(*rtl);
   board.expect(expect_fifo);
   board.file_expect(file_fifo);
+  std::optional<ScFirstMismatch<SpanOut>> first;
+  SpanVectors fail_case;
+  uint64_t fail_first = 0;
+  bool fail_from_accept = false;
+  if (o.save_fail)
+    board.on_first_mismatch = [&](const sc_core::sc_time& t, const SpanOut& e, bool from_file) {
+      first = ScFirstMismatch<SpanOut>{t, e, from_file};  // the outputs during the cycle sampled at t
+      fail_case = golden.capturedCase(t, fail_first, fail_from_accept);
+    };
 
   sc_core::sc_start(sc_core::SC_ZERO_TIME);
   // Tracing starts after elaboration (VerilatedFstSc::open requires it). The kernel keeps the
@@ -182,6 +237,14 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   ScReport r;
   r.score = board.score();
   const ScScore& s = r.score;
+  if (first) r.fail = saveSpanFail(o, *first, std::move(fail_case), fail_first, fail_from_accept, fault, s.first);
+  if (file) {
+    // Where the first mismatching sample falls in the file (1-based; cycle i's outputs are sampled
+    // kResetCycles + 1 + i edges from time 0), and the first that differs from the file's own
+    // expectation: a replayed failing case must fail at its last cycle.
+    r.add("mismatch_file_cycle", s.first.empty() ? uint64_t{0} : scCycle(s.first_time) - kResetCycles);
+    r.add("file_mismatch_cycle", static_cast<uint64_t>(s.first_file_cycle + 1));
+  }
   std::string what;
   uint64_t descs = 0;
   if (file) {

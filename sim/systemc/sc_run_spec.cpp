@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 #include <verilated.h>
@@ -40,6 +43,58 @@ std::string promPath(const ScOptions& o, const SpecVectors* file) {
     return (p.is_absolute() ? p : fs::absolute(o.vector_file).parent_path() / p).lexically_normal().string();
   }
   return fmt::format("{}/vectors/prom/spec_{}.hex", SHD_SOURCE_DIR, o.config);
+}
+
+// The failing case (sc_run.h, ScFailCase): the captured window of inputs, from reset, with the
+// golden module's predictions replayed on it (the fault included: that is what differs from the
+// RTL), beside a copy of the PROM; the last cycle, the failing one, carries the expectation the
+// run failed when that was the vector file's (the model agrees with the RTL there).
+ScFailCase saveSpecFail(const ScOptions& o, const ScFirstMismatch<SpecOut>& first, const std::vector<SpecIn>& window,
+                        uint64_t run_first, const SpecUnitParams& unit, const SpecUnitModel& model, SpecFault fault,
+                        const std::string& prom, const std::string& what) {
+  ScFailCase f;
+  f.attempted = true;
+  f.what = what;
+  if (window.empty()) {
+    f.not_saved = "the first mismatch is the sample at the first active edge (the state reset left), which no cycle "
+                  "of a vector file holds";
+    return f;
+  }
+  try {
+    if (!o.fail_dir.empty()) fs::create_directories(o.fail_dir);
+    const std::string vec = failPath(o, "vec"), hex = failPath(o, "hex");
+    SpecVectors v;
+    v.config = o.config;
+    v.params = unit;  // the unit's: the file replays on it
+    v.prom = fs::path(hex).filename().string();
+    v.in = window;
+    v.expected = specGoldenReplay(model, fault, window);
+    if (first.from_file) v.expected.back() = first.expected;
+    const uint64_t run_last = run_first + window.size() - 1;
+    v.source = fmt::format(
+        "shadesim_systemc --unit spec --config {} {}{}: the failing case, the run's cycles {}..{} after reset replayed "
+        "from reset",
+        o.config,
+        o.vector_file.empty() ? fmt::format("--seed {} --vectors {}", o.seed, o.vectors) : "--vector-file " + o.vector_file,
+        o.fault == "none" ? "" : " --fault " + o.fault, run_first, run_last);
+    v.notes = {fmt::format("expected outputs: the golden-model module{} replayed on these inputs from reset{}",
+                           o.fault == "none" ? "" : " (fault " + o.fault + ")",
+                           first.from_file ? "; the last cycle: the run's vector file's expectation, which it failed" : ""),
+               fmt::format("the run's first mismatch (the outputs after the last cycle's edge): {}", what)};
+    // The PROM the simulator loaded, beside the file (the file names it relative to itself).
+    std::ifstream in(prom, std::ios::binary);
+    if (!in) throw std::runtime_error(fmt::format("cannot read back PROM file {}", prom));
+    writeFileAtomic(hex, std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()));
+    writeSpecVectors(vec, v);
+    f.vec = vec;
+    f.prom = hex;
+    f.fst = failPath(o, "fst");
+    f.cycles = window.size();
+    f.run_first = run_first;
+  } catch (const std::exception& e) {
+    f.not_saved = e.what();
+  }
+  return f;
 }
 
 }  // namespace
@@ -135,7 +190,9 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   driver.file_expect(file_fifo);
 
   const SpecFault fault = o.fault == "latency" ? SpecFault::Latency : o.fault == "value" ? SpecFault::Value : SpecFault::None;
-  SpecGolden golden("golden", model, fault, !o.save_vectors.empty());
+  // The failing case's window: the C++ co-simulation's (sim/spec_cosim.cpp), latency + 8 cycles.
+  SpecGolden golden("golden", model, fault, !o.save_vectors.empty(),
+                    o.save_fail ? static_cast<size_t>(cfg.rtl.latency()) + 8 : 0);
   golden.clk(clk);
   golden.rst_n(rst_n);
   golden.valid_i(valid_i);
@@ -156,6 +213,15 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   board.spec_b_o(spec_b_o);
   board.expect(expect_fifo);
   board.file_expect(file_fifo);
+  std::optional<ScFirstMismatch<SpecOut>> first;
+  std::vector<SpecIn> fail_window;
+  uint64_t fail_first = 0;
+  if (o.save_fail)
+    board.on_first_mismatch = [&](const sc_core::sc_time& t, const SpecOut& e, bool from_file) {
+      // The sample at t is the outputs after the edge before it: that edge's cycle fails last.
+      first = ScFirstMismatch<SpecOut>{t, e, from_file};
+      fail_window = golden.capturedWindow(t - scPeriod(), fail_first);
+    };
 
   // Elaborate and evaluate once (initial blocks: the PROM loads), then check what it loaded.
   sc_core::sc_start(sc_core::SC_ZERO_TIME);
@@ -199,6 +265,14 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   ScReport r;
   r.score = board.score();
   const ScScore& s = r.score;
+  if (first) r.fail = saveSpecFail(o, *first, fail_window, fail_first, cfg.rtl, model, fault, prom, s.first);
+  if (file) {
+    // Where the first mismatching sample falls in the file (1-based; the outputs after cycle i's
+    // edge are sampled kResetCycles + 2 + i edges from time 0), and the first that differs from the
+    // file's own expectation: a replayed failing case must fail at its last cycle.
+    r.add("mismatch_file_cycle", s.first.empty() ? uint64_t{0} : scCycle(s.first_time) - kResetCycles - 1);
+    r.add("file_mismatch_cycle", static_cast<uint64_t>(s.first_file_cycle + 1));
+  }
   if (driver.driven() != src->total()) {
     r.complete = false;
     r.incomplete = fmt::format("the run stopped after {} of {} valid vectors", driver.driven(), src->total());

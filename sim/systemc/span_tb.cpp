@@ -112,40 +112,21 @@ void SpanFileDriver::onEdge() {
 
 // ---------------------------------------------------------------- golden model
 
-SpanGolden::SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record)
-    : sc_module(name), model_(p), fault_(fault), record_(record) {
-  SC_METHOD(onEdge);
-  sensitive << clk.pos();
-  dont_initialize();
+void SpanGoldenCore::offer(std::shared_ptr<const SpanDesc> d) {
+  if (fault_ == SpanFault::Value && !d->iref.empty()) {
+    auto f = std::make_shared<SpanDesc>(*d);
+    f->iref[0] += 1;
+    d = std::move(f);
+  }
+  queue_.push_back(std::move(d));
 }
 
-SpanVectors SpanGolden::recorded() const {
-  SpanVectors v;
-  v.params = model_.params();
-  v.descs = rec_descs_;
-  v.cycles = rec_cycles_;
-  return v;
+void SpanGoldenCore::reset() {
+  model_.reset();
+  delayed_valid_ = delayed_ready_ = false;
 }
 
-void SpanGolden::onEdge() {
-  DescToken t;
-  while (offered.nb_read(t)) {
-    if (record_) rec_descs_.push_back(*t.desc);  // on the ports from this cycle on
-    if (fault_ == SpanFault::Value && !t.desc->iref.empty()) {
-      auto d = std::make_shared<SpanDesc>(*t.desc);
-      d->iref[0] += 1;
-      t.desc = std::move(d);
-    }
-    queue_.push_back(t.desc);
-  }
-  if (!rst_n.read()) {
-    model_.reset();
-    delayed_valid_ = delayed_ready_ = false;
-    model_idle.write(true);
-    return;
-  }
-  bool valid = desc_valid_i.read(), ready = out_ready_i.read();
-  const bool pin_valid = valid, pin_ready = ready;
+const SpanOut& SpanGoldenCore::tick(bool valid, bool ready) {
   if (fault_ == SpanFault::Latency) {
     std::swap(valid, delayed_valid_);
     std::swap(ready, delayed_ready_);
@@ -157,22 +138,104 @@ void SpanGolden::onEdge() {
   in.desc_valid = valid && !queue_.empty();
   in.desc = in.desc_valid ? queue_.front().get() : nullptr;
   in.out_ready = ready;
+  ready_taken_ = ready;
   model_.tick(in, out_);  // the outputs before this edge: the sample at this edge
   if (in.desc_valid && out_.desc_ready) {
     queue_.pop_front();
     ++accepted_;
   }
-  if (!expect.nb_write(SpanExpect{sc_time_stamp(), out_, ready, -1}))
+  return out_;
+}
+
+void spanGoldenReplay(SpanVectors& v, SpanParams model_params, SpanFault fault) {
+  SpanGoldenCore core(model_params, fault);
+  core.reset();
+  std::vector<std::shared_ptr<const SpanDesc>> descs;
+  for (const SpanDesc& d : v.descs) descs.push_back(std::make_shared<const SpanDesc>(d));
+  bool offering = false;
+  for (SpanVectorCycle& c : v.cycles) {
+    if (c.desc_valid && !offering && c.desc >= 0) {  // a new offer (as SpanFileDriver makes it)
+      core.offer(descs.at(static_cast<size_t>(c.desc)));
+      offering = true;
+    }
+    c.expected = core.tick(c.desc_valid, c.out_ready);
+    if (c.desc_valid && c.expected.desc_ready) offering = false;
+  }
+}
+
+SpanGolden::SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record, bool capture)
+    : sc_module(name), core_(p, fault), record_(record), capture_(capture) {
+  SC_METHOD(onEdge);
+  sensitive << clk.pos();
+  dont_initialize();
+}
+
+SpanVectors SpanGolden::recorded() const {
+  SpanVectors v;
+  v.params = core_.model().params();
+  v.descs = rec_descs_;
+  v.cycles = rec_cycles_;
+  return v;
+}
+
+SpanVectors SpanGolden::capturedCase(const sc_time& last_edge, uint64_t& first_cycle, bool& from_accept) const {
+  SpanVectors v;
+  v.params = core_.model().params();
+  const SpanDesc* last = nullptr;
+  first_cycle = cap_.empty() ? 0 : cap_.front().cycle;
+  from_accept = cap_from_accept_;
+  for (const Captured& e : cap_) {
+    if (e.edge > last_edge) break;
+    if (e.on_ports && e.on_ports.get() != last) {  // a D record: on the ports from this cycle on
+      v.descs.push_back(*e.on_ports);
+      last = e.on_ports.get();
+    }
+    SpanVectorCycle c;
+    c.desc_valid = e.desc_valid;
+    c.out_ready = e.out_ready;
+    c.desc = static_cast<int>(v.descs.size()) - 1;
+    v.cycles.push_back(std::move(c));
+  }
+  return v;
+}
+
+void SpanGolden::onEdge() {
+  DescToken t;
+  while (offered.nb_read(t)) {
+    if (record_) rec_descs_.push_back(*t.desc);  // on the ports from this cycle on
+    if (capture_) on_ports_ = t.desc;
+    core_.offer(t.desc);
+  }
+  if (!rst_n.read()) {
+    core_.reset();
+    model_idle.write(true);
+    return;
+  }
+  const bool pin_valid = desc_valid_i.read(), pin_ready = out_ready_i.read();
+  const SpanOut& out = core_.tick(pin_valid, pin_ready);
+  if (!expect.nb_write(SpanExpect{sc_time_stamp(), out, core_.readyTaken(), -1}))
     SC_REPORT_FATAL("shadesim/span_golden", "expectation FIFO full");
+  ++active_edges_;
+  if (capture_) {
+    if (accept_at_ >= 0) {  // the current triangle was accepted at the previous edge: start there
+      cap_.erase(cap_.begin(), cap_.begin() + accept_at_);
+      cap_from_accept_ = true;
+      accept_at_ = -1;
+    }
+    cap_.push_back(Captured{sc_time_stamp(), active_edges_, pin_valid, pin_ready, on_ports_});
+    // Accepted at this edge: desc_valid on the ports and desc_ready (the model's, equal to the
+    // RTL's up to the first mismatch, which is all a failing case needs).
+    if (pin_valid && out.desc_ready) accept_at_ = static_cast<int64_t>(cap_.size()) - 1;
+  }
   if (record_) {
     SpanVectorCycle c;
     c.desc_valid = pin_valid;
     c.out_ready = pin_ready;
     c.desc = static_cast<int>(rec_descs_.size()) - 1;
-    c.expected = out_;
+    c.expected = out;
     rec_cycles_.push_back(std::move(c));
   }
-  model_idle.write(model_.idle() && queue_.empty());
+  model_idle.write(core_.idle());
 }
 
 // ---------------------------------------------------------------- scoreboard
@@ -256,10 +319,13 @@ void SpanScoreboard::check(const Sample& got, const SpanExpect& exp, const char*
   const std::string diff = firstDifference(exp.out, got.out, who);
   if (diff.empty()) return;
   ++s_.sample_mismatches;
-  if (s_.first.empty())
-    s_.first = fmt::format("at {}{}: {} (the current triangle: {})", scWhen(got.time),
-                           exp.cycle >= 0 ? fmt::format(", vector file cycle {}", exp.cycle + 1) : std::string(), diff,
-                           exp.out.tag);
+  const bool from_file = exp.cycle >= 0;
+  if (from_file && s_.first_file_cycle < 0) s_.first_file_cycle = exp.cycle;
+  if (s_.firstSample(got.time, fmt::format("at {}{}: {} (the current triangle: {})", scWhen(got.time),
+                                           from_file ? fmt::format(", vector file cycle {}", exp.cycle + 1) : std::string(),
+                                           diff, exp.out.tag)) &&
+      on_first_mismatch)
+    on_first_mismatch(got.time, exp.out, from_file);
 }
 
 void SpanScoreboard::compare() {
@@ -272,9 +338,9 @@ void SpanScoreboard::compare() {
     ++s_.samples;
     if (expected_.empty() || expected_.front().time != got.time) {
       ++s_.sample_mismatches;  // a testbench error, reported so that it cannot pass unnoticed
-      if (s_.first.empty())
-        s_.first = fmt::format("at {}: no prediction of the golden model for this sample (next one at {})",
-                               scWhen(got.time), expected_.empty() ? std::string("none") : scWhen(expected_.front().time));
+      s_.firstSample(got.time, fmt::format("at {}: no prediction of the golden model for this sample (next one at {})",
+                                           scWhen(got.time),
+                                           expected_.empty() ? std::string("none") : scWhen(expected_.front().time)));
     } else {
       const SpanExpect exp = std::move(expected_.front());
       expected_.pop_front();
@@ -283,9 +349,8 @@ void SpanScoreboard::compare() {
     }
     if (!file_expected_.empty() && file_expected_.front().time < got.time) {
       ++s_.sample_mismatches;  // every file cycle falls on an active cycle: a testbench error
-      if (s_.first.empty())
-        s_.first = fmt::format("at {}: the vector file's expectation for {} was never compared", scWhen(got.time),
-                               scWhen(file_expected_.front().time));
+      s_.firstSample(got.time, fmt::format("at {}: the vector file's expectation for {} was never compared",
+                                           scWhen(got.time), scWhen(file_expected_.front().time)));
       file_expected_.pop_front();
     }
     if (!file_expected_.empty() && file_expected_.front().time == got.time) {

@@ -116,6 +116,39 @@ class SpanFileDriver : public sc_core::sc_module {
 
 enum class SpanFault { None, Latency, Value };
 
+// What SpanGolden computes, free of SystemC, so that the failing case's expected outputs come
+// from the same code: the model behind the faults. Latency puts one register in front of the
+// model's inputs (its predictions come a cycle late); Value gives the model every descriptor
+// with attribute 0's reference value one code higher.
+class SpanGoldenCore {
+ public:
+  SpanGoldenCore(SpanParams p, SpanFault fault) : model_(p), fault_(fault) {}
+  // A descriptor offered on the ports (as a transaction), queued for the model.
+  void offer(std::shared_ptr<const SpanDesc> d);
+  void reset();  // the model and the Latency register (the queue of offers stays)
+  // One rising edge with desc_valid and out_ready as on the ports: the model's outputs before
+  // it (the sample at that edge). readyTaken() is the out_ready the model took.
+  const SpanOut& tick(bool desc_valid, bool out_ready);
+  bool readyTaken() const { return ready_taken_; }
+  bool idle() const { return model_.idle() && queue_.empty(); }
+  uint64_t accepted() const { return accepted_; }
+  const SpanUnitModel& model() const { return model_; }
+
+ private:
+  SpanUnitModel model_;
+  SpanFault fault_;
+  std::deque<std::shared_ptr<const SpanDesc>> queue_;  // offered, not yet taken by the model
+  bool delayed_valid_ = false, delayed_ready_ = false;  // the Latency fault's register
+  bool ready_taken_ = false;
+  SpanOut out_;
+  uint64_t accepted_ = 0;
+};
+
+// The golden model's predictions for a vector file's cycles, from reset, the way SpanGolden
+// computes them when SpanFileDriver replays the file: each descriptor offered to the model when
+// an offer starts (desc_valid after none pending), the expected outputs filled in.
+void spanGoldenReplay(SpanVectors& v, SpanParams model_params, SpanFault fault);
+
 class SpanGolden : public sc_core::sc_module {
  public:
   sc_core::sc_in<bool> clk{"clk"}, rst_n{"rst_n"}, desc_valid_i{"desc_valid_i"}, out_ready_i{"out_ready_i"};
@@ -123,29 +156,44 @@ class SpanGolden : public sc_core::sc_module {
   sc_core::sc_fifo_out<SpanExpect> expect{"expect"};
   sc_core::sc_out<bool> model_idle{"model_idle"};
 
-  // Fault injection, to prove the scoreboard can fail: Latency puts one register in front of
-  // the model's inputs (its predictions come a cycle late); Value gives the model every
-  // descriptor with attribute 0's reference value one code higher.
+  // Fault injection, to prove the scoreboard can fail (SpanGoldenCore).
   // record: keep every active cycle's inputs (as on the ports) and the model's outputs, and the
   // descriptors, as a vector file's cycles (--save-vectors).
-  SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record);
+  // capture: keep what the failing case is saved from, bounded by one triangle: the inputs on
+  // the ports (desc_valid, out_ready, the descriptor) of every active cycle since the one at
+  // which the current triangle was accepted (from reset before the first), as
+  // sim/span_cosim.cpp does: the unit loads every register it uses when it accepts a descriptor.
+  SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record, bool capture = false);
   SC_HAS_PROCESS(SpanGolden);
-  uint64_t accepted() const { return accepted_; }
-  const SpanUnitModel& model() const { return model_; }
+  uint64_t accepted() const { return core_.accepted(); }
+  const SpanUnitModel& model() const { return core_.model(); }
   // The recorded cycles as a vector file's content (config, params and source left to the caller).
   SpanVectors recorded() const;
+  // The captured cycles up to the one sampled at last_edge, as a vector file's cycles without
+  // expected outputs (params, descs, cycles; spanGoldenReplay fills them in). first_cycle gets
+  // the run's cycle (1-based from reset) of the first one, from_accept whether it is the cycle
+  // that accepted the current triangle (else the run's first).
+  SpanVectors capturedCase(const sc_core::sc_time& last_edge, uint64_t& first_cycle, bool& from_accept) const;
 
  private:
   void onEdge();
-  SpanUnitModel model_;
-  SpanFault fault_;
+  SpanGoldenCore core_;
   bool record_;
   std::vector<SpanDesc> rec_descs_;  // as offered (before the Value fault)
   std::vector<SpanVectorCycle> rec_cycles_;
-  std::deque<std::shared_ptr<const SpanDesc>> queue_;  // offered, not yet taken by the model
-  bool delayed_valid_ = false, delayed_ready_ = false;  // the Latency fault's register
-  SpanOut out_;
-  uint64_t accepted_ = 0;
+  bool capture_;
+  struct Captured {
+    sc_core::sc_time edge;
+    uint64_t cycle;  // 1-based from reset
+    bool desc_valid, out_ready;
+    std::shared_ptr<const SpanDesc> on_ports;  // as offered (before the Value fault); null: none yet
+  };
+  std::deque<Captured> cap_;
+  bool cap_from_accept_ = false;
+  int64_t accept_at_ = -1;  // index in cap_ of an acceptance not yet applied (the window moves
+                            // at the next edge, so a mismatch at the accepting cycle keeps its triangle)
+  std::shared_ptr<const SpanDesc> on_ports_;
+  uint64_t active_edges_ = 0;
 };
 
 class SpanScoreboard : public sc_core::sc_module {
@@ -156,6 +204,10 @@ class SpanScoreboard : public sc_core::sc_module {
 
   SpanScoreboard(const sc_core::sc_module_name& name, ScRunControl& ctl);
   SC_HAS_PROCESS(SpanScoreboard);
+  // Called once, at the first sample whose outputs differ from an expectation: the sample's
+  // rising edge, the expectation it failed and whether it came from the vector file (else the
+  // golden model). The runner saves the failing case from it.
+  std::function<void(const sc_core::sc_time& sample, const SpanOut& expected, bool from_file)> on_first_mismatch;
   void finish();  // fragments only one side produced count as mismatches
   const ScScore& score() const { return s_; }
   uint64_t fileChecks() const { return file_checks_; }

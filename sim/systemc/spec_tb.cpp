@@ -103,8 +103,9 @@ void SpecDriver::onEdge() {
 
 // ---------------------------------------------------------------- golden model
 
-SpecGolden::SpecGolden(const sc_core::sc_module_name& name, SpecUnitModel& model, SpecFault fault, bool record)
-    : sc_module(name), model_(model), fault_(fault), record_(record) {
+SpecGolden::SpecGolden(const sc_core::sc_module_name& name, SpecUnitModel& model, SpecFault fault, bool record,
+                       size_t capture)
+    : sc_module(name), model_(model), fault_(fault), record_(record), capture_(capture) {
   SC_METHOD(onEdge);
   sensitive << clk.pos();
   dont_initialize();
@@ -128,6 +129,11 @@ void SpecGolden::onEdge() {
   in.shin = shin_i.read();
   in.cos = cos_i.read();
   in.light = {light_r_i.read(), light_g_i.read(), light_b_i.read()};
+  ++active_edges_;
+  if (capture_ > 0) {
+    cap_.push_back(Captured{now, active_edges_, in});
+    if (cap_.size() > capture_ + 1) cap_.pop_front();
+  }
   sc_time in_time = now;
   if (fault_ == SpecFault::Latency) {
     std::swap(in, delayed_);
@@ -154,6 +160,29 @@ void SpecGolden::onEdge() {
                              {light_r_i.read(), light_g_i.read(), light_b_i.read()}});
     rec_out_.push_back(o);
   }
+}
+
+std::vector<SpecIn> SpecGolden::capturedWindow(const sc_time& last_edge, uint64_t& first_cycle) const {
+  std::vector<SpecIn> w;
+  size_t end = cap_.size();
+  while (end > 0 && cap_[end - 1].edge > last_edge) --end;
+  const size_t begin = end > capture_ ? end - capture_ : 0;
+  for (size_t i = begin; i < end; ++i) w.push_back(cap_[i].in);
+  first_cycle = begin < end ? cap_[begin].cycle : 0;
+  return w;
+}
+
+std::vector<SpecOut> specGoldenReplay(const SpecUnitModel& model, SpecFault fault, const std::vector<SpecIn>& in) {
+  SpecUnitModel m(model.params(), model.prom());
+  m.reset();
+  SpecIn delayed;  // the Latency fault's register, reset to no input as in SpecGolden
+  std::vector<SpecOut> out;
+  out.reserve(in.size());
+  for (SpecIn x : in) {
+    if (fault == SpecFault::Latency) std::swap(x, delayed);
+    out.push_back(m.tick(x));
+  }
+  return out;
 }
 
 // ---------------------------------------------------------------- scoreboard
@@ -197,10 +226,13 @@ void SpecScoreboard::check(const Sample& got, const SpecExpect& exp, const char*
       if (e.rgb[k] != g.rgb[k]) diff = fmt::format("{}: {} {}, rtl {}", kRgb[k], who, e.rgb[k], g.rgb[k]);
   if (diff.empty()) return;
   ++s_.sample_mismatches;
-  if (s_.first.empty())
-    s_.first = fmt::format("at {}{}: {}{}", scWhen(got.time),
-                           exp.cycle >= 0 ? fmt::format(", vector file cycle {}", exp.cycle + 1) : std::string(), diff,
-                           describe(exp));
+  const bool from_file = exp.cycle >= 0;
+  if (from_file && s_.first_file_cycle < 0) s_.first_file_cycle = exp.cycle;
+  if (s_.firstSample(got.time, fmt::format("at {}{}: {}{}", scWhen(got.time),
+                                           from_file ? fmt::format(", vector file cycle {}", exp.cycle + 1) : std::string(),
+                                           diff, describe(exp))) &&
+      on_first_mismatch)
+    on_first_mismatch(got.time, exp.out, from_file);
 }
 
 void SpecScoreboard::pairResults() {
@@ -234,9 +266,9 @@ void SpecScoreboard::compare() {
       // The golden module predicts every active cycle; a gap is a testbench error, reported as a
       // mismatch so that it cannot pass unnoticed.
       ++s_.sample_mismatches;
-      if (s_.first.empty())
-        s_.first = fmt::format("at {}: no prediction of the golden model for this sample (next one at {})",
-                               scWhen(got.time), expected_.empty() ? std::string("none") : scWhen(expected_.front().time));
+      s_.firstSample(got.time, fmt::format("at {}: no prediction of the golden model for this sample (next one at {})",
+                                           scWhen(got.time),
+                                           expected_.empty() ? std::string("none") : scWhen(expected_.front().time)));
     } else {
       const SpecExpect exp = expected_.front();
       expected_.pop_front();
@@ -249,9 +281,8 @@ void SpecScoreboard::compare() {
     if (!file_expected_.empty() && file_expected_.front().time < got.time) {
       // Every file expectation falls on an active cycle; one left behind is a testbench error.
       ++s_.sample_mismatches;
-      if (s_.first.empty())
-        s_.first = fmt::format("at {}: the vector file's expectation for {} was never compared", scWhen(got.time),
-                               scWhen(file_expected_.front().time));
+      s_.firstSample(got.time, fmt::format("at {}: the vector file's expectation for {} was never compared",
+                                           scWhen(got.time), scWhen(file_expected_.front().time)));
       file_expected_.pop_front();
     }
     if (!file_expected_.empty() && file_expected_.front().time == got.time) {

@@ -18,6 +18,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <random>
@@ -128,10 +129,17 @@ class SpecGolden : public sc_core::sc_module {
   // the model (every prediction one cycle late); Value is applied by the caller (a model built
   // with other parameters). record: keep every active cycle's input (as on the ports) and the
   // model's prediction after that edge, a vector file's cycles (--save-vectors).
-  SpecGolden(const sc_core::sc_module_name& name, SpecUnitModel& model, SpecFault fault, bool record);
+  // capture: keep the inputs (as on the ports) of the last `capture` active cycles, the window
+  // a failing case is saved from (0: none). Bounded whatever the run length.
+  SpecGolden(const sc_core::sc_module_name& name, SpecUnitModel& model, SpecFault fault, bool record,
+             size_t capture = 0);
   SC_HAS_PROCESS(SpecGolden);
   const std::vector<SpecIn>& recordedInputs() const { return rec_in_; }
   const std::vector<SpecOut>& recordedOutputs() const { return rec_out_; }
+  // The captured inputs of the active edges up to last_edge, at most `capture` of them, oldest
+  // first; first_cycle gets the run's cycle (1-based from reset) of the oldest one. Empty if
+  // last_edge precedes the first active edge.
+  std::vector<SpecIn> capturedWindow(const sc_core::sc_time& last_edge, uint64_t& first_cycle) const;
 
  private:
   void onEdge();
@@ -145,7 +153,20 @@ class SpecGolden : public sc_core::sc_module {
   std::deque<std::pair<sc_core::sc_time, SpecIn>> history_;  // the last `latency` inputs
   std::vector<SpecIn> rec_in_;
   std::vector<SpecOut> rec_out_;
+  size_t capture_;
+  uint64_t active_edges_ = 0;
+  struct Captured {
+    sc_core::sc_time edge;
+    uint64_t cycle;  // 1-based from reset
+    SpecIn in;
+  };
+  std::deque<Captured> cap_;  // the last capture_ + 1 active edges
 };
+
+// What SpecGolden predicts for a vector file's cycles: from reset, `in` (as on the ports) through
+// the Latency fault's register (if any) into a fresh copy of `model` (its parameters and table,
+// so a Value fault too); one output per cycle, after its rising edge. Used for the failing case.
+std::vector<SpecOut> specGoldenReplay(const SpecUnitModel& model, SpecFault fault, const std::vector<SpecIn>& in);
 
 class SpecScoreboard : public sc_core::sc_module {
  public:
@@ -156,6 +177,10 @@ class SpecScoreboard : public sc_core::sc_module {
 
   SpecScoreboard(const sc_core::sc_module_name& name, const SpecUnitParams& p, ScRunControl& ctl);
   SC_HAS_PROCESS(SpecScoreboard);
+  // Called once, at the first sample whose outputs differ from an expectation: the sample's
+  // rising edge, the expectation it failed and whether it came from the vector file (else the
+  // golden model). The runner saves the failing case from it.
+  std::function<void(const sc_core::sc_time& sample, const SpecOut& expected, bool from_file)> on_first_mismatch;
   // After the run: pairs left over (a result only one side produced) count as mismatches.
   void finish();
   const ScScore& score() const { return s_; }
