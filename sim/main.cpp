@@ -514,7 +514,9 @@ struct RenderCmd {
   Engines makeEngines(const Scene& sc, const RenderOptions& ro, bool with_rtl, const fs::path& tmp) {
     Engines e;
     const SpanMode m = parseSpanMode(mode);
-    if (with_rtl) e.span = std::make_unique<RtlSpanEngine>(m);
+    // A disagreement between a unit and its model saves the failing case beside the image.
+    const std::string fail_dir = fs::path(output).parent_path().empty() ? "." : fs::path(output).parent_path().string();
+    if (with_rtl) e.span = std::make_unique<RtlSpanEngine>(m, fail_dir);
     else e.span = std::make_unique<ModelSpanEngine>(SpanParams::forMode(m));
     for (Lobe l : deviceLobesUsed(sc, ro)) {
       const std::string cfg_name = specConfigForLobe(l);
@@ -522,7 +524,8 @@ struct RenderCmd {
       PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
       if (with_rtl) {
         fs::create_directories(tmp);
-        e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg_name, std::move(t), (tmp / ("spec_" + cfg_name + ".hex")).string()));
+        e.spec.push_back(
+            std::make_unique<RtlSpecEngine>(cfg_name, std::move(t), (tmp / ("spec_" + cfg_name + ".hex")).string(), fail_dir));
       } else {
         e.spec.push_back(std::make_unique<ModelSpecEngine>(std::move(t)));
       }

@@ -1,15 +1,28 @@
 #include "render_rtl.h"
 
+#include <filesystem>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "device/prom_io.h"
+#include "replay.h"
+#include "span_cosim.h"
 #include "spec_cosim.h"
+#include "vector_file.h"
 
 namespace shd {
 
-RtlSpanEngine::RtlSpanEngine(SpanMode mode) : dut_(makeSpanDut(toString(mode), "")) { dut_->reset(); }
+namespace fs = std::filesystem;
+
+RtlSpanEngine::RtlSpanEngine(SpanMode mode, std::string fail_dir, std::optional<SpanParams> model_params)
+    : mode_(toString(mode)),
+      fail_dir_(std::move(fail_dir)),
+      dut_(makeSpanDut(mode_, "")),
+      model_(model_params ? *model_params : dut_->params()) {
+  dut_->reset();
+  model_.reset();
+}
 
 SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
   SpanWalk run;
@@ -18,8 +31,44 @@ SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
   in.desc = &d;
   in.out_ready = true;
   for (bool accepted = false;;) {
+    model_.tick(in, expected_);
     dut_->tick(in, out_);
     ++run.cycles;
+    if (const std::string diff = compareSpanOutputs(expected_, out_); !diff.empty()) {
+      // The triangle alone from reset: the accepting cycle, then out_ready high to this cycle.
+      fs::create_directories(fail_dir_);
+      const std::string vec = fmt::format("{}/render_span_{}_fail.vec", fail_dir_, mode_);
+      const std::string fst = fmt::format("{}/render_span_{}_fail.fst", fail_dir_, mode_);
+      SpanVectors v;
+      v.config = mode_;
+      v.params = dut_->params();
+      v.source = fmt::format("shadesim render --rtl: triangle {} alone, from reset; the RTL differed from the model at "
+                             "its cycle {}",
+                             d.tag, run.cycles);
+      v.descs.push_back(d);
+      SpanUnitModel replay(model_.params());
+      replay.reset();
+      for (uint64_t c = 0; c < run.cycles; ++c) {
+        SpanVectorCycle vc;
+        vc.desc_valid = c == 0;
+        vc.out_ready = true;
+        vc.desc = 0;
+        SpanIn rin;
+        rin.desc_valid = vc.desc_valid;
+        rin.desc = &v.descs[0];
+        replay.tick(rin, vc.expected);
+        v.cycles.push_back(std::move(vc));
+      }
+      writeSpanVectors(vec, v);
+      ReplayOptions ro;
+      ro.fst_path = fst;
+      const ReplayResult rr = replayVectorFile(vec, ro);
+      throw std::runtime_error(fmt::format(
+          "span unit ({}): the RTL differs from the model on triangle {} at its cycle {}: {}; the triangle alone: {} "
+          "({}), waveform {}",
+          mode_, d.tag, run.cycles, diff, vec,
+          rr.first ? "replays alone: " + rr.first->describe() : std::string("does NOT fail when replayed alone"), fst));
+    }
     if (!accepted) {
       if (!out_.desc_ready) throw std::logic_error("RtlSpanEngine: the span unit is not idle");
       accepted = true;
@@ -39,8 +88,12 @@ SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
   return run;
 }
 
-RtlSpecEngine::RtlSpecEngine(const std::string& config, PromTable table, const std::string& prom_path)
-    : t_(std::move(table)) {
+RtlSpecEngine::RtlSpecEngine(const std::string& config, PromTable table, const std::string& prom_path,
+                             std::string fail_dir, std::optional<std::vector<PromWord>> model_words)
+    : config_(config),
+      fail_dir_(std::move(fail_dir)),
+      t_(std::move(table)),
+      model_(t_.unit, model_words ? *model_words : t_.words) {
   writeFileAtomic(prom_path, renderProm(t_, PromFormat::Hex));
   dut_ = makeSpecDut(config, SpecDutOptions{prom_path, ""});
   verifyLoadedProm(*dut_, t_.words, prom_path, t_.unit);
@@ -64,7 +117,41 @@ uint64_t RtlSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector
     }
     const SpecOut o = dut_->tick(v);
     ++cycles;
-    if (o.valid) out.push_back(o.rgb);
+    if (o.valid) {
+      const SpecRequest& r = in[out.size()];
+      const SpecOut m = model_.evaluate(r.shin, r.cos, r.light);
+      if (m.spec != o.spec || m.rgb != o.rgb) {
+        // The request alone from reset: one valid cycle, then the pipeline's latency.
+        fs::create_directories(fail_dir_);
+        const std::string vec = fmt::format("{}/render_spec_{}_fail.vec", fail_dir_, config_);
+        const std::string fst = fmt::format("{}/render_spec_{}_fail.fst", fail_dir_, config_);
+        const std::string hex = fmt::format("{}/render_spec_{}_fail.hex", fail_dir_, config_);
+        writeFileAtomic(hex, renderProm(t_, PromFormat::Hex));
+        SpecVectors sv;
+        sv.config = config_;
+        sv.params = t_.unit;
+        sv.prom = fs::path(hex).filename().string();
+        sv.source = "shadesim render --rtl: the specular request the RTL and the model disagree on, alone, from reset";
+        SpecUnitModel replay(t_.unit, model_.prom());
+        for (int c = 0; c < t_.unit.latency(); ++c) {
+          SpecIn si;
+          if (c == 0) si = {true, r.shin, r.cos, r.light};
+          sv.in.push_back(si);
+          sv.expected.push_back(replay.tick(si));
+        }
+        writeSpecVectors(vec, sv);
+        ReplayOptions ro;
+        ro.fst_path = fst;
+        const ReplayResult rr = replayVectorFile(vec, ro);
+        throw std::runtime_error(fmt::format(
+            "specular unit ({}): the RTL differs from the model for shininess code {}, cos {:#x}, light ({}, {}, {}): "
+            "model spec {:#x} rgb ({}, {}, {}), rtl spec {:#x} rgb ({}, {}, {}); the request alone: {} ({}), waveform {}",
+            config_, r.shin, r.cos, r.light[0], r.light[1], r.light[2], m.spec, m.rgb[0], m.rgb[1], m.rgb[2], o.spec,
+            o.rgb[0], o.rgb[1], o.rgb[2], vec,
+            rr.first ? "replays alone: " + rr.first->describe() : std::string("does NOT fail when replayed alone"), fst));
+      }
+      out.push_back(o.rgb);
+    }
     if (cycles > limit) throw std::logic_error("RtlSpecEngine: results missing from the specular unit");
   }
   return cycles;

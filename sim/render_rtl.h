@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "render/render.h"
@@ -13,29 +14,43 @@ namespace shd {
 
 // Each descriptor runs from IDLE to IDLE with the consumer always ready. The ports show the
 // cycles and the fragments; the ROW/SPAN split of the cycles is internal (left 0).
+// The cycle-accurate model ticks beside the RTL and every output is compared on every cycle. On
+// the first difference the triangle is saved alone, from reset, as a vector file
+// <fail_dir>/render_span_<mode>_fail.vec with the model's expected outputs, replayed into an FST
+// beside it, and run() throws std::runtime_error naming the triangle, the cycle, both values
+// and the files. (model_params: fault injection for the tests, a model of another layout.)
 class RtlSpanEngine final : public SpanEngine {
  public:
-  explicit RtlSpanEngine(SpanMode mode);
+  explicit RtlSpanEngine(SpanMode mode, std::string fail_dir = ".", std::optional<SpanParams> model_params = {});
   const SpanParams& params() const override { return dut_->params(); }
   SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override;
 
  private:
+  std::string mode_, fail_dir_;
   std::unique_ptr<SpanDut> dut_;
-  SpanOut out_;
+  SpanUnitModel model_;
+  SpanOut out_, expected_;
 };
 
 // A batch streams through the pipeline with valid_i high on every cycle; the results are
 // collected in order as valid_o rises. The PROM is written to `prom_path` (hex) and the words
-// the simulator loaded are checked against the table.
+// the simulator loaded are checked against the table. Every result is compared with the
+// model's; on the first difference the request is saved alone, from reset, as
+// <fail_dir>/render_spec_<config>_fail.vec (with a copy of the PROM beside it), replayed into an
+// FST, and evaluate() throws std::runtime_error naming the request, both values and the files.
+// (model_words: fault injection for the tests, the model's PROM words.)
 class RtlSpecEngine final : public SpecEngine {
  public:
-  RtlSpecEngine(const std::string& config, PromTable table, const std::string& prom_path);
+  RtlSpecEngine(const std::string& config, PromTable table, const std::string& prom_path, std::string fail_dir = ".",
+                std::optional<std::vector<PromWord>> model_words = {});
   const PromTable& table() const override { return t_; }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
 
  private:
+  std::string config_, fail_dir_;
   PromTable t_;
   std::unique_ptr<SpecDut> dut_;
+  SpecUnitModel model_;
 };
 
 }  // namespace shd

@@ -27,10 +27,7 @@ nlohmann::json toJson(const SpanDesc& d) {
           {"iref", d.iref}, {"didx", d.didx},           {"didy", d.didy},         {"tri", tris}};
 }
 
-namespace {
-
-// The first difference between two cycles' outputs, or "".
-std::string compareOutputs(const SpanOut& exp, const SpanOut& got) {
+std::string compareSpanOutputs(const SpanOut& exp, const SpanOut& got) {
   if (exp.desc_ready != got.desc_ready)
     return fmt::format("desc_ready: model {} rtl {}", exp.desc_ready, got.desc_ready);
   if (exp.out_valid != got.out_valid) return fmt::format("out_valid: model {} rtl {}", exp.out_valid, got.out_valid);
@@ -47,8 +44,6 @@ std::string compareOutputs(const SpanOut& exp, const SpanOut& got) {
   }
   return "";
 }
-
-}  // namespace
 
 SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(SpanDesc&)>& next,
                              const SpanCosimOptions& opts) {
@@ -87,7 +82,7 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
     window.emplace_back(in.desc_valid, in.out_ready);
     if (exp.out_valid && in.out_ready)
       for (const SpanLaneOut& l : exp.lane) res.fragments += l.valid ? 1 : 0;
-    const std::string diff = compareOutputs(exp, got);
+    const std::string diff = compareSpanOutputs(exp, got);
     if (!diff.empty()) {
       ++res.mismatches;
       if (!res.first) {

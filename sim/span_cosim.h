@@ -58,4 +58,7 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
 
 nlohmann::json toJson(const SpanDesc& d);
 
+// The first difference between the outputs of one cycle (model, rtl) as a message, or "".
+std::string compareSpanOutputs(const SpanOut& model, const SpanOut& rtl);
+
 }  // namespace shd

@@ -2,11 +2,13 @@
 // model's image pixel for pixel, and the methods order as expected against the reference.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <random>
 
 #include "render/render.h"
 #include "render_rtl.h"
+#include "replay.h"
 #include "scene/scene.h"
 
 using namespace shd;
@@ -81,6 +83,76 @@ TEST(Render, RtlInTheLoopEqualsTheModelPixelForPixel) {
       EXPECT_EQ(hw.stats.spec_cycles, model.stats.spec_cycles);
       EXPECT_GT(model.stats.spec_evaluations, 1000u);
     }
+  }
+}
+
+// The engines compare the RTL with the model on every cycle (span) and every result (spec): a
+// model of another lane layout, or a PROM word flipped in the model only, must stop the render
+// with the triangle or request saved alone as a vector file that fails when replayed, and an FST.
+TEST(Render, RtlDisagreementSavesTheCaseAlone) {
+  const Scene s = loadScene("builtin:sphere");
+  const fs::path dir = fs::path(testing::TempDir()) / "render_rtl_fault";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const SpecUnitConfig c = SpecUnitConfig::load(configPath("default"));
+  const PromTable table = buildPromTable(PromRequest::fromContent(c.prom), c.rtl);
+  RenderOptions o;
+  o.method = Method::Phong;
+  o.brdf = "quadratic";
+  auto messageOf = [&](SpanEngine& span, SpecEngine& spec) {
+    SpecEngines view;
+    view.quadratic = &spec;
+    try {
+      render(s, o, span, view);
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  {  // span: the seg2 RTL against a model with the even/odd lane layout
+    o.span_mode = SpanMode::Seg2;
+    RtlSpanEngine span(SpanMode::Seg2, dir.string(), SpanParams::forMode(SpanMode::EvenOdd));
+    RtlSpecEngine spec("default", table, (dir / "spec.hex").string(), dir.string());
+    const std::string msg = messageOf(span, spec);
+    std::printf("%s\n", msg.c_str());
+    EXPECT_NE(msg.find("span unit (seg2): the RTL differs from the model on triangle"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("replays alone"), std::string::npos) << msg;
+    const fs::path vec = dir / "render_span_seg2_fail.vec";
+    ASSERT_TRUE(fs::exists(vec));
+    EXPECT_GT(fs::file_size(dir / "render_span_seg2_fail.fst"), 1000u);
+    const ReplayResult r = replayVectorFile(vec.string());
+    ASSERT_TRUE(r.first.has_value());
+    EXPECT_EQ(r.first->cycle, r.cycles) << "the failing cycle is the file's last";
+  }
+  {  // spec: one PROM word differs in the model only (the word of the sphere's shininess)
+    o.span_mode = SpanMode::Serial;
+    std::vector<PromWord> words = table.words;
+    const int addr = table.addressOf(std::round(s.materials.at(0).shininess));
+    ASSERT_GE(addr, 0);
+    words[static_cast<size_t>(addr)] ^= PromWord{1} << 3;
+    RtlSpanEngine span(SpanMode::Serial, dir.string());
+    RtlSpecEngine spec("default", table, (dir / "spec.hex").string(), dir.string(), words);
+    const std::string msg = messageOf(span, spec);
+    std::printf("%s\n", msg.c_str());
+    EXPECT_NE(msg.find("specular unit (default): the RTL differs from the model for shininess code"), std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("replays alone"), std::string::npos) << msg;
+    const fs::path vec = dir / "render_spec_default_fail.vec";
+    ASSERT_TRUE(fs::exists(vec));
+    ASSERT_TRUE(fs::exists(dir / "render_spec_default_fail.hex"));
+    EXPECT_GT(fs::file_size(dir / "render_spec_default_fail.fst"), 500u);
+    EXPECT_TRUE(replayVectorFile(vec.string()).first.has_value());
+  }
+  {  // and agreeing units save nothing
+    const fs::path clean = dir / "clean";
+    fs::create_directories(clean);
+    o.span_mode = SpanMode::Serial;
+    RtlSpanEngine span(SpanMode::Serial, clean.string());
+    RtlSpecEngine spec("default", table, (clean / "spec.hex").string(), clean.string());
+    EXPECT_EQ(messageOf(span, spec), "");
+    size_t files = 0;
+    for (const auto& e : fs::directory_iterator(clean)) files += e.path().extension() == ".vec" ? 1 : 0;
+    EXPECT_EQ(files, 0u);
   }
 }
 
