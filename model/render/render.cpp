@@ -149,12 +149,14 @@ bool adaptiveChoice(const std::array<PVertex, 3>& t, const ShadeContext& ctx, co
 }
 
 // normal-bisection (see render.h): the normal used at each fragment, row by row in x order.
+// The interpolated (unnormalised) normal of a fragment, from attributes 0..2.
+Vec3 rawNormal(const int64_t* attr) {
+  return Vec3{static_cast<double>(attr[0]) * kUnitLsb, static_cast<double>(attr[1]) * kUnitLsb,
+              static_cast<double>(attr[2]) * kUnitLsb};
+}
+
 void bisectNormals(const std::vector<SpanFragment>& frags, double threshold, std::vector<size_t>& order,
                    std::vector<Vec3>& bisected, uint64_t& normalisations) {
-  auto rawNormal = [](const SpanFragment& f) {
-    return Vec3{static_cast<double>(f.attr[0]) * kUnitLsb, static_cast<double>(f.attr[1]) * kUnitLsb,
-                static_cast<double>(f.attr[2]) * kUnitLsb};
-  };
   order.resize(frags.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -170,7 +172,7 @@ void bisectNormals(const std::vector<SpanFragment>& frags, double threshold, std
     n.assign(j - i, Vec3{0, 0, 0});
     node.assign(j - i, false);
     auto exact = [&](size_t k) {
-      n[k] = normalize(rawNormal(frags[order[i + k]]));
+      n[k] = normalize(rawNormal(frags[order[i + k]].attr.data()));
       node[k] = true;
       ++normalisations;
     };
@@ -487,10 +489,6 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           for (size_t k = 0; k < 3; ++k) fb.rgb[p * 3 + k] = c[k];
           fb.depth[p] = static_cast<int32_t>(w);
           fb.tri[p] = static_cast<int32_t>(tag);
-        };
-        auto rawNormal = [&](const int64_t* attr) {
-          return Vec3{static_cast<double>(attr[0]) * kUnitLsb, static_cast<double>(attr[1]) * kUnitLsb,
-                      static_cast<double>(attr[2]) * kUnitLsb};
         };
         // phong-incremental: |N|^2 along each run of consecutive pixels of a row by the
         // recurrence, restarted (three products) where the stream is not the next pixel. The
