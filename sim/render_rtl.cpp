@@ -15,6 +15,18 @@ namespace shd {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// Replays a saved failing case on the RTL into an FST beside it: the verdict for the message.
+std::string replayAlone(const std::string& vec, const std::string& fst) {
+  ReplayOptions ro;
+  ro.fst_path = fst;
+  const ReplayResult rr = replayVectorFile(vec, ro);
+  return rr.first ? "replays alone: " + rr.first->describe() : std::string("does NOT fail when replayed alone");
+}
+
+}  // namespace
+
 RtlSpanEngine::RtlSpanEngine(SpanMode mode, std::string fail_dir, std::optional<SpanParams> model_params)
     : mode_(toString(mode)),
       fail_dir_(std::move(fail_dir)),
@@ -60,14 +72,10 @@ SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
         v.cycles.push_back(std::move(vc));
       }
       writeSpanVectors(vec, v);
-      ReplayOptions ro;
-      ro.fst_path = fst;
-      const ReplayResult rr = replayVectorFile(vec, ro);
       throw std::runtime_error(fmt::format(
           "span unit ({}): the RTL differs from the model on triangle {} at its cycle {}: {}; the triangle alone: {} "
           "({}), waveform {}",
-          mode_, d.tag, run.cycles, diff, vec,
-          rr.first ? "replays alone: " + rr.first->describe() : std::string("does NOT fail when replayed alone"), fst));
+          mode_, d.tag, run.cycles, diff, vec, replayAlone(vec, fst), fst));
     }
     if (!accepted) {
       if (!out_.desc_ready) throw std::logic_error("RtlSpanEngine: the span unit is not idle");
@@ -140,15 +148,11 @@ uint64_t RtlSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector
           sv.expected.push_back(replay.tick(si));
         }
         writeSpecVectors(vec, sv);
-        ReplayOptions ro;
-        ro.fst_path = fst;
-        const ReplayResult rr = replayVectorFile(vec, ro);
         throw std::runtime_error(fmt::format(
             "specular unit ({}): the RTL differs from the model for shininess code {}, cos {:#x}, light ({}, {}, {}): "
             "model spec {:#x} rgb ({}, {}, {}), rtl spec {:#x} rgb ({}, {}, {}); the request alone: {} ({}), waveform {}",
             config_, r.shin, r.cos, r.light[0], r.light[1], r.light[2], m.spec, m.rgb[0], m.rgb[1], m.rgb[2], o.spec,
-            o.rgb[0], o.rgb[1], o.rgb[2], vec,
-            rr.first ? "replays alone: " + rr.first->describe() : std::string("does NOT fail when replayed alone"), fst));
+            o.rgb[0], o.rgb[1], o.rgb[2], vec, replayAlone(vec, fst), fst));
       }
       out.push_back(o.rgb);
     }

@@ -10,26 +10,9 @@
 
 #include "spec_dut.h"
 #include "verilated_harness.h"
+#include "verilated_ports.h"
 
 namespace shd {
-
-// A PROM word as Verilator stores it: CData/SData/IData/QData, or VlWide for > 64 bits.
-inline PromWord toPromWord(uint64_t v) { return v; }
-template <std::size_t N>
-PromWord toPromWord(const VlWide<N>& w) {
-  static_assert(N <= 4, "PROM words are at most 128 bits");
-  PromWord r = 0;
-  for (std::size_t i = 0; i < N; ++i) r |= static_cast<PromWord>(w[i]) << (32 * i);
-  return r;
-}
-
-template <class T, std::size_t Depth>
-std::vector<PromWord> romWordsOf(const VlUnpacked<T, Depth>& rom) {
-  std::vector<PromWord> words;
-  words.reserve(Depth);
-  for (std::size_t i = 0; i < Depth; ++i) words.push_back(toPromWord(rom[i]));
-  return words;
-}
 
 template <class V>
 class SpecDutImpl final : public SpecDut {
@@ -67,7 +50,7 @@ class SpecDutImpl final : public SpecDut {
     return out;
   }
 
-  std::vector<PromWord> romWords() override { return romWordsOf(h_.dut().rootp->shd_spec_unit__DOT__u_rom__DOT__rom); }
+  std::vector<PromWord> romWords() override { return ports::romWords(h_.dut().rootp->shd_spec_unit__DOT__u_rom__DOT__rom); }
 
   uint64_t cycle() const override { return h_.cycle(); }
   void finish() override { h_.finish(); }

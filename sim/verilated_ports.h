@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <type_traits>
+#include <vector>
 
 #include <verilated.h>
 
@@ -57,6 +58,24 @@ uint64_t get(const VlWide<N>& port, int lsb, int width) {
 inline int64_t signExtend(uint64_t v, int width) {
   const uint64_t sign = uint64_t{1} << (width - 1);
   return static_cast<int64_t>((v ^ sign) - sign);
+}
+
+// A ROM's words as Verilator stores an unpacked array of them: CData/SData/IData/QData, or
+// VlWide for words wider than 64 bits (at most 128: unsigned __int128, the PROM word type).
+inline unsigned __int128 romWord(uint64_t v) { return v; }
+template <std::size_t N>
+unsigned __int128 romWord(const VlWide<N>& w) {
+  static_assert(N <= 4, "ROM words are at most 128 bits");
+  unsigned __int128 r = 0;
+  for (std::size_t i = 0; i < N; ++i) r |= static_cast<unsigned __int128>(w[i]) << (32 * i);
+  return r;
+}
+template <class T, std::size_t Depth>
+std::vector<unsigned __int128> romWords(const VlUnpacked<T, Depth>& rom) {
+  std::vector<unsigned __int128> words;
+  words.reserve(Depth);
+  for (std::size_t i = 0; i < Depth; ++i) words.push_back(romWord(rom[i]));
+  return words;
 }
 
 }  // namespace shd::ports

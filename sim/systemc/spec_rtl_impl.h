@@ -9,26 +9,9 @@
 #include <verilated.h>
 
 #include "spec_rtl.h"
+#include "verilated_ports.h"
 
 namespace shd {
-
-namespace detail {
-inline PromWord promWordOf(uint64_t v) { return v; }
-template <std::size_t N>
-PromWord promWordOf(const VlWide<N>& w) {
-  static_assert(N <= 4, "PROM words are at most 128 bits");
-  PromWord r = 0;
-  for (std::size_t i = 0; i < N; ++i) r |= static_cast<PromWord>(w[i]) << (32 * i);
-  return r;
-}
-template <class T, std::size_t Depth>
-std::vector<PromWord> romWordsOf(const VlUnpacked<T, Depth>& rom) {
-  std::vector<PromWord> words;
-  words.reserve(Depth);
-  for (std::size_t i = 0; i < Depth; ++i) words.push_back(promWordOf(rom[i]));
-  return words;
-}
-}  // namespace detail
 
 template <class V>
 class SpecRtlImpl final : public SpecRtl {
@@ -55,7 +38,7 @@ class SpecRtlImpl final : public SpecRtl {
   const std::string& configName() const override { return config_; }
   const SpecUnitParams& params() const override { return p_; }
   std::vector<PromWord> romWords() const override {
-    return detail::romWordsOf(dut_.rootp->shd_spec_unit__DOT__u_rom__DOT__rom);
+    return ports::romWords(dut_.rootp->shd_spec_unit__DOT__u_rom__DOT__rom);
   }
   void traceFst(VerilatedFstC& tfp, int levels) override { dut_.trace(&tfp, levels); }
   void finalize() override { dut_.final(); }

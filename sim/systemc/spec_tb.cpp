@@ -16,32 +16,6 @@ std::ostream& operator<<(std::ostream& os, const SpecExpect& e) {
 
 // ---------------------------------------------------------------- sources
 
-RandomSpecSource::RandomSpecSource(const SpecUnitParams& p, uint64_t seed, uint64_t vectors, double gap)
-    : p_(p), rng_(seed), vectors_(vectors), gap_(gap) {}
-
-bool RandomSpecSource::next(SpecIn& in) {
-  if (sent_ >= vectors_) return false;
-  if (gap_left_ == 0 && gap_ > 0 && std::uniform_real_distribution<double>(0, 1)(rng_) < gap_)
-    gap_left_ = 1 + static_cast<int>(rng_() % 3);
-  const uint64_t r = rng_(), r2 = rng_();
-  const uint32_t one = static_cast<uint32_t>(p_.cosOne());
-  in.shin = static_cast<uint32_t>(r % static_cast<uint64_t>(p_.promDepth()));
-  const unsigned sel = static_cast<unsigned>(r2 & 31);
-  if (sel == 0) in.cos = one + static_cast<uint32_t>((r2 >> 8) % one);                  // above 1.0
-  else if (sel < 9) in.cos = one - static_cast<uint32_t>((r2 >> 8) % (one / 64 + 1));  // near 1.0
-  else in.cos = static_cast<uint32_t>((r2 >> 8) % (one + 1));
-  const uint32_t lmask = static_cast<uint32_t>(p_.lightMax());
-  for (int k = 0; k < 3; ++k) in.light[static_cast<size_t>(k)] = static_cast<uint32_t>(r >> (20 + 12 * k)) & lmask;
-  if (gap_left_ > 0) {
-    --gap_left_;
-    in.valid = false;
-    return true;
-  }
-  in.valid = true;
-  ++sent_;
-  return true;
-}
-
 FileSpecSource::FileSpecSource(const SpecVectors& v) : v_(v) {
   for (const SpecIn& in : v_.in) valid_ += in.valid ? 1 : 0;
 }

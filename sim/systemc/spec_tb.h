@@ -27,6 +27,7 @@
 
 #include <systemc>
 
+#include "device/spec_stimulus.h"
 #include "device/spec_unit.h"
 #include "sc_common.h"
 #include "vector_file.h"
@@ -55,22 +56,18 @@ class SpecSource {
   virtual uint64_t total() const = 0;  // valid inputs it will produce
 };
 
-// Seeded random vectors: shininess uniform over the PROM addresses; cos uniform over [0, 1],
-// with one vector in four within the last 1/64 below 1.0 (the narrow lobes of large n) and one
-// in 32 above 1.0 (input saturation); light channels uniform. valid_i dropped with probability
-// gap for 1..3 cycles at a time; the inputs change on idle cycles too (the unit must ignore them).
+// Seeded random vectors: RandomSpecStimulus (device/spec_stimulus.h), the C++ co-simulation's
+// stream: shininess over the PROM, cos biased toward 1.0 and above it, valid_i dropped with
+// probability gap for 1..3 cycles at a time; the inputs change on idle cycles too.
 class RandomSpecSource final : public SpecSource {
  public:
-  RandomSpecSource(const SpecUnitParams& p, uint64_t seed, uint64_t vectors, double gap);
-  bool next(SpecIn& in) override;
-  uint64_t total() const override { return vectors_; }
+  RandomSpecSource(const SpecUnitParams& p, uint64_t seed, uint64_t vectors, double gap)
+      : stim_(p, seed, vectors, gap) {}
+  bool next(SpecIn& in) override { return stim_.next(in); }
+  uint64_t total() const override { return stim_.total(); }
 
  private:
-  SpecUnitParams p_;
-  std::mt19937_64 rng_;
-  uint64_t vectors_, sent_ = 0;
-  double gap_;
-  int gap_left_ = 0;
+  RandomSpecStimulus stim_;
 };
 
 // The cycles of a vector file (sim/vector_file.h), one per active cycle, with their expected
