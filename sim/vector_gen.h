@@ -5,7 +5,7 @@
 //   entry, depth-1 (padding: the all-zero word)} x cos codes {0, 1, 1.0/2, 1.0 - 1 LSB, 1.0,
 //   1.0 + 1 LSB, the largest code (saturates to 1.0)} x light {0, full scale, (1, mid, max-1)};
 //   degree 3: cos one code below, at and above the cut-off code of every eighth table entry and
-//   the last; then RandomSpecStimulus (sim/spec_cosim.h: near-1 and above-1 cosines, valid dropped for
+//   the last; then RandomSpecStimulus (model/device/spec_stimulus.h: near-1 and above-1 cosines, valid dropped for
 //   1..3 cycles with probability 0.2, inputs changing on idle cycles) up to the cycle count.
 // span: descriptors from triangle setup of generator triangles (model/raster/trigen.h):
 //   1. one triangle of every size class x every shape (5 x 6; zero-area ones are dropped by

@@ -85,7 +85,7 @@ if [ -z "$work" ]; then
   trap 'rm -rf "$work"' EXIT
 fi
 mkdir -p "$work"
-if ! iverilog -g2012 -Wall -s "$top" "${pargs[@]}" -o "$work/$top.vvp" \
+if ! iverilog -g2012 -Wall -I "$root/testbench/icarus" -s "$top" "${pargs[@]}" -o "$work/$top.vvp" \
        "$root/testbench/icarus/$top.v" "${sources[@]}" >"$work/iverilog.log" 2>&1 ||
    [ -s "$work/iverilog.log" ]; then
   cat "$work/iverilog.log" >&2

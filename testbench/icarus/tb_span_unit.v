@@ -3,7 +3,7 @@
 // Why:      the vector files hold the golden model's outputs cycle by cycle; the same files pass
 //           under Verilator (`shadesim replay`), so the RTL means the same in both simulators.
 // Run:      testbench/icarus/run_icarus.sh FILE does all of it; by hand:
-//             iverilog -g2012 -Wall -s tb_span_unit -Ptb_span_unit.<Name>=<value>... -o tb.vvp \
+//             iverilog -g2012 -Wall -I testbench/icarus -s tb_span_unit -Ptb_span_unit.<Name>=<value>... -o tb.vvp \
 //               testbench/icarus/tb_span_unit.v rtl/shd_span_unit.v
 //             vvp -n tb.vvp +vec=/abs/file.vec [+dump=/abs/wave.fst -fst]
 //           The parameters are those of the configuration; the file's "# params" line must
@@ -97,7 +97,7 @@ module tb_span_unit #(
   reg [8*1024-1:0] line;
   integer fd, n, ch, lineno, cycle, descs, fragments, compared, mismatches, bad_cycles;
   integer j, s, a, l, e, digits;
-  reg     cycle_bad, params_seen, pending, have_desc, done;
+  reg     cycle_bad, params_seen, pending, have_desc, done, dumping;
   reg [63:0] v, exp_mask, exp_tag, exp_dr, exp_ov;
   reg [8*40-1:0] signal;
   integer hp [0:9];
@@ -106,12 +106,8 @@ module tb_span_unit #(
   // so a record's fields are taken from its own line only.
   localparam integer EOF = -1;
 
-  task automatic malformed(input [8*200-1:0] what);
-    begin
-      $display("tb_span_unit: error: %0s, line %0d: %0s", path, lineno, what);
-      $fatal(1);
-    end
-  endtask
+  localparam TB_NAME = "tb_span_unit";
+`include "tb_vectors.vh"
 
   function automatic is_blank(input integer c);
     is_blank = (c == " ") || (c == "\t") || (c == "\r");
@@ -163,19 +159,6 @@ module tb_span_unit #(
       if (ch == "\n") begin
         lineno = lineno + 1;
         advance;
-      end
-    end
-  endtask
-
-  task automatic check(input [8*40-1:0] name, input [63:0] expected, input [63:0] got);
-    begin
-      compared = compared + 1;
-      if (got !== expected) begin
-        mismatches = mismatches + 1;
-        if (!cycle_bad) bad_cycles = bad_cycles + 1;
-        cycle_bad = 1'b1;
-        if (mismatches <= MAX_SHOWN)
-          $display("MISMATCH cycle %0d: %0s: expected 0x%0h, rtl 0x%0h", cycle, name, expected, got);
       end
     end
   endtask
@@ -258,19 +241,8 @@ module tb_span_unit #(
   endtask
 
   initial begin
-    if (!$value$plusargs("vec=%s", path)) begin
-      $display("tb_span_unit: error: no vector file: pass +vec=<absolute path>");
-      $fatal(1);
-    end
-    fd = $fopen(path, "r");
-    if (fd == 0) begin
-      $display("tb_span_unit: error: cannot open vector file %0s", path);
-      $fatal(1);
-    end
-    if ($value$plusargs("dump=%s", dump)) begin
-      $dumpfile(dump);
-      $dumpvars(0, tb_span_unit);
-    end
+    open_vectors(dumping);
+    if (dumping) $dumpvars(0, tb_span_unit);
     lineno = 0; cycle = 0; descs = 0; fragments = 0; compared = 0; mismatches = 0; bad_cycles = 0;
     params_seen = 1'b0; pending = 1'b0; have_desc = 1'b0;
 
@@ -331,14 +303,7 @@ module tb_span_unit #(
         malformed("unknown record (D, C or a # comment expected)");
       end
     end
-    $fclose(fd);
-    if (cycle == 0) malformed("no C records (cycles)");
-    if (mismatches != 0) begin
-      if (mismatches > MAX_SHOWN) $display("(%0d more mismatches not shown)", mismatches - MAX_SHOWN);
-      $display("tb_span_unit: FAIL %0s: %0d of %0d output values differ, in %0d of %0d cycles", path, mismatches,
-               compared, bad_cycles, cycle);
-      $fatal(1);
-    end
+    fail_on_mismatches("no C records (cycles)");
     $display("tb_span_unit: PASS %0s: %0d cycles, %0d descriptors, %0d valid lane outputs, %0d output values compared, 0 mismatches",
              path, cycle, descs, fragments, compared);
     $finish;

@@ -3,7 +3,7 @@
 // Why:      the vector files hold the golden model's outputs cycle by cycle; the same files pass
 //           under Verilator (`shadesim replay`), so the RTL means the same in both simulators.
 // Run:      testbench/icarus/run_icarus.sh FILE does all of it; by hand:
-//             iverilog -g2012 -Wall -s tb_spec_unit -Ptb_spec_unit.<Name>=<value>... -o tb.vvp \
+//             iverilog -g2012 -Wall -I testbench/icarus -s tb_spec_unit -Ptb_spec_unit.<Name>=<value>... -o tb.vvp \
 //               testbench/icarus/tb_spec_unit.v rtl/shd_spec_unit.v rtl/shd_coef_rom.v rtl/shd_pipe_reg.v
 //             vvp -n tb.vvp +vec=/abs/file.vec +prom=/abs/prom.hex [+dump=/abs/wave.fst -fst]
 //           Paths must be absolute (TOOLCHAIN pitfall 6). Parameters: those of the configuration,
@@ -60,6 +60,7 @@ module tb_spec_unit #(
   integer fd, n, i, lineno, cycle, results, compared, mismatches, bad_cycles;
   reg     cycle_bad;
   reg     params_seen;
+  reg     dumping;
   integer hp [0:10];
   reg [63:0] f [0:11];   // one more than the 11 columns: a 12th field makes the line malformed
 
@@ -70,25 +71,8 @@ module tb_spec_unit #(
     end
   endtask
 
-  task automatic malformed(input [8*160-1:0] what);
-    begin
-      $display("tb_spec_unit: error: %0s, line %0d: %0s", path, lineno, what);
-      $fatal(1);
-    end
-  endtask
-
-  task automatic check(input [8*16-1:0] name, input [63:0] expected, input [63:0] got);
-    begin
-      compared = compared + 1;
-      if (got !== expected) begin
-        mismatches = mismatches + 1;
-        if (!cycle_bad) bad_cycles = bad_cycles + 1;
-        cycle_bad = 1'b1;
-        if (mismatches <= MAX_SHOWN)
-          $display("MISMATCH cycle %0d: %0s: expected 0x%0h, rtl 0x%0h", cycle, name, expected, got);
-      end
-    end
-  endtask
+  localparam TB_NAME = "tb_spec_unit";
+`include "tb_vectors.vh"
 
   // A column of `width` bits: hex without X or Z digits, no bit at or above the width.
   task automatic field(input integer k, input integer width, input [8*16-1:0] name);
@@ -102,19 +86,8 @@ module tb_spec_unit #(
   endtask
 
   initial begin
-    if (!$value$plusargs("vec=%s", path)) begin
-      $display("tb_spec_unit: error: no vector file: pass +vec=<absolute path>");
-      $fatal(1);
-    end
-    fd = $fopen(path, "r");
-    if (fd == 0) begin
-      $display("tb_spec_unit: error: cannot open vector file %0s", path);
-      $fatal(1);
-    end
-    if ($value$plusargs("dump=%s", dump)) begin
-      $dumpfile(dump);
-      $dumpvars(0, tb_spec_unit);
-    end
+    open_vectors(dumping);
+    if (dumping) $dumpvars(0, tb_spec_unit);
     lineno = 0; cycle = 0; results = 0; compared = 0; mismatches = 0; bad_cycles = 0;
     params_seen = 1'b0;
 
@@ -188,14 +161,7 @@ module tb_spec_unit #(
         end
       end
     end
-    $fclose(fd);
-    if (cycle == 0) malformed("no cycle lines");
-    if (mismatches != 0) begin
-      if (mismatches > MAX_SHOWN) $display("(%0d more mismatches not shown)", mismatches - MAX_SHOWN);
-      $display("tb_spec_unit: FAIL %0s: %0d of %0d output values differ, in %0d of %0d cycles", path, mismatches,
-               compared, bad_cycles, cycle);
-      $fatal(1);
-    end
+    fail_on_mismatches("no cycle lines");
     $display("tb_spec_unit: PASS %0s: %0d cycles, %0d valid results, %0d output values compared, 0 mismatches",
              path, cycle, results, compared);
     $finish;
