@@ -81,7 +81,9 @@ TEST(Render, RtlInTheLoopEqualsTheModelPixelForPixel) {
       EXPECT_EQ(hw.fb.depth, model.fb.depth);
       EXPECT_EQ(hw.stats.span_cycles, model.stats.span_cycles);
       EXPECT_EQ(hw.stats.spec_cycles, model.stats.spec_cycles);
-      EXPECT_GT(model.stats.spec_evaluations, 1000u);
+      // The specular unit is exercised: per lit pixel (phong, about 80,000), or per lit vertex
+      // of the triangles that survive culling (gouraud: 826 of the sphere's 4160 vertices).
+      EXPECT_GT(model.stats.spec_evaluations, m == Method::Phong ? 10000u : 500u);
     }
   }
 }

@@ -5,6 +5,7 @@
 #include "raster/setup.h"
 #include "raster/span_unit.h"
 #include "raster/desc_stream.h"
+#include "raster/trigen.h"
 
 #include <gtest/gtest.h>
 
@@ -148,7 +149,7 @@ TEST(TriangleSetup, SnapsHalfwayCoordinatesAndAttributesToEven) {
   // with Quant::RoundHalfEven: at S = 4 a coordinate k/32 is a half subpixel.
   RasterConfig c = configFor(SpanMode::Serial, 64, 64);
   c.attr_frac_bits = {0, 1, 12, 28};
-  const std::vector<double> xs = {1 + 1 / 32.0, 1 + 3 / 32.0, 2 - 1 / 32.0, 40.5 + 5 / 32.0};
+  const std::vector<double> xs = {1 + 1 / 32.0, 1 + 3 / 32.0, 2 - 1 / 32.0, 40.5 + 5 / 32.0, -1 - 1 / 32.0, -1 - 3 / 32.0};
   const std::vector<double> as = {2.5, 3.5, -2.5, 0.25, 0.75, 1 + std::ldexp(1.0, -13), std::ldexp(3.0, -29)};
   for (double x : xs)
     for (double a : as) {
@@ -166,6 +167,20 @@ TEST(TriangleSetup, SnapsHalfwayCoordinatesAndAttributesToEven) {
   // The halfway cases themselves: 1 + 1/32 -> 16.5 subpixels -> 16; 1 + 3/32 -> 17.5 -> 18.
   EXPECT_EQ(setupTriangle({vtx(1 + 1 / 32.0, 1), vtx(20, 3), vtx(4, 30)}, 1, c).tri.X[0], 16);
   EXPECT_EQ(setupTriangle({vtx(1 + 3 / 32.0, 1), vtx(20, 3), vtx(4, 30)}, 1, c).tri.X[0], 18);
+  // Setup rounds below 2^51 by adding and subtracting 1.5 * 2^52, above through nearbyint:
+  // ties on both sides of the switch, both signs, up to the widest attribute (AttrBits 62).
+  RasterConfig wide = configFor(SpanMode::Serial, 64, 64);
+  wide.unit.AttrBits = 62;
+  wide.attr_frac_bits = {0, 1, 0, 28};
+  for (double a : {0x1p51 - 0.5, 0x1p51 - 1.5, 0x1p51 + 0.5, 0x1p51 + 1.5, 0x1p51 + 1, 0x1p51 + 3, -(0x1p51 - 0.5),
+                   -(0x1p51 + 0.5), -(0x1p51 + 1), 0x1p52 + 1, 0x1p52 + 2,
+                   -0x1p57, 0x1p50 + 0.5, 0x1p50 + 0.25}) {
+    const SetupResult s = setupTriangle({vtx(1, 1, {a, a / 2, 0, 0}), vtx(21, 3, {0, 0, 0, 0}), vtx(4, 30, {0, 0, 0, 0})}, 1, wide);
+    EXPECT_EQ(s.tri.a[0][0], Fixed::fromDouble(a, FixedFormat::s(62, 0), Quant::RoundHalfEven, Overflow::Error).raw())
+        << std::hexfloat << a;
+    EXPECT_EQ(s.tri.a[1][0], Fixed::fromDouble(a / 2, FixedFormat::s(61, 1), Quant::RoundHalfEven, Overflow::Error).raw())
+        << std::hexfloat << a;
+  }
 }
 
 TEST(TriangleSetup, TopLeftBiasAndPlaneOfAHandTriangle) {
@@ -343,6 +358,101 @@ TEST(SpanUnitModel, EveryModeEqualsSerialOnGeneratorTriangles) { checkModesAgain
 
 // The million triangles per mode (slow label: about a minute).
 TEST(SpanUnitModel, EveryModeEqualsSerialOnAMillionTriangles) { checkModesAgainstSerial(20261122, 1000000); }
+
+// Setup's descriptors never make a shown value wrap; other descriptors must still wrap in the
+// walker exactly as in the cycle model (and the RTL). The generator's descriptors run here on
+// units of narrower AttrBits, where colour codes (up to 2^20) and depth codes (up to 2^28)
+// overflow, and with the single lane-triangle of the serial and lane modes flipped.
+TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
+  for (SpanMode m : allSpanModes()) {
+    RasterConfig c;
+    c.unit = SpanParams::forMode(m);
+    DescriptorStream stream(5, 3000, c);
+    uint64_t fragments = 0, wrapped = 0;
+    SpanDesc d;
+    std::vector<SpanFragment> walked, wide;
+    while (stream.next(d)) {
+      for (int bits : {16, 24}) {
+        for (bool flip : {false, true}) {
+          SpanParams p = c.unit;
+          p.AttrBits = bits;
+          SpanDesc x = d;
+          if (flip && p.NumTri == 1) {
+            x.tri[0].flip = true;
+            x.tri[0].ox = 600;
+            x.tri[0].oy = 500;
+          }
+          SpanUnitModel unit(p);
+          const SpanRun run = runSpanUnit(unit, x);
+          walked.clear();
+          walkSpanUnit(p, x, walked);
+          wide.clear();
+          walkSpanUnit(c.unit, x, wide);  // AttrBits 32: nothing wraps
+          ASSERT_EQ(walked.size(), run.fragments.size()) << toString(m) << " AttrBits " << bits;
+          for (size_t i = 0; i < walked.size(); ++i) {
+            ASSERT_TRUE(walked[i].x == run.fragments[i].x && walked[i].y == run.fragments[i].y &&
+                        walked[i].attr == run.fragments[i].attr)
+                << toString(m) << " AttrBits " << bits << " flip " << flip << " fragment " << i << " of triangle "
+                << d.tag;
+            wrapped += walked[i].attr != wide[i].attr ? 1 : 0;
+          }
+          fragments += walked.size();
+        }
+      }
+    }
+    EXPECT_GT(wrapped, fragments / 2) << toString(m);  // both loops ran: most rows wrap, some fit
+    EXPECT_LT(wrapped, fragments) << toString(m);
+  }
+}
+
+// The plane codes are the exact rationals of setup.h rounded half to even: didx = 2^S nx / det,
+// didy = 2^S ny / det, iref = the plane at the reference pixel centre, recomputed here in
+// 128-bit integers, on generator triangles with the renderer's fraction bits (numerators below
+// 2^52: setup's reciprocal estimate) and with 40-bit colour fractions on AttrBits 62
+// (numerators beyond 2^52: its exact division).
+TEST(TriangleSetup, PlaneCodesAreTheExactRationalsRoundedHalfToEven) {
+  using i128 = __int128;
+  auto roundHalfEven = [](i128 n, i128 d) {  // d > 0
+    i128 q = n / d, r = n % d;
+    if (r < 0) {
+      q -= 1;
+      r += d;
+    }
+    if (2 * r > d || (2 * r == d && (q & 1) != 0)) q += 1;
+    return static_cast<int64_t>(q);
+  };
+  for (const std::vector<int>& frac : {std::vector<int>{12, 12, 12, 28}, std::vector<int>{40, 40, 40, 28}}) {
+    RasterConfig c;  // 512 x 512
+    c.unit = SpanParams::forMode(SpanMode::Serial);
+    c.unit.AttrBits = frac[0] > 30 ? 62 : 32;
+    c.attr_frac_bits = frac;
+    TriangleGenerator gen(31);
+    uint64_t planes = 0, wide = 0;
+    for (int n = 0; n < 100000; ++n) {
+      const GenTriangle g = gen.next();
+      const SetupResult s = setupTriangle(toSetupVertices(g, 4), g.id, c);
+      if (s.tri.det == 0) continue;
+      const SnappedTriangle& t = s.tri;
+      const int S = c.subpixel_bits;
+      for (size_t k = 0; k < 4; ++k) {
+        const auto& a = t.a[k];
+        const i128 nx = static_cast<i128>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) - static_cast<i128>(a[2] - a[0]) * (t.Y[1] - t.Y[0]);
+        const i128 ny = static_cast<i128>(t.X[1] - t.X[0]) * (a[2] - a[0]) - static_cast<i128>(t.X[2] - t.X[0]) * (a[1] - a[0]);
+        ASSERT_EQ(s.plane.didx[k], roundHalfEven(nx << S, t.det)) << g.kind() << " attribute " << k;
+        ASSERT_EQ(s.plane.didy[k], roundHalfEven(ny << S, t.det)) << g.kind() << " attribute " << k;
+        const i128 cx = (2 * static_cast<i128>(s.plane.xref) + 1) << S, cy = (2 * static_cast<i128>(s.plane.yref) + 1) << S;
+        const i128 num = 2 * static_cast<i128>(t.det) * a[0] + nx * (cx - 2 * t.X[0]) + ny * (cy - 2 * t.Y[0]);
+        ASSERT_EQ(s.plane.iref[k], roundHalfEven(num, 2 * static_cast<i128>(t.det))) << g.kind() << " attribute " << k;
+        ++planes;
+        const i128 lim = i128{1} << 52;
+        wide += (nx << S) >= lim || (nx << S) <= -lim || num >= lim || num <= -lim ? 1 : 0;
+      }
+    }
+    EXPECT_GT(planes, 300000u);
+    if (frac[0] > 30) EXPECT_GT(wide, planes / 2);  // the exact-division path ran
+    else EXPECT_LT(wide, planes / 100);             // the reciprocal path ran
+  }
+}
 
 TEST(SpanUnitModel, SharedEdgesOfMeshesDrawnExactlyOnce) {
   // Grid and fan meshes: every pixel whose centre lies strictly inside the meshed region is

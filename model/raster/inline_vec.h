@@ -3,19 +3,26 @@
 // lane-triangles (NumTri <= 4) are bounded by the Verilog parameters, so descriptors, setup
 // results and fragments hold them inline: a frame of 100,000 fragments then makes no
 // allocation per fragment or per triangle. Exceeding N throws std::length_error.
+// Elements are constructed when they are added (the storage beyond size() holds no object, so
+// an empty InlineVec<SpanLaneTri, 4> constructs no lane-triangle) and a copy copies size()
+// elements: a descriptor's 16-attribute capacity costs nothing when it holds 4. T must be
+// trivially destructible (no destructor runs when elements are dropped or overwritten).
 #pragma once
 
 #include <algorithm>
-#include <array>
 #include <cstddef>
 #include <initializer_list>
 #include <iterator>
+#include <new>
 #include <stdexcept>
+#include <type_traits>
 
 namespace shd {
 
 template <class T, size_t N>
 class InlineVec {
+  static_assert(std::is_trivially_destructible<T>::value, "InlineVec drops elements without destroying them");
+
  public:
   using value_type = T;
   using size_type = size_t;
@@ -27,7 +34,12 @@ class InlineVec {
   using iterator = T*;
   using const_iterator = const T*;
 
-  InlineVec() = default;
+  InlineVec() {}  // no element constructed (see above)
+  InlineVec(const InlineVec& o) { assign(o.begin(), o.end()); }
+  InlineVec& operator=(const InlineVec& o) {
+    if (this != &o) assign(o.begin(), o.end());
+    return *this;
+  }
   explicit InlineVec(size_t n, const T& v = T()) { assign(n, v); }
   InlineVec(std::initializer_list<T> l) { assign(l.begin(), l.end()); }
   template <class It, class = typename std::iterator_traits<It>::iterator_category>
@@ -41,32 +53,33 @@ class InlineVec {
 
   void assign(size_t n, const T& v) {
     check(n);
-    std::fill_n(a_.begin(), n, v);
+    for (size_t i = 0; i < n; ++i) ::new (static_cast<void*>(a_ + i)) T(v);
     n_ = n;
   }
   template <class It, class = typename std::iterator_traits<It>::iterator_category>
   void assign(It first, It last) {
-    const auto n = std::distance(first, last);
-    check(static_cast<size_t>(n));
-    std::copy(first, last, a_.begin());
-    n_ = static_cast<size_t>(n);
+    check(static_cast<size_t>(std::distance(first, last)));
+    size_t i = 0;
+    for (; first != last; ++first, ++i) ::new (static_cast<void*>(a_ + i)) T(*first);
+    n_ = i;
   }
   void resize(size_t n, const T& v = T()) {
     check(n);
-    if (n > n_) std::fill(a_.begin() + static_cast<std::ptrdiff_t>(n_), a_.begin() + static_cast<std::ptrdiff_t>(n), v);
+    for (size_t i = n_; i < n; ++i) ::new (static_cast<void*>(a_ + i)) T(v);
     n_ = n;
   }
   void push_back(const T& v) {
     check(n_ + 1);
-    a_[n_++] = v;
+    ::new (static_cast<void*>(a_ + n_)) T(v);
+    ++n_;
   }
   void clear() { n_ = 0; }
 
   size_t size() const { return n_; }
   bool empty() const { return n_ == 0; }
   static constexpr size_t capacity() { return N; }
-  T* data() { return a_.data(); }
-  const T* data() const { return a_.data(); }
+  T* data() { return a_; }
+  const T* data() const { return a_; }
   T& operator[](size_t i) { return a_[i]; }
   const T& operator[](size_t i) const { return a_[i]; }
   T& at(size_t i) { return i < n_ ? a_[i] : throw std::out_of_range("InlineVec::at"); }
@@ -75,10 +88,10 @@ class InlineVec {
   const T& front() const { return a_[0]; }
   T& back() { return a_[n_ - 1]; }
   const T& back() const { return a_[n_ - 1]; }
-  iterator begin() { return a_.data(); }
-  iterator end() { return a_.data() + n_; }
-  const_iterator begin() const { return a_.data(); }
-  const_iterator end() const { return a_.data() + n_; }
+  iterator begin() { return a_; }
+  iterator end() { return a_ + n_; }
+  const_iterator begin() const { return a_; }
+  const_iterator end() const { return a_ + n_; }
 
   friend bool operator==(const InlineVec& a, const InlineVec& b) {
     return a.n_ == b.n_ && std::equal(a.begin(), a.end(), b.begin());
@@ -89,7 +102,9 @@ class InlineVec {
   static void check(size_t n) {
     if (n > N) throw std::length_error("InlineVec: more elements than its capacity");
   }
-  std::array<T, N> a_{};
+  union {
+    T a_[N];  // elements [0, n_) constructed in place
+  };
   size_t n_ = 0;
 };
 

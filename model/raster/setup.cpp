@@ -14,12 +14,16 @@ namespace {
 
 using i128 = __int128;
 
-// round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven (nearbyint rounds half to even
-// in the default rounding mode), without its format checks: the callers have bounded |v 2^frac|
-// well below 2^62 (the guard band, the attribute range).
-// (2^frac as a double multiplier: exact, like ldexp, and no libm call.)
+// round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven, without its format checks: the
+// callers have bounded |v 2^frac| well below 2^62 (the guard band, the attribute range). 2^frac
+// as a double multiplier is exact, like ldexp. Below 2^51 in magnitude, adding and subtracting
+// 1.5 * 2^52 rounds to an integer half to even in IEEE double (the default rounding mode, as
+// nearbyint uses) without a libm call; larger values go through nearbyint.
 int64_t snapHalfEven(double v, int frac) {
-  return static_cast<int64_t>(std::nearbyint(v * static_cast<double>(int64_t{1} << frac)));
+  const double x = v * static_cast<double>(int64_t{1} << frac);
+  constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
+  if (std::fabs(x) < 2251799813685248.0) return static_cast<int64_t>((x + kMagic) - kMagic);  // 2^51
+  return static_cast<int64_t>(std::nearbyint(x));
 }
 
 bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }
@@ -37,16 +41,10 @@ int64_t floorDiv(i128 a, i128 b) {  // b > 0
 }
 int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
 
-// round-half-even(num / den), den > 0
-i128 roundDiv(i128 num, i128 den) {
-  i128 q, r;
-  if (fitsI64(num) && fitsI64(den)) {
-    q = static_cast<int64_t>(num) / static_cast<int64_t>(den);
-    r = static_cast<int64_t>(num) % static_cast<int64_t>(den);
-  } else {
-    q = num / den;
-    r = num % den;
-  }
+// round-half-even(num / den), den > 0: in 64 bits with one division when both fit (the
+// common case, inlined), else in 128 bits.
+__attribute__((noinline)) i128 roundDivWide(i128 num, i128 den) {
+  i128 q = num / den, r = num % den;
   if (r < 0) {
     --q;
     r += den;
@@ -55,6 +53,50 @@ i128 roundDiv(i128 num, i128 den) {
   if (twice > den || (twice == den && (q & 1) != 0)) ++q;
   return q;
 }
+inline i128 roundDiv(i128 num, i128 den) {
+  if (!fitsI64(num) || !fitsI64(den)) return roundDivWide(num, den);
+  const int64_t n = static_cast<int64_t>(num), d = static_cast<int64_t>(den);
+  int64_t q = n / d, r = n % d;
+  if (r < 0) {
+    --q;
+    r += d;
+  }
+  const int64_t rest = d - r;  // 2r vs d without overflow: r vs d - r
+  if (r > rest || (r == rest && (q & 1) != 0)) ++q;
+  return q;
+}
+
+// round-half-even(num / den) for many numerators over one denominator den > 0: the quotient
+// estimated from one reciprocal, trunc(num * (1/den)), then corrected in exact integers. For
+// |num| < 2^52 and den < 2^52 the estimate is within 2 of the exact quotient (the reciprocal
+// and the product each err by at most 2^-53 relatively, and |num / den| < 2^52), so the
+// correction takes at most two steps; other numerators and denominators take roundDiv.
+class RoundingDivider {
+ public:
+  explicit RoundingDivider(int64_t den) : den_(den), inv_(1.0 / static_cast<double>(den)) {}
+  int64_t operator()(i128 num) const {
+    if (den_ >= kLimit || num <= -kLimit || num >= kLimit) return static_cast<int64_t>(roundDiv(num, den_));
+    const int64_t n = static_cast<int64_t>(num);
+    int64_t q = static_cast<int64_t>(static_cast<double>(n) * inv_);  // truncated estimate
+    int64_t r = n - q * den_;                                          // exact: |q den| < 2^53 + den
+    while (r < 0) {
+      --q;
+      r += den_;
+    }
+    while (r >= den_) {
+      ++q;
+      r -= den_;
+    }
+    const int64_t rest = den_ - r;  // 2r vs den: r vs den - r
+    if (r > rest || (r == rest && (q & 1) != 0)) ++q;
+    return q;
+  }
+
+ private:
+  static constexpr int64_t kLimit = int64_t{1} << 52;
+  int64_t den_;
+  double inv_;
+};
 
 // A triangle in one frame: vertices in u units and its three biased edge functions in that
 // frame's pixel coordinates (edge s runs from vertex s to vertex s+1).
@@ -107,10 +149,11 @@ Geom reflected(const Geom& g, int64_t ox, int64_t oy, int S) {
   return w;
 }
 
-// Rows whose pixel centre (2w+1)*2^S lies in [lo, hi] (u units).
+// Rows whose pixel centre (2w+1)*2^S lies in [lo, hi] (u units): floor and ceiling divisions
+// by step = 2^(S+1) as arithmetic shifts (floor for any sign; |lo|, |hi| are far below 2^62).
 std::pair<int64_t, int64_t> centreRows(int64_t lo, int64_t hi, int S) {
-  const int64_t half = int64_t{1} << S, step = int64_t{1} << (S + 1);
-  return {ceilDiv(lo - half, step), floorDiv(hi - half, step)};
+  const int64_t half = int64_t{1} << S;
+  return {-((half - lo) >> (S + 1)), (hi - half) >> (S + 1)};
 }
 
 void requireCoord(int64_t v, const SpanParams& p, const char* what) {
@@ -170,9 +213,10 @@ SpanLaneTri buildLaneTri(const Geom& g, bool flip, int64_t ox, int64_t oy, const
     d.r = static_cast<int64_t>(static_cast<i128>(q) * D - N);
     d.div = D;
     if (eb > ea) {  // the DDA steps: -B = k D + m
-      d.k = static_cast<int32_t>(floorDiv(-static_cast<i128>(e.B), D));
-      d.m = static_cast<int64_t>(-static_cast<i128>(e.B) - static_cast<i128>(d.k) * D);
-      requireCoord(floorDiv(-static_cast<i128>(e.B), D), p, "edge DDA step k");
+      const int64_t k = floorDiv(-static_cast<i128>(e.B), D);
+      requireCoord(k, p, "edge DDA step k");
+      d.k = static_cast<int32_t>(k);
+      d.m = static_cast<int64_t>(-static_cast<i128>(e.B) - static_cast<i128>(k) * D);
     }
     // While active the bound lies within the edge's horizontal extent (+-1): it fits.
     requireCoord(q, p, "edge DDA quotient");
@@ -190,9 +234,12 @@ int defaultAttrFracBits(int width, int height, int out_frac) {
   return out_frac + 1 + lg;
 }
 
+// Output fraction bits of attribute k by default: colour channels integer codes, depth 16.
+static int defaultOutFrac(int k) { return k == 3 ? 16 : 0; }
+
 std::vector<int> defaultAttrFracBitsFor(int width, int height, int num_attr) {
   std::vector<int> f;
-  for (int k = 0; k < num_attr; ++k) f.push_back(defaultAttrFracBits(width, height, k == 3 ? 16 : 0));
+  for (int k = 0; k < num_attr; ++k) f.push_back(defaultAttrFracBits(width, height, defaultOutFrac(k)));
   return f;
 }
 
@@ -214,7 +261,7 @@ void RasterConfig::validate() const {
 }
 
 int RasterConfig::attrFracBits(int k) const {
-  if (attr_frac_bits.empty()) return defaultAttrFracBitsFor(width, height, unit.NumAttr)[static_cast<size_t>(k)];
+  if (attr_frac_bits.empty()) return defaultAttrFracBits(width, height, defaultOutFrac(k));
   return attr_frac_bits[static_cast<size_t>(k)];
 }
 
@@ -224,7 +271,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   SetupResult res;
   SnappedTriangle& t = res.tri;
   // Snap to the subpixel grid; the guard band bounds every width downstream.
-  const double guard = std::ldexp(1.0, p.CoordBits - 3);
+  const double guard = static_cast<double>(int64_t{1} << (p.CoordBits - 3));
   for (size_t i = 0; i < 3; ++i) {
     if (!std::isfinite(v[i].x) || !std::isfinite(v[i].y))
       throw std::invalid_argument(fmt::format("triangle {}: vertex {} has a non-finite coordinate ({}, {})", tag, i, v[i].x, v[i].y));
@@ -240,16 +287,18 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   t.a.assign(static_cast<size_t>(K), {});
   const int64_t err_bound = (1 + int64_t{cfg.width} + cfg.height) / 2 + 2;  // codes, see header
   const int64_t lim = (int64_t{1} << (p.AttrBits - 1)) - 1 - err_bound;
-  for (int k = 0; k < K; ++k)
+  for (int k = 0; k < K; ++k) {
+    const int F = cfg.attrFracBits(k);
+    const double scale = static_cast<double>(int64_t{1} << F);  // 2^F, exact: val * scale == ldexp(val, F)
     for (size_t i = 0; i < 3; ++i) {
       const double val = v[i].attr[static_cast<size_t>(k)];
-      const int F = cfg.attrFracBits(k);
-      if (!std::isfinite(val) || std::fabs(std::ldexp(val, F)) > static_cast<double>(lim))
+      if (!std::isfinite(val) || std::fabs(val * scale) > static_cast<double>(lim))
         throw std::invalid_argument(fmt::format(
             "triangle {}: attribute {} = {} at vertex {} does not fit AttrBits {} with {} fraction bits", tag, k, val, i,
             p.AttrBits, F));
       t.a[static_cast<size_t>(k)][i] = snapHalfEven(val, F);
     }
+  }
   t.det = (t.X[1] - t.X[0]) * (t.Y[2] - t.Y[0]) - (t.X[2] - t.X[0]) * (t.Y[1] - t.Y[0]);
   if (t.det == 0) {
     res.dropped = "zero area";
@@ -273,16 +322,17 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   pl.xref = std::clamp<int64_t>(px_min, 0, cfg.width - 1);
   pl.yref = std::clamp<int64_t>(py_min, 0, cfg.height - 1);
   const i128 det = t.det;
+  const RoundingDivider by_det(t.det), by_2det(2 * t.det);
+  const i128 cx = (2 * static_cast<i128>(pl.xref) + 1) << S, cy = (2 * static_cast<i128>(pl.yref) + 1) << S;
   for (int k = 0; k < K; ++k) {
     const auto& a = t.a[static_cast<size_t>(k)];
     const i128 nx = static_cast<i128>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) - static_cast<i128>(a[2] - a[0]) * (t.Y[1] - t.Y[0]);
     const i128 ny = static_cast<i128>(t.X[1] - t.X[0]) * (a[2] - a[0]) - static_cast<i128>(t.X[2] - t.X[0]) * (a[1] - a[0]);
     // per pixel = per subpixel * 2^S
-    pl.didx.push_back(static_cast<int64_t>(roundDiv(nx * (i128{1} << S), det)));
-    pl.didy.push_back(static_cast<int64_t>(roundDiv(ny * (i128{1} << S), det)));
+    pl.didx.push_back(by_det(nx * (i128{1} << S)));
+    pl.didy.push_back(by_det(ny * (i128{1} << S)));
     // exact plane at the reference pixel centre, in u units: I = a0 + (nx (cx - U0) + ny (cy - V0)) / (2 det)
-    const i128 cx = (2 * static_cast<i128>(pl.xref) + 1) << S, cy = (2 * static_cast<i128>(pl.yref) + 1) << S;
-    pl.iref.push_back(static_cast<int64_t>(roundDiv(2 * det * a[0] + nx * (cx - xu[0]) + ny * (cy - yu[0]), 2 * det)));
+    pl.iref.push_back(by_2det(2 * det * a[0] + nx * (cx - xu[0]) + ny * (cy - yu[0])));
   }
 
   // Lane-triangles in the walker frame, built in place in the descriptor.

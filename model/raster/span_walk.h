@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <stdexcept>
+#include <type_traits>
 
 #include "raster/span_unit.h"
 
@@ -45,13 +46,9 @@ inline void stepEdges(const SpanLaneTri& t, int64_t w, SpanDdaState* e, int coor
     if (w < g.row_first || w >= g.row_last) continue;
     SpanDdaState& st = e[s];
     const int64_t r = st.r - g.m;
-    if (r < 0) {
-      st.r = r + g.div;
-      st.q = wrapTo(u(st.q + g.k + 1), coord_bits);
-    } else {
-      st.r = r;
-      st.q = wrapTo(u(st.q + g.k), coord_bits);
-    }
+    const int64_t borrow = r < 0 ? 1 : 0;  // without a branch: r's sign is data, not a pattern
+    st.r = r + (g.div & -borrow);
+    st.q = wrapTo(u(st.q + g.k + borrow), coord_bits);
   }
 }
 
@@ -77,14 +74,56 @@ inline void laneFragment(const SpanParams& p, const SpanDesc& d, const SpanLaneT
   }
 }
 
+// The fragments of a row of a single lane-triangle (T == 1), x = lo..hi in order: one
+// accumulator acc = I_w(x, w) stepped by didx, mapped by the lane's output map. KC: NumAttr
+// known at compile time (4, the renderer's), or 0 for p.NumAttr.
+template <int KC, class Sink>
+inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t w, int64_t lo, int64_t hi,
+                      const int64_t* irow, Sink& emit) {
+  const int K = KC > 0 ? KC : p.NumAttr, bits = p.AttrBits;
+  std::array<uint64_t, kMaxAttr> acc, step, off;  // the first K are set and read
+  std::array<int64_t, kMaxAttr> attr;
+  for (int a = 0; a < K; ++a) {
+    const size_t ai = static_cast<size_t>(a);
+    acc[ai] = u(irow[ai]) + u(d.didx[ai]) * u(lo - d.xref);
+    step[ai] = u(d.didx[ai]);
+    off[ai] = u(t.aoff[ai]);
+  }
+  const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
+  const int32_t py = static_cast<int32_t>((t.flip ? t.oy - w : w + t.oy) & pix_mask);
+  if (!t.flip) {
+    for (int64_t x = lo; x <= hi; ++x) {
+      for (int a = 0; a < K; ++a) {
+        const size_t ai = static_cast<size_t>(a);
+        attr[ai] = wrapTo(acc[ai] + off[ai], bits);
+        acc[ai] += step[ai];
+      }
+      emit(static_cast<int32_t>((x + t.ox) & pix_mask), py, static_cast<const int64_t*>(attr.data()));
+    }
+  } else {
+    for (int64_t x = lo; x <= hi; ++x) {
+      for (int a = 0; a < K; ++a) {
+        const size_t ai = static_cast<size_t>(a);
+        attr[ai] = wrapTo(off[ai] - acc[ai], bits);
+        acc[ai] += step[ai];
+      }
+      emit(static_cast<int32_t>((t.ox - x) & pix_mask), py, static_cast<const int64_t*>(attr.data()));
+    }
+  }
+}
+
 }  // namespace span_detail
 
 // The fragments of one descriptor, in the order SpanUnitModel hands them over with out_ready
 // always 1, each passed to emit(x, y, attr) (attr: NumAttr codes, valid during the call), and
 // the cycles counted as runSpanUnit counts them. See walkSpanUnit in raster/span_unit.h.
 template <class Sink>
-SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& emit) {
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
   using namespace span_detail;
+  // A local copy of the consumer (a closure of pointers and references): the compiler may then
+  // keep what it captured in registers across the consumer's own stores (a byte store may
+  // alias any object whose address has escaped, such as the caller's closure).
+  std::decay_t<Sink> emit(consumer);
   checkDescriptor(p, d);
   const int L = p.LanesPerTri, T = p.NumTri, K = p.NumAttr;
   SpanWalk walk;
@@ -95,11 +134,11 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& emit) {
       const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];
       e[static_cast<size_t>(j * 3 + s)] = {g.q, g.r};
     }
-  std::array<int64_t, kMaxAttr> irow{}, icur{};
+  std::array<int64_t, kMaxAttr> irow, icur;  // the first K are set before they are read
   std::copy(d.iref.begin(), d.iref.end(), irow.begin());
   std::array<int64_t, kMaxLaneTri> lo{}, hi{};
   std::array<bool, kMaxLaneTri> ne{};
-  std::array<int64_t, kMaxAttr> attr{};
+  std::array<int64_t, kMaxAttr> attr;
   for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
     ++walk.row_cycles;
     bool any = false;
@@ -120,21 +159,8 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& emit) {
       const SpanLaneTri& t = d.tri[0];
       const int64_t xg0 = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
       walk.span_cycles += static_cast<uint64_t>((xe - xg0) / L + 1);
-      std::array<uint64_t, kMaxAttr> acc{};
-      for (int a = 0; a < K; ++a) {
-        const size_t ai = static_cast<size_t>(a);
-        acc[ai] = u(irow[ai]) + u(d.didx[ai]) * u(lo[0] - d.xref);
-      }
-      const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
-      const int32_t py = static_cast<int32_t>((t.flip ? t.oy - w : w + t.oy) & pix_mask);
-      for (int64_t x = lo[0]; x <= hi[0]; ++x) {
-        for (int a = 0; a < K; ++a) {
-          const size_t ai = static_cast<size_t>(a);
-          attr[ai] = wrapTo(t.flip ? u(t.aoff[ai]) - acc[ai] : acc[ai] + u(t.aoff[ai]), p.AttrBits);
-          acc[ai] += u(d.didx[ai]);
-        }
-        emit(static_cast<int32_t>((t.flip ? t.ox - x : x + t.ox) & pix_mask), py, attr.data());
-      }
+      if (K == 4) singleRow<4>(p, d, t, w, lo[0], hi[0], irow.data(), emit);
+      else singleRow<0>(p, d, t, w, lo[0], hi[0], irow.data(), emit);
       walk.fragments += static_cast<uint64_t>(hi[0] - lo[0] + 1);
     } else if (any) {
       int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;

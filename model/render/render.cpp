@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -77,8 +78,10 @@ double area2(const PVertex& a, const PVertex& b, const PVertex& c) {
   return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
 }
 
+// A screen triangle to draw: its vertices (in the object's vertex array, the clipped polygon
+// or a split) and the method that draws it.
 struct Part {
-  std::array<PVertex, 3> v;
+  std::array<const PVertex*, 3> v;
   Method method;
 };
 
@@ -242,8 +245,7 @@ std::string specConfigForLobe(Lobe l) { return l == Lobe::Cubic ? "cubic" : "def
 uint64_t ModelSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) {
   out.resize(in.size());
   for (size_t i = 0; i < in.size(); ++i) out[i] = unit_.evaluate(in[i].shin, in[i].cos, in[i].light).rgb;
-  // Pipelined: the last of n results leaves latency - 1 cycles after the n-th input cycle.
-  return in.empty() ? 0 : in.size() + static_cast<uint64_t>(unit_.params().latency()) - 1;
+  return batchCycles(in.size(), unit_.params().latency());
 }
 
 std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt) {
@@ -272,9 +274,10 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   Framebuffer& fb = res.fb;
   fb.width = W;
   fb.height = H;
+  // Depth last: every fragment reads it, so it is the buffer to find in the cache.
   fb.rgb.assign(static_cast<size_t>(W) * H * 3, 0);
-  fb.depth.assign(static_cast<size_t>(W) * H, 0);
   fb.tri.assign(static_cast<size_t>(W) * H, -1);
+  fb.depth.assign(static_cast<size_t>(W) * H, 0);
   const bool reference = opt.method == Method::Reference;
   if (reference) {
     fb.lsb.assign(static_cast<size_t>(W) * H * 3, 0.0);
@@ -309,16 +312,17 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     c.shin = static_cast<uint32_t>(a);
     return c;
   };
-  std::vector<std::array<uint32_t, 3>> device_out;
+  std::vector<std::array<uint32_t, 3>> device_out, direct_out;
   std::vector<SpecRequest> point_requests;
   SpecEngine* spec = nullptr;  // the current object's
   DeviceCoding coding;
+  std::optional<PointShader> shader;  // the current object's material and lobe
 
   // A point's shade, with its device-lobe evaluations done by the specular unit right away
   // (vertices: few; pixels are batched per triangle below).
-  auto shadeNow = [&](const Material& m, Lobe lobe, Vec3 n, Vec3 p) {
+  auto shadeNow = [&](Vec3 n, Vec3 p) {
     point_requests.clear();
-    Shade s = shadePoint(ctx, m, lobe, n, p, &coding, &point_requests);
+    Shade s = shader->shade(n, p, &point_requests);
     if (!point_requests.empty()) {
       st.spec_cycles += spec->evaluate(point_requests, device_out);
       st.spec_evaluations += point_requests.size();
@@ -342,6 +346,11 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
 
   // Per-triangle buffers, reused across the frame (no allocation per triangle or fragment once
   // they have grown).
+  std::vector<PVertex> verts;
+  std::vector<uint8_t> lit;  // verts[i].colour is computed
+  Poly poly;                 // a clipped triangle
+  InlineVec<const PVertex*, Poly::capacity()> fan;  // the polygon to draw: 3 vertices unless clipped
+  std::vector<std::array<PVertex, 3>> splits;       // modified-gouraud's parts
   std::vector<Part> parts;
   std::vector<SpanFragment> frags;
   struct Pending {  // a fragment waiting for its specular-unit results
@@ -368,18 +377,29 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     if (isDeviceLobe(lobe) && spec == nullptr && !reference)
       throw std::invalid_argument(fmt::format("object '{}': brdf {} needs the specular unit", obj.name, toString(lobe)));
     coding = codingFor(spec, mat);
-    // Object -> camera space, the projection of the vertices in front of the near plane, and
-    // the Gouraud vertex colours.
-    std::vector<PVertex> verts(obj.mesh.positions.size());
+    shader.emplace(ctx, mat, lobe, &coding);
+    // The reference: the exact lobes (the Blinn lobe a device lobe approximates), and the same
+    // without k_s for the specular part alone (highlight masks).
+    const Lobe ref_lobe = isDeviceLobe(lobe) ? Lobe::Blinn : lobe;
+    Material nospec = mat;
+    nospec.ks = 0;
+    const PointShader ref_shader(ctx, mat, ref_lobe, nullptr), ref_diffuse(ctx, nospec, ref_lobe, nullptr);
+    // Per-pixel device lobes on the model: each request evaluated as it is made.
+    const SpecUnitModel* direct = spec != nullptr ? spec->model() : nullptr;
+    // Object -> camera space and the projection of the vertices in front of the near plane.
+    verts.assign(obj.mesh.positions.size(), PVertex{});
+    const NormalTransform to_world(obj.transform);
     for (size_t i = 0; i < verts.size(); ++i) {
       PVertex& v = verts[i];
       v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
-      v.n = normalize(toCameraDirection(basis, obj.transform.normal(obj.mesh.normals[i])));
+      v.n = normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
       if (v.cam.z >= cam.z_near) project(v);
     }
-    if (opt.method == Method::Gouraud || opt.method == Method::GouraudClassical || opt.method == Method::Biquadratic ||
-        opt.method == Method::ModifiedGouraud || opt.method == Method::Adaptive)
-      for (PVertex& v : verts) v.colour = shadeNow(mat, lobe, v.n, v.cam);
+    // Gouraud vertex colours: computed when a triangle that is not culled first needs them.
+    const bool vertex_colours = opt.method == Method::Gouraud || opt.method == Method::GouraudClassical ||
+                                opt.method == Method::Biquadratic || opt.method == Method::ModifiedGouraud ||
+                                opt.method == Method::Adaptive;
+    lit.assign(verts.size(), 0);
 
     for (size_t ti = 0; ti < obj.mesh.triangles.size(); ++ti) {
       ++st.triangles;
@@ -392,64 +412,82 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         ++st.culled;
         continue;
       }
-      Poly poly{v0, v1, v2};
-      if (!all_in) {  // near plane, camera space
-        poly = clipPolygon(poly, [&](const PVertex& v) { return v.cam.z - cam.z_near; });
-        if (poly.size() < 3) {
-          ++st.culled;
-          continue;
-        }
-        ++st.clipped;
-        for (PVertex& v : poly) project(v);
-        if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
-          ++st.culled;
-          continue;
-        }
-      }
-      // Guard band, screen space (attributes interpolate linearly there, as in the span unit).
-      const bool in_guard = std::all_of(poly.begin(), poly.end(), [&](const PVertex& v) {
+      if (vertex_colours)
+        for (const uint32_t i : tri)
+          if (!lit[i]) {
+            verts[i].colour = shadeNow(verts[i].n, verts[i].cam);
+            lit[i] = 1;
+          }
+      auto inGuard = [&](const PVertex& v) {
         return v.x >= -kGuard && v.x <= W + kGuard && v.y >= -kGuard && v.y <= H + kGuard;
-      });
-      if (!in_guard) {
-        poly = clipPolygon(poly, [&](const PVertex& v) { return v.x + kGuard; });
-        poly = clipPolygon(poly, [&](const PVertex& v) { return W + kGuard - v.x; });
-        poly = clipPolygon(poly, [&](const PVertex& v) { return v.y + kGuard; });
-        poly = clipPolygon(poly, [&](const PVertex& v) { return H + kGuard - v.y; });
-        if (poly.size() < 3) {
-          ++st.culled;
-          continue;
+      };
+      fan.clear();
+      if (all_in && inGuard(v0) && inGuard(v1) && inGuard(v2)) {
+        fan = {&v0, &v1, &v2};  // the common case: drawn from the vertex array, nothing copied
+      } else {
+        poly = {v0, v1, v2};
+        if (!all_in) {  // near plane, camera space
+          poly = clipPolygon(poly, [&](const PVertex& v) { return v.cam.z - cam.z_near; });
+          if (poly.size() < 3) {
+            ++st.culled;
+            continue;
+          }
+          ++st.clipped;
+          for (PVertex& v : poly) project(v);
+          if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
+            ++st.culled;
+            continue;
+          }
         }
-        for (PVertex& v : poly) v.cam = pixelCam(v.x - 0.5, v.y - 0.5, v.w);
-        ++st.clipped;
+        // Guard band, screen space (attributes interpolate linearly there, as in the span unit).
+        if (!std::all_of(poly.begin(), poly.end(), inGuard)) {
+          poly = clipPolygon(poly, [&](const PVertex& v) { return v.x + kGuard; });
+          poly = clipPolygon(poly, [&](const PVertex& v) { return W + kGuard - v.x; });
+          poly = clipPolygon(poly, [&](const PVertex& v) { return v.y + kGuard; });
+          poly = clipPolygon(poly, [&](const PVertex& v) { return H + kGuard - v.y; });
+          if (poly.size() < 3) {
+            ++st.culled;
+            continue;
+          }
+          for (PVertex& v : poly) v.cam = pixelCam(v.x - 0.5, v.y - 0.5, v.w);
+          ++st.clipped;
+        }
+        for (const PVertex& v : poly) fan.push_back(&v);
       }
       // Flat: one colour from the face normal at the centroid.
       std::array<double, 3> flat{};
       if (opt.method == Method::Flat) {
-        Vec3 fn = normalize(cross(poly[1].cam - poly[0].cam, poly[2].cam - poly[0].cam));
+        Vec3 fn = normalize(cross(fan[1]->cam - fan[0]->cam, fan[2]->cam - fan[0]->cam));
         if (dot(fn, ctx.view) < 0) fn = -fn;  // toward the viewer
-        const Vec3 centroid = (1.0 / 3) * (poly[0].cam + poly[1].cam + poly[2].cam);
-        flat = shadeNow(mat, lobe, fn, centroid);
+        const Vec3 centroid = (1.0 / 3) * (fan[0]->cam + fan[1]->cam + fan[2]->cam);
+        flat = shadeNow(fn, centroid);
       }
       // The screen triangles to draw (a fan of the clipped polygon), each with the method that
       // draws it: modified Gouraud may split one into parts, adaptive picks per triangle.
       parts.clear();
-      for (size_t k = 1; k + 1 < poly.size(); ++k) {
-        const std::array<PVertex, 3> t{poly[0], poly[k], poly[k + 1]};
+      splits.clear();
+      splits.reserve(4 * fan.size());  // at most 4 parts per fan triangle: no reallocation below
+      for (size_t k = 1; k + 1 < fan.size(); ++k) {
+        const std::array<const PVertex*, 3> t{fan[0], fan[k], fan[k + 1]};
         if (opt.method == Method::ModifiedGouraud) {
           const auto subs = splitAtEdgeMaxima(
-              t, ctx, opt.modified_threshold_lsb, [&](Vec3 n, Vec3 p) { return shadeNow(mat, lobe, n, p); },
+              {*t[0], *t[1], *t[2]}, ctx, opt.modified_threshold_lsb,
+              [&](Vec3 n, Vec3 p) { return shadeNow(n, p); },
               [&](const PVertex& v) { return pixelCam(v.x - 0.5, v.y - 0.5, v.w); });
           if (subs.size() > 1) st.split_parts += subs.size();
-          for (const auto& sub : subs) parts.push_back({sub, Method::Gouraud});
+          for (const auto& sub : subs) {
+            splits.push_back(sub);
+            parts.push_back({{&splits.back()[0], &splits.back()[1], &splits.back()[2]}, Method::Gouraud});
+          }
         } else if (opt.method == Method::Adaptive) {
-          parts.push_back({t, adaptiveChoice(t, ctx, opt) ? Method::Gouraud : Method::Phong});
+          parts.push_back({t, adaptiveChoice({*t[0], *t[1], *t[2]}, ctx, opt) ? Method::Gouraud : Method::Phong});
         } else {
           parts.push_back({t, opt.method});
         }
       }
       for (const Part& part : parts) {
         const Method m = part.method;
-        const std::array<const PVertex*, 3> tv{&part.v[0], &part.v[1], &part.v[2]};
+        const std::array<const PVertex*, 3>& tv = part.v;
         const bool colour_attrs_m =
             m == Method::Flat || m == Method::Gouraud || m == Method::GouraudClassical || m == Method::Biquadratic;
         const RasterConfig& rcm = colour_attrs_m ? rc_colour : rc_unit;
@@ -481,14 +519,26 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
 
         // A fragment's colour is written at once, or (per-pixel device lobes) once the specular
         // unit has evaluated the triangle's batch of requests.
-        const bool batched =
-            !reference && isDeviceLobe(lobe) && (m == Method::Phong || m == Method::PhongIncremental || m == Method::NormalBisection);
+        const bool batched = !reference && direct == nullptr && isDeviceLobe(lobe) &&
+                             (m == Method::Phong || m == Method::PhongIncremental || m == Method::NormalBisection);
         pend.clear();
         requests.clear();
-        auto write = [&](size_t p, int64_t w, const std::array<uint8_t, 3>& c) {
-          for (size_t k = 0; k < 3; ++k) fb.rgb[p * 3 + k] = c[k];
-          fb.depth[p] = static_cast<int32_t>(w);
-          fb.tri[p] = static_cast<int32_t>(tag);
+        // A written fragment has w > 0 (the z-test), so depth 0 marks a pixel not yet covered.
+        auto write = [rgb = fb.rgb.data(), depth = fb.depth.data(), tri_of = fb.tri.data(), tag,
+                      &covered = st.pixels_covered](size_t p, int64_t w, const std::array<uint8_t, 3>& c) {
+          for (size_t k = 0; k < 3; ++k) rgb[p * 3 + k] = c[k];
+          if (depth[p] == 0) ++covered;
+          depth[p] = static_cast<int32_t>(w);
+          tri_of[p] = static_cast<int32_t>(tag);
+        };
+        // Flat and Gouraud: z-test, then the interpolated colour codes straight to unorm8 (what
+        // combine() gives them).
+        auto colourFragment = [write, depth = fb.depth.data(), W](int32_t x, int32_t y, const int64_t* attr) {
+          const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+          __builtin_prefetch(depth + p + W);  // the row below: most likely this triangle's next
+          if (attr[3] <= depth[p]) return;
+          write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
+                             unorm8FromCode(attr[2], kColourFrac)});
         };
         // phong-incremental: |N|^2 along each run of consecutive pixels of a row by the
         // recurrence, restarted (three products) where the stream is not the next pixel. The
@@ -501,7 +551,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         if (m == Method::Biquadratic)
           for (size_t e = 0; e < 3; ++e) {
             PVertex mv = lerp(*tv[e], *tv[(e + 1) % 3], 0.5);
-            mid_colour[e] = shadeNow(mat, lobe, normalize(mv.n), pixelCam(mv.x - 0.5, mv.y - 0.5, mv.w));
+            mid_colour[e] = shadeNow(normalize(mv.n), pixelCam(mv.x - 0.5, mv.y - 0.5, mv.w));
           }
         // Barycentric coordinates of a pixel centre on the unsnapped screen triangle.
         auto barycentric = [&](int32_t x, int32_t y) {
@@ -529,9 +579,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           switch (m) {
             case Method::Flat:
             case Method::Gouraud:
-              // The interpolated colour codes straight to unorm8 (what combine() gives them).
-              write(p, wcode, {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
-                               unorm8FromCode(attr[2], kColourFrac)});
+              colourFragment(x, y, attr);
               return;
             case Method::GouraudClassical: {
               // The classical loop: along both edges, then one division per raster line (float).
@@ -584,11 +632,21 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                 // |N|^2 from the recurrence (exact integers), then the fixed-point 1/sqrt.
                 n = rsqrtFixed(sqnorm, 2 * kUnitFrac) * nraw;
               }
-              const Vec3 pc = pixelCam(x, y, static_cast<double>(wcode) * kUnitLsb);
+              const Vec3 pc = shader->needsPosition() ? pixelCam(x, y, static_cast<double>(wcode) * kUnitLsb) : Vec3{};
               const size_t first = requests.size();
-              lsb = shadePoint(ctx, mat, lobe, n, pc, &coding, &requests).lsb;
+              lsb = shader->shade(n, pc, &requests).lsb;
+              const size_t count = requests.size() - first;
               if (batched) {
-                pend.push_back({p, wcode, lsb, first, requests.size() - first});
+                pend.push_back({p, wcode, lsb, first, count});
+                return;
+              }
+              if (count > 0) {  // the model's results now (the cycles are counted per triangle below)
+                direct_out.resize(count);
+                for (size_t i = 0; i < count; ++i) {
+                  const SpecRequest& r = requests[first + i];
+                  direct_out[i] = direct->evaluate(r.shin, r.cos, r.light).rgb;
+                }
+                write(p, wcode, combine(lsb, direct_out.data(), count));
                 return;
               }
               break;
@@ -613,13 +671,9 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
               const Vec3 n = normalize(l0 * tv[0]->n + l1 * tv[1]->n + l2 * tv[2]->n);
               const double w = l0 * tv[0]->w + l1 * tv[1]->w + l2 * tv[2]->w;
               const Vec3 pc = pixelCam(x, y, w);
-              const Lobe ref_lobe = isDeviceLobe(lobe) ? Lobe::Blinn : lobe;
-              const Shade sh = shadePoint(ctx, mat, ref_lobe, n, pc, nullptr, nullptr);
+              const Shade sh = ref_shader.shade(n, pc, nullptr);
               lsb = sh.lsb;
-              // The specular part alone, for highlight masks.
-              Material nospec = mat;
-              nospec.ks = 0;
-              const Shade dif = shadePoint(ctx, nospec, ref_lobe, n, pc, nullptr, nullptr);
+              const Shade dif = ref_diffuse.shade(n, pc, nullptr);
               for (size_t k = 0; k < 3; ++k) {
                 fb.lsb[p * 3 + k] = sh.lsb[k];
                 fb.spec_lsb[p * 3 + k] = sh.lsb[k] - dif.lsb[k];
@@ -634,7 +688,11 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // reference walks the same pixel set by direct edge evaluation; the RTL's stream;
         // normal-bisection needs whole rows).
         const SpanParams* walker = span.walker();
-        if (!reference && walker != nullptr && m != Method::NormalBisection) {
+        if (!reference && walker != nullptr && (m == Method::Flat || m == Method::Gouraud)) {
+          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, colourFragment);
+          st.span_cycles += wk.cycles;
+          st.fragments += wk.fragments;
+        } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
           const SpanWalk wk = walkSpanUnit(*walker, *s.desc, [&](int32_t x, int32_t y, const int64_t* attr) {
             shadeFragment(x, y, attr, nullptr);
           });
@@ -653,7 +711,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         for (int32_t row : divided_rows) row_divided[static_cast<size_t>(row)] = 0;
         divided_rows.clear();
         if (!requests.empty()) {
-          st.spec_cycles += spec->evaluate(requests, device_out);
+          st.spec_cycles += direct != nullptr ? batchCycles(requests.size(), direct->params().latency())
+                                              : spec->evaluate(requests, device_out);
           st.spec_evaluations += requests.size();
         }
         for (const Pending& pd : pend)
@@ -661,7 +720,6 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
       }
     }
   }
-  for (int32_t t : fb.tri) st.pixels_covered += t >= 0 ? 1 : 0;
   st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 

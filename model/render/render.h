@@ -15,7 +15,9 @@
 //
 // Methods:
 //   flat               one colour per triangle: the face normal at the centroid
-//   gouraud            vertex colours, the constant increment of the span unit (paper 4.1)
+//   gouraud            vertex colours, the constant increment of the span unit (paper 4.1).
+//                      (The vertex colours of every Gouraud-type method are computed once per
+//                      vertex, and only for vertices of triangles that survive back-face culling.)
 //   gouraud-classical  vertex colours; per raster line the colour is interpolated along both
 //                      edges and divided by the span length (one division per line, float, as
 //                      the idx3d listings)
@@ -117,13 +119,21 @@ class SpecEngine {
   virtual const PromTable& table() const = 0;
   // out[i] = the unorm8 RGB of in[i]; returns the cycles the batch took (with the pipeline fill).
   virtual uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) = 0;
+  // Non-null when the engine is the bit-exact model: the renderer may then evaluate each
+  // request as it is made (the results are the same; batchCycles() counts the cycles).
+  virtual const SpecUnitModel* model() const { return nullptr; }
 };
+
+// The cycles of a batch of n requests through a pipelined unit of the given latency: the last
+// result leaves latency - 1 cycles after the n-th input cycle (0 for an empty batch).
+inline uint64_t batchCycles(size_t n, int latency) { return n == 0 ? 0 : n + static_cast<uint64_t>(latency) - 1; }
 
 class ModelSpecEngine final : public SpecEngine {
  public:
   explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words) {}
   const PromTable& table() const override { return t_; }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
+  const SpecUnitModel* model() const override { return &unit_; }
 
  private:
   PromTable t_;

@@ -85,50 +85,57 @@ double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v, Vec3 h) {
 
 Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, Vec3 p_cam, const DeviceCoding* coding,
                  std::vector<SpecRequest>* device) {
-  Shade s;
-  for (int k = 0; k < 3; ++k) {
-    const double base = k == 0 ? m.colour.x : (k == 1 ? m.colour.y : m.colour.z);
-    const double amb = k == 0 ? ctx.ambient.x : (k == 1 ? ctx.ambient.y : ctx.ambient.z);
-    s.lsb[static_cast<size_t>(k)] = 255.0 * amb * base;
-  }
+  return PointShader(ctx, m, lobe, coding).shade(n, p_cam, device);
+}
+
+PointShader::PointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding)
+    : ctx_(ctx), m_(m), lobe_(lobe), device_lobe_(isDeviceLobe(lobe)), has_coding_(coding != nullptr) {
+  if (coding != nullptr) coding_ = *coding;
+  const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
+  const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
+  for (size_t k = 0; k < 3; ++k) ambient_[k] = 255.0 * amb[k] * base[k];
   for (const CameraLight& l : ctx.lights) {
+    needs_position_ = needs_position_ || l.point;
+    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
+    PerLight pl;
+    for (size_t k = 0; k < 3; ++k) {
+      pl.diffuse[k] = 255.0 * m.kd * base[k] * lc[k];
+      pl.specular[k] = 255.0 * m.ks * lc[k];
+      pl.device_light[k] = static_cast<uint32_t>(std::lround(255.0 * std::clamp(m.ks * lc[k], 0.0, 1.0)));
+    }
+    lights_.push_back(pl);
+  }
+}
+
+Shade PointShader::shade(Vec3 n, Vec3 p_cam, std::vector<SpecRequest>* device) const {
+  Shade s;
+  s.lsb = ambient_;
+  for (size_t li = 0; li < lights_.size(); ++li) {
+    const CameraLight& l = ctx_.lights[li];
+    const PerLight& pl = lights_[li];
     const Vec3 ld = lightDirection(l, p_cam);
     const double nl = dot(n, ld);
     if (nl <= 0) continue;  // the surface faces away from this light
-    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
-    const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
-    for (size_t k = 0; k < 3; ++k) s.lsb[k] += 255.0 * m.kd * base[k] * lc[k] * nl;
-    if (isDeviceLobe(lobe)) {
-      if (coding == nullptr || device == nullptr)
+    for (size_t k = 0; k < 3; ++k) s.lsb[k] += pl.diffuse[k] * nl;
+    if (device_lobe_) {
+      if (!has_coding_ || device == nullptr)
         throw std::logic_error("shadePoint: a device lobe needs the specular unit's coding and a request list");
-      const double nh = std::clamp(dot(n, l.point ? normalize(ld + ctx.view) : l.half), 0.0, 1.0);
+      const double nh = std::clamp(dot(n, l.point ? normalize(ld + ctx_.view) : l.half), 0.0, 1.0);
+      // round(nh 2^F), half away from zero (lround) for nh >= 0, without libm: the scaling by
+      // 2^F is exact, and so is the fraction x - trunc(x).
+      const double x = nh * static_cast<double>(int64_t{1} << coding_.cos_frac_bits);
       SpecRequest r;
-      r.cos = static_cast<uint32_t>(std::lround(std::ldexp(nh, coding->cos_frac_bits)));
-      r.shin = coding->shin;
-      for (size_t k = 0; k < 3; ++k)
-        r.light[k] = static_cast<uint32_t>(std::lround(255.0 * std::clamp(m.ks * lc[k], 0.0, 1.0)));
+      r.cos = static_cast<uint32_t>(x);
+      if (x - r.cos >= 0.5) ++r.cos;
+      r.shin = coding_.shin;
+      r.light = pl.device_light;
       device->push_back(r);
     } else {
-      const double f = lobeValue(lobe, m, n, ld, ctx.view, l.point ? normalize(ld + ctx.view) : l.half);
-      for (size_t k = 0; k < 3; ++k) s.lsb[k] += 255.0 * m.ks * lc[k] * f;
+      const double f = lobeValue(lobe_, m_, n, ld, ctx_.view, l.point ? normalize(ld + ctx_.view) : l.half);
+      for (size_t k = 0; k < 3; ++k) s.lsb[k] += pl.specular[k] * f;
     }
   }
   return s;
-}
-
-std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb, size_t count) {
-  std::array<uint8_t, 3> out{};
-  for (size_t k = 0; k < 3; ++k) {
-    // round(clamp(lsb, 0, 255)), half away from zero, without a libm call: the fraction of a
-    // value in [0, 255] is exact in double.
-    if (std::isnan(lsb[k])) throw std::logic_error("combine: a NaN colour (a shading bug)");
-    const double c = std::clamp(lsb[k], 0.0, 255.0);
-    uint32_t v = static_cast<uint32_t>(c);
-    if (c - v >= 0.5) ++v;
-    for (size_t i = 0; i < count; ++i) v += device_rgb[i][k];
-    out[k] = static_cast<uint8_t>(std::min<uint32_t>(255, v));
-  }
-  return out;
 }
 
 }  // namespace shd

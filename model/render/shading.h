@@ -11,8 +11,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -70,9 +72,53 @@ struct Shade {
 Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n_unit, Vec3 p_cam,
                  const DeviceCoding* coding, std::vector<SpecRequest>* device);
 
+// shadePoint for many points of one material: the per-material factors (ambient, k_d and k_s
+// times base and light colours, a device request's light codes) computed once, with the same
+// floating-point operations in the same order, so shade() equals shadePoint() bit for bit
+// (shadePoint is this class used once). ctx and m must outlive it.
+class PointShader {
+ public:
+  // coding and device may be null unless the lobe is a device lobe (std::logic_error then).
+  PointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding);
+  Shade shade(Vec3 n_unit, Vec3 p_cam, std::vector<SpecRequest>* device) const;
+  // Whether shade() reads p_cam: only point lights depend on the position (the viewer is at
+  // infinity), so with directional lights alone a caller may pass any point.
+  bool needsPosition() const { return needs_position_; }
+
+ private:
+  struct PerLight {
+    std::array<double, 3> diffuse{};   // 255 k_d base light, per channel
+    std::array<double, 3> specular{};  // 255 k_s light, per channel
+    std::array<uint32_t, 3> device_light{};  // a device request's light*k_s codes
+  };
+  const ShadeContext& ctx_;
+  const Material& m_;
+  Lobe lobe_;
+  bool device_lobe_, has_coding_;
+  DeviceCoding coding_;
+  bool needs_position_ = false;
+  std::array<double, 3> ambient_{};  // 255 ambient base
+  std::vector<PerLight> lights_;
+};
+
 // Final unorm8: round(lsb) plus the device outputs, clamped to 0..255.
 // device_rgb points at `count` specular-unit results (may be null when count is 0).
-std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb, size_t count);
+// Inline: it runs once per pixel.
+inline std::array<uint8_t, 3> combine(const std::array<double, 3>& lsb, const std::array<uint32_t, 3>* device_rgb,
+                                      size_t count) {
+  std::array<uint8_t, 3> out{};
+  for (size_t k = 0; k < 3; ++k) {
+    // round(clamp(lsb, 0, 255)), half away from zero, without a libm call: the fraction of a
+    // value in [0, 255] is exact in double. min/max rather than clamp: no branch on the value.
+    if (std::isnan(lsb[k])) throw std::logic_error("combine: a NaN colour (a shading bug)");
+    const double c = std::min(std::max(lsb[k], 0.0), 255.0);
+    uint32_t v = static_cast<uint32_t>(c);
+    if (c - v >= 0.5) ++v;
+    for (size_t i = 0; i < count; ++i) v += device_rgb[i][k];
+    out[k] = static_cast<uint8_t>(std::min<uint32_t>(255, v));
+  }
+  return out;
+}
 
 // combine() of one channel without device outputs, from a fixed-point code with `frac` fraction
 // bits: round(clamp(code 2^-frac, 0, 255)) in integers (round half up = half away from zero

@@ -114,21 +114,27 @@ double Mat4::determinant3() const {
          m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
 
-Vec3 Mat4::normal(Vec3 n) const {
+Vec3 Mat4::normal(Vec3 n) const { return NormalTransform(*this)(n); }
+
+NormalTransform::NormalTransform(const Mat4& t) : mirror(t.determinant3() < 0) {
   // The cofactor matrix is det * inverse transpose: no division, and the sign of det restores
   // the orientation (a mirror must keep outward normals outward).
-  const double c00 = m[1][1] * m[2][2] - m[1][2] * m[2][1];
-  const double c01 = m[1][2] * m[2][0] - m[1][0] * m[2][2];
-  const double c02 = m[1][0] * m[2][1] - m[1][1] * m[2][0];
-  const double c10 = m[0][2] * m[2][1] - m[0][1] * m[2][2];
-  const double c11 = m[0][0] * m[2][2] - m[0][2] * m[2][0];
-  const double c12 = m[0][1] * m[2][0] - m[0][0] * m[2][1];
-  const double c20 = m[0][1] * m[1][2] - m[0][2] * m[1][1];
-  const double c21 = m[0][2] * m[1][0] - m[0][0] * m[1][2];
-  const double c22 = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-  const Vec3 r{c00 * n.x + c01 * n.y + c02 * n.z, c10 * n.x + c11 * n.y + c12 * n.z,
-               c20 * n.x + c21 * n.y + c22 * n.z};
-  return normalize(determinant3() < 0 ? -r : r);
+  const auto& m = t.m;
+  c[0][0] = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+  c[0][1] = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+  c[0][2] = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+  c[1][0] = m[0][2] * m[2][1] - m[0][1] * m[2][2];
+  c[1][1] = m[0][0] * m[2][2] - m[0][2] * m[2][0];
+  c[1][2] = m[0][1] * m[2][0] - m[0][0] * m[2][1];
+  c[2][0] = m[0][1] * m[1][2] - m[0][2] * m[1][1];
+  c[2][1] = m[0][2] * m[1][0] - m[0][0] * m[1][2];
+  c[2][2] = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+}
+
+Vec3 NormalTransform::operator()(Vec3 n) const {
+  const Vec3 r{c[0][0] * n.x + c[0][1] * n.y + c[0][2] * n.z, c[1][0] * n.x + c[1][1] * n.y + c[1][2] * n.z,
+               c[2][0] * n.x + c[2][1] * n.y + c[2][2] * n.z};
+  return normalize(mirror ? -r : r);
 }
 
 Mesh worldMesh(const SceneObject& obj) {

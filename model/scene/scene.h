@@ -115,6 +115,15 @@ struct Mat4 {
   double determinant3() const;   // of the linear (upper-left 3x3) part; < 0 mirrors
 };
 
+// Mat4::normal for many normals: the cofactor matrix (det times the inverse transpose) and the
+// sign of det computed once; operator() equals Mat4::normal bit for bit.
+struct NormalTransform {
+  explicit NormalTransform(const Mat4& t);
+  Vec3 operator()(Vec3 n) const;
+  double c[3][3];
+  bool mirror;  // det < 0
+};
+
 struct Material {
   std::string name = "default";
   Vec3 colour{0x30 / 255.0, 0x70 / 255.0, 0xC0 / 255.0};  // base colour, linear 0..1
