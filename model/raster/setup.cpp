@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "raster/span_walk.h"
+
 
 namespace shd {
 
@@ -156,16 +158,21 @@ std::pair<int64_t, int64_t> centreRows(int64_t lo, int64_t hi, int S) {
   return {-((half - lo) >> (S + 1)), (hi - half) >> (S + 1)};
 }
 
-void requireCoord(int64_t v, const SpanParams& p, const char* what) {
+[[noreturn]] __attribute__((noinline, cold)) void coordDoesNotFit(int64_t v, const SpanParams& p, const char* what) {
+  throw std::logic_error(fmt::format("setup: {} = {} does not fit CoordBits {}", what, v, p.CoordBits));
+}
+inline void requireCoord(int64_t v, const SpanParams& p, const char* what) {
   const int64_t lim = int64_t{1} << (p.CoordBits - 1);
-  if (v < -lim || v >= lim)
-    throw std::logic_error(fmt::format("setup: {} = {} does not fit CoordBits {}", what, v, p.CoordBits));
+  if (v < -lim || v >= lim) coordDoesNotFit(v, p, what);
 }
 
-SpanLaneTri buildLaneTri(const Geom& g, bool flip, int64_t ox, int64_t oy, const RasterConfig& cfg) {
+// Appends the lane-triangle of g to `lanes` (built in place).
+void buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, bool flip, int64_t ox, int64_t oy,
+                  const RasterConfig& cfg) {
   const int S = cfg.subpixel_bits;
   const SpanParams& p = cfg.unit;
-  SpanLaneTri t;
+  lanes.push_back(SpanLaneTri{});
+  SpanLaneTri& t = lanes.back();
   t.flip = flip;
   t.ox = static_cast<int32_t>(ox);
   t.oy = static_cast<int32_t>(oy);
@@ -188,7 +195,7 @@ SpanLaneTri buildLaneTri(const Geom& g, bool flip, int64_t ox, int64_t oy, const
     t.clip_x0 = static_cast<int32_t>(-ox);
     t.clip_x1 = static_cast<int32_t>(W - 1 - ox);
   }
-  if (r0 > r1) return t;  // no rows: row_first > row_last
+  if (r0 > r1) return;  // no rows: row_first > row_last
   requireCoord(r0, p, "lane-triangle first row");
   requireCoord(r1, p, "lane-triangle last row");
   t.row_first = static_cast<int32_t>(r0);
@@ -223,7 +230,6 @@ SpanLaneTri buildLaneTri(const Geom& g, bool flip, int64_t ox, int64_t oy, const
     if (D >= (int64_t{1} << p.RemBits))
       throw std::logic_error(fmt::format("setup: edge divisor {} does not fit RemBits {}", D, p.RemBits));
   }
-  return t;
 }
 
 }  // namespace
@@ -340,7 +346,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   auto& lanes = d.tri;
   const SpanMode mode = p.mode();
   if (mode != SpanMode::Sierpinski) {
-    lanes.push_back(buildLaneTri(whole, false, 0, 0, cfg));
+    buildLaneTri(lanes, whole, false, 0, 0, cfg);
   } else {
     // Split at the edge midpoints (exact in u units): T0 = (V0, M01, M20) is the walker frame,
     // T1 = (M01, V1, M12) and T2 = (M20, M12, V2) are its translates by (V1-V0)/2 and
@@ -357,10 +363,10 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
     const int64_t t1x = static_cast<int64_t>(roundDiv(t.X[1] - t.X[0], step)), t1y = static_cast<int64_t>(roundDiv(t.Y[1] - t.Y[0], step));
     const int64_t t2x = static_cast<int64_t>(roundDiv(t.X[2] - t.X[0], step)), t2y = static_cast<int64_t>(roundDiv(t.Y[2] - t.Y[0], step));
     const int64_t ox = static_cast<int64_t>(roundDiv(mx[0] + mx[2], step)) - 1, oy = static_cast<int64_t>(roundDiv(my[0] + my[2], step)) - 1;
-    lanes.push_back(buildLaneTri(g0, false, 0, 0, cfg));
-    lanes.push_back(buildLaneTri(translated(g1, t1x, t1y, S), false, t1x, t1y, cfg));
-    lanes.push_back(buildLaneTri(translated(g2, t2x, t2y, S), false, t2x, t2y, cfg));
-    lanes.push_back(buildLaneTri(reflected(g3, ox, oy, S), true, ox, oy, cfg));
+    buildLaneTri(lanes, g0, false, 0, 0, cfg);
+    buildLaneTri(lanes, translated(g1, t1x, t1y, S), false, t1x, t1y, cfg);
+    buildLaneTri(lanes, translated(g2, t2x, t2y, S), false, t2x, t2y, cfg);
+    buildLaneTri(lanes, reflected(g3, ox, oy, S), true, ox, oy, cfg);
   }
   int64_t row_first = 0, row_last = -1;
   bool any = false;
@@ -379,12 +385,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   d.row_first = static_cast<int32_t>(row_first);
   d.row_last = static_cast<int32_t>(row_last);
   d.xref = static_cast<int32_t>(pl.xref);
-  const int64_t amask = (int64_t{1} << p.AttrBits) - 1;
-  auto wrap = [&](i128 x) {
-    int64_t low = static_cast<int64_t>(static_cast<uint64_t>(x) & static_cast<uint64_t>(amask));
-    if (low >> (p.AttrBits - 1)) low -= int64_t{1} << p.AttrBits;
-    return low;
-  };
+  auto wrap = [&](i128 x) { return span_detail::wrapTo(static_cast<uint64_t>(x), p.AttrBits); };  // mod 2^AttrBits
   for (int k = 0; k < K; ++k) {
     d.iref.push_back(wrap(pl.at(k, d.xref, d.row_first)));
     d.didx.push_back(wrap(pl.didx[static_cast<size_t>(k)]));

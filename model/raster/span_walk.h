@@ -158,7 +158,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
       // shows the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
       const SpanLaneTri& t = d.tri[0];
       const int64_t xg0 = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
-      walk.span_cycles += static_cast<uint64_t>((xe - xg0) / L + 1);
+      walk.span_cycles += static_cast<uint64_t>(L == 1 ? xe - xg0 + 1 : (xe - xg0) / L + 1);  // no division in serial
       if (K == 4) singleRow<4>(p, d, t, w, lo[0], hi[0], irow.data(), emit);
       else singleRow<0>(p, d, t, w, lo[0], hi[0], irow.data(), emit);
       walk.fragments += static_cast<uint64_t>(hi[0] - lo[0] + 1);
