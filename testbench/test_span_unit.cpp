@@ -438,14 +438,15 @@ TEST(TriangleSetup, PlaneCodesAreTheExactRationalsRoundedHalfToEven) {
         const auto& a = t.a[k];
         const i128 nx = static_cast<i128>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) - static_cast<i128>(a[2] - a[0]) * (t.Y[1] - t.Y[0]);
         const i128 ny = static_cast<i128>(t.X[1] - t.X[0]) * (a[2] - a[0]) - static_cast<i128>(t.X[2] - t.X[0]) * (a[1] - a[0]);
-        ASSERT_EQ(s.plane.didx[k], roundHalfEven(nx << S, t.det)) << g.kind() << " attribute " << k;
-        ASSERT_EQ(s.plane.didy[k], roundHalfEven(ny << S, t.det)) << g.kind() << " attribute " << k;
+        const i128 one = i128{1} << S;  // multiplied, not shifted: nx, ny may be negative
+        ASSERT_EQ(s.plane.didx[k], roundHalfEven(nx * one, t.det)) << g.kind() << " attribute " << k;
+        ASSERT_EQ(s.plane.didy[k], roundHalfEven(ny * one, t.det)) << g.kind() << " attribute " << k;
         const i128 cx = (2 * static_cast<i128>(s.plane.xref) + 1) << S, cy = (2 * static_cast<i128>(s.plane.yref) + 1) << S;
         const i128 num = 2 * static_cast<i128>(t.det) * a[0] + nx * (cx - 2 * t.X[0]) + ny * (cy - 2 * t.Y[0]);
         ASSERT_EQ(s.plane.iref[k], roundHalfEven(num, 2 * static_cast<i128>(t.det))) << g.kind() << " attribute " << k;
         ++planes;
         const i128 lim = i128{1} << 52;
-        wide += (nx << S) >= lim || (nx << S) <= -lim || num >= lim || num <= -lim ? 1 : 0;
+        wide += nx * one >= lim || nx * one <= -lim || num >= lim || num <= -lim ? 1 : 0;
       }
     }
     EXPECT_GT(planes, 300000u);
