@@ -367,7 +367,7 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
   for (SpanMode m : allSpanModes()) {
     RasterConfig c;
     c.unit = SpanParams::forMode(m);
-    DescriptorStream stream(5, 3000, c);
+    DescriptorStream stream(5, 2000, c);
     uint64_t fragments = 0, wrapped = 0;
     SpanDesc d;
     std::vector<SpanFragment> walked, wide;
