@@ -166,9 +166,6 @@ module shd_span_unit #(
   reg  [C-1:0]           xe_q;
   reg  [C-1:0]           wspan_q;
   reg  [AV-1:0]          icur_q;
-  reg  [C-1:0]           xg_d;
-  reg  [C-1:0]           xe_d;
-  reg  [AV-1:0]          icur_d;
 
   // ---------------------------------------------------------------- control
   wire in_idle  = (state_q == ST_IDLE);
@@ -226,40 +223,98 @@ module shd_span_unit #(
     end
   end
 
-  // ---------------------------------------------------------------- ROW: walker and edges
+  // ---------------------------------------------------------------- ROW datapath
+  // The logic of this section feeds only registers that load in ROW (w, irow, the edges'
+  // (q, r), lo, hi, ne; xg, xe, icur, wspan on span_load) and state_d's ROW branch (any_ne).
+  // It is written as combinational blocks that compute it under `if (in_row)` and leave it
+  // don't-care ('x) otherwise: a simulator that evaluates every block on every clock
+  // (Verilator) then skips it in SPAN and IDLE cycles, and synthesis may simplify with the
+  // don't-care (the registers load these values only in ROW, where they are unchanged). The
+  // functions carry `verilator no_inline_task`: Verilator then makes them C++ functions with
+  // local variables instead of copying every argument and local into a member of the model at
+  // each call site, which is faster; other tools ignore the comment.
+
+  // One edge slot in row w: the DDA state of row w+1, stepped iff row_first <= w < row_last
+  // (active at w and w < row_last): r' = r - m; if r' < 0 { r' += D; q' = q + k + 1 } else
+  // { q' = q + k }. Returns {q', r'}.
+  function automatic [C+R-1:0] dda_row(input [C-1:0] w, input [C-1:0] rf, input [C-1:0] rl,
+                                       input [C-1:0] q, input [R-1:0] r, input [C-1:0] k,
+                                       input [R-1:0] m, input [R-1:0] div);
+    /*verilator no_inline_task*/
+    reg [R:0] r_sub;  // exact: |r - m| < 2^R
+    begin
+      r_sub = {1'b0, r} - {1'b0, m};
+      if ($signed(rf) <= $signed(w) && $signed(w) < $signed(rl))
+        // 0 <= r' < div < 2^R when 0 <= r, m < div: its low R bits are all of it. q' wraps at
+        // CoordBits.
+        dda_row = {q + k + {{(C-1){1'b0}}, r_sub[R]}, r_sub[R-1:0] + (r_sub[R] ? div : {R{1'b0}})};
+      else
+        dda_row = {q, r};
+    end
+  endfunction
+
+  // An edge slot is active at w iff row_first_e <= w <= row_last_e (signed).
+  function automatic edge_act(input [C-1:0] w, input [C-1:0] rf, input [C-1:0] rl);
+    /*verilator no_inline_task*/
+    edge_act = ($signed(rf) <= $signed(w)) && ($signed(w) <= $signed(rl));
+  endfunction
+
+  // An edge slot's bound: q (left) or -q (right), CoordBits+1 bits (exact).
+  function automatic [C:0] edge_bound(input right, input [C-1:0] q);
+    /*verilator no_inline_task*/
+    edge_bound = right ? (~{q[C-1], q} + {{C{1'b0}}, 1'b1}) : {q[C-1], q};
+  endfunction
+
+  // One lane-triangle in row w: {ne, lo, hi}, lo and hi in CoordBits+1 bits. lo = max(clip_x0,
+  // q of the active left edges), hi = min(clip_x1, -q of the active right edges), compared with
+  // CoordBits+1 bits; ne = row_first <= w <= row_last && lo <= hi.
+  function automatic [2*C+2:0] tri_row(input [C-1:0] w, input [C-1:0] rf, input [C-1:0] rl,
+                                       input [C-1:0] x0, input [C-1:0] x1, input [3*C-1:0] erf,
+                                       input [3*C-1:0] erl, input [2:0] right, input [3*C-1:0] q);
+    /*verilator no_inline_task*/
+    reg [2:0]        act;
+    reg signed [C:0] b_0, b_1, b_2;
+    reg signed [C:0] cl_0, cl_1, cl_2, cr_0, cr_1, cr_2;   // candidates per edge slot
+    reg signed [C:0] lo_x0, hi_x1, lo_a, lo_b, lo, hi_a, hi_b, hi;
+    begin
+      act  = {edge_act(w, erf[2*C +: C], erl[2*C +: C]), edge_act(w, erf[C +: C], erl[C +: C]),
+              edge_act(w, erf[0 +: C], erl[0 +: C])};
+      b_0  = edge_bound(right[0], q[0 +: C]);
+      b_1  = edge_bound(right[1], q[C +: C]);
+      b_2  = edge_bound(right[2], q[2*C +: C]);
+      cl_0 = (act[0] && !right[0]) ? b_0 : EXT_MIN;
+      cl_1 = (act[1] && !right[1]) ? b_1 : EXT_MIN;
+      cl_2 = (act[2] && !right[2]) ? b_2 : EXT_MIN;
+      cr_0 = (act[0] && right[0]) ? b_0 : EXT_MAX;
+      cr_1 = (act[1] && right[1]) ? b_1 : EXT_MAX;
+      cr_2 = (act[2] && right[2]) ? b_2 : EXT_MAX;
+      lo_x0 = {x0[C-1], x0};
+      hi_x1 = {x1[C-1], x1};
+      lo_a = (cl_0 > lo_x0) ? cl_0 : lo_x0;
+      lo_b = (cl_2 > cl_1) ? cl_2 : cl_1;
+      lo   = (lo_b > lo_a) ? lo_b : lo_a;
+      hi_a = (cr_0 < hi_x1) ? cr_0 : hi_x1;
+      hi_b = (cr_2 < cr_1) ? cr_2 : cr_1;
+      hi   = (hi_b < hi_a) ? hi_b : hi_a;
+      tri_row = {edge_act(w, rf, rl) && (lo <= hi), lo, hi};
+    end
+  endfunction
+
   // IDLE (accepting) loads row_first, iref and every edge's (q0, r0); ROW steps them.
   assign w_d = w_q + {{(C-1){1'b0}}, 1'b1};  // ROW: next row, wraps at CoordBits
-
-  wire [NE-1:0]       e_act;     // edge bounds the span at w
-  wire [NE*(C+1)-1:0] e_bound;   // q (left) or -q (right), CoordBits+1 bits
 
   genvar e;
   generate
     for (e = 0; e < NE; e = e + 1) begin : g_edge
-      wire signed [C-1:0] rf_e  = e_row_first_q[e*C +: C];
-      wire signed [C-1:0] rl_e  = e_row_last_q[e*C +: C];
-      wire signed [C-1:0] w_e   = w_q;
-      wire [C-1:0]        q_e   = quo_q[e*C +: C];
-      wire [C-1:0]        k_e   = e_k_q[e*C +: C];
-      wire [R-1:0]        r_e   = rem_q[e*R +: R];
-      wire [R-1:0]        m_e   = e_m_q[e*R +: R];
-      wire [R-1:0]        div_e = e_div_q[e*R +: R];
-      wire [C:0]          q_x   = {q_e[C-1], q_e};
-
-      assign e_act[e] = (rf_e <= w_e) && (w_e <= rl_e);
-      wire step_e = (rf_e <= w_e) && (w_e < rl_e);      // active at w and w < row_last
-      assign e_bound[e*(C+1) +: C+1] = e_right_q[e] ? (~q_x + {{C{1'b0}}, 1'b1}) : q_x;
-
-      // DDA: r' = r - m; if r' < 0 { r' += D; q' = q + k + 1 } else { q' = q + k }.
-      wire [R:0]   r_sub  = {1'b0, r_e} - {1'b0, m_e};      // exact: |r - m| < 2^R
-      wire         borrow = r_sub[R];
-      wire [R:0]   r_fix  = r_sub + (borrow ? {1'b0, div_e} : {(R+1){1'b0}});
-      // 0 <= r_fix < div < 2^R when 0 <= r, m < div: r_fix[R] is 0.
-      wire         unused_r_fix = r_fix[R];
-      wire [C-1:0] q_next = q_e + k_e + {{(C-1){1'b0}}, borrow};  // wraps at CoordBits
-
-      assign quo_d[e*C +: C] = step_e ? q_next : q_e;
-      assign rem_d[e*R +: R] = step_e ? r_fix[R-1:0] : r_e;
+      reg [C+R-1:0] qr_d;
+      always @* begin
+        qr_d = {(C+R){1'bx}};
+        if (in_row)
+          qr_d = dda_row(w_q, e_row_first_q[e*C +: C], e_row_last_q[e*C +: C], quo_q[e*C +: C],
+                         rem_q[e*R +: R], e_k_q[e*C +: C], e_m_q[e*R +: R], e_div_q[e*R +: R]);
+      end
+      assign quo_d[e*C +: C] = qr_d[R +: C];
+      assign rem_d[e*R +: R] = qr_d[0 +: R];
     end
   endgenerate
 
@@ -282,43 +337,24 @@ module shd_span_unit #(
   end
 
   // ---------------------------------------------------------------- ROW: lane-triangle bounds
-  // lo_j = max(clip_x0_j, q of the active left edges), hi_j = min(clip_x1_j, -q of the active
-  // right edges), compared with CoordBits+1 bits; ne_j = in_j && lo_j <= hi_j.
   genvar j;
   generate
     for (j = 0; j < NumTri; j = j + 1) begin : g_tri
-      wire signed [C-1:0] rf_j = lt_row_first_q[j*C +: C];
-      wire signed [C-1:0] rl_j = lt_row_last_q[j*C +: C];
-      wire signed [C-1:0] w_j  = w_q;
-      wire [C-1:0]        x0_j = lt_clip_x0_q[j*C +: C];
-      wire [C-1:0]        x1_j = lt_clip_x1_q[j*C +: C];
-      wire signed [C:0]   cl_0, cl_1, cl_2, cr_0, cr_1, cr_2;   // candidates per edge slot
-      wire signed [C:0]   b_0 = e_bound[(j*3+0)*(C+1) +: C+1];
-      wire signed [C:0]   b_1 = e_bound[(j*3+1)*(C+1) +: C+1];
-      wire signed [C:0]   b_2 = e_bound[(j*3+2)*(C+1) +: C+1];
-      wire [2:0]          act_j   = e_act[j*3 +: 3];
-      wire [2:0]          right_j = e_right_q[j*3 +: 3];
-      assign cl_0 = (act_j[0] && !right_j[0]) ? b_0 : EXT_MIN;
-      assign cl_1 = (act_j[1] && !right_j[1]) ? b_1 : EXT_MIN;
-      assign cl_2 = (act_j[2] && !right_j[2]) ? b_2 : EXT_MIN;
-      assign cr_0 = (act_j[0] && right_j[0]) ? b_0 : EXT_MAX;
-      assign cr_1 = (act_j[1] && right_j[1]) ? b_1 : EXT_MAX;
-      assign cr_2 = (act_j[2] && right_j[2]) ? b_2 : EXT_MAX;
-      wire signed [C:0] lo_x0 = {x0_j[C-1], x0_j};
-      wire signed [C:0] hi_x1 = {x1_j[C-1], x1_j};
-      wire signed [C:0] lo_a  = (cl_0 > lo_x0) ? cl_0 : lo_x0;
-      wire signed [C:0] lo_b  = (cl_2 > cl_1) ? cl_2 : cl_1;
-      wire signed [C:0] lo_j  = (lo_b > lo_a) ? lo_b : lo_a;
-      wire signed [C:0] hi_a  = (cr_0 < hi_x1) ? cr_0 : hi_x1;
-      wire signed [C:0] hi_b  = (cr_2 < cr_1) ? cr_2 : cr_1;
-      wire signed [C:0] hi_j  = (hi_b < hi_a) ? hi_b : hi_a;
-      // lo_j is a CoordBits value (clip_x0 or some q); hi_j <= clip_x1 and hi_j >= -(2^(C-1)-1)
+      reg [2*C+2:0] b_d;   // {ne, lo, hi}, lo and hi in CoordBits+1 bits
+      always @* begin
+        b_d = {(2*C+3){1'bx}};
+        if (in_row)
+          b_d = tri_row(w_q, lt_row_first_q[j*C +: C], lt_row_last_q[j*C +: C],
+                        lt_clip_x0_q[j*C +: C], lt_clip_x1_q[j*C +: C],
+                        e_row_first_q[j*3*C +: 3*C], e_row_last_q[j*3*C +: 3*C],
+                        e_right_q[j*3 +: 3], quo_q[j*3*C +: 3*C]);
+      end
+      // lo is a CoordBits value (clip_x0 or some q); hi <= clip_x1 and hi >= -(2^(C-1)-1)
       // unless it is clip_x1 (see header): both fit CoordBits, the MSBs are sign copies.
-      wire unused_lohi_msb = lo_j[C] ^ hi_j[C];
-
-      assign ne_d[j] = (rf_j <= w_j) && (w_j <= rl_j) && (lo_j <= hi_j);
-      assign lo_d[j*C +: C] = lo_j[C-1:0];
-      assign hi_d[j*C +: C] = hi_j[C-1:0];
+      assign ne_d[j] = b_d[2*C+2];
+      assign lo_d[j*C +: C] = b_d[C+1 +: C];
+      assign hi_d[j*C +: C] = b_d[0 +: C];
+      wire unused_lohi_msb = b_d[2*C+1] ^ b_d[C];
     end
   endgenerate
 
@@ -335,12 +371,17 @@ module shd_span_unit #(
   reg signed [C-1:0] xe_r;
   integer t;
   always @* begin
-    xs_r = COORD_MAX;
-    xe_r = COORD_MIN;
-    for (t = 0; t < NumTri; t = t + 1) begin
-      if (ne_d[t]) begin
-        if ($signed(lo_d[t*C +: C]) < xs_r) xs_r = lo_d[t*C +: C];
-        if ($signed(hi_d[t*C +: C]) > xe_r) xe_r = hi_d[t*C +: C];
+    t    = 0;  // the loop variable too is assigned on every path (no latch)
+    xs_r = {C{1'bx}};
+    xe_r = {C{1'bx}};
+    if (in_row) begin
+      xs_r = COORD_MAX;
+      xe_r = COORD_MIN;
+      for (t = 0; t < NumTri; t = t + 1) begin
+        if (ne_d[t]) begin
+          if ($signed(lo_d[t*C +: C]) < xs_r) xs_r = lo_d[t*C +: C];
+          if ($signed(hi_d[t*C +: C]) > xe_r) xe_r = hi_d[t*C +: C];
+        end
       end
     end
   end
@@ -364,11 +405,14 @@ module shd_span_unit #(
   generate
     for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
       wire signed [A-1:0]  didx_a = didx_q[a*A +: A];
-      wire signed [MW-1:0] didx_x = {{(C+1){didx_a[A-1]}}, didx_a};
-      wire signed [MW-1:0] dx_x   = {{A{dx_row[C]}}, dx_row};
       // Signed A x (C+1) product (the sign copies are removed by synthesis); only its low
-      // AttrBits are needed: the plane is computed modulo 2^AttrBits.
-      wire signed [MW-1:0] prod_a = didx_x * dx_x;
+      // AttrBits are needed: the plane is computed modulo 2^AttrBits. ROW only.
+      reg signed [MW-1:0] prod_a;
+      always @* begin
+        prod_a = {MW{1'bx}};
+        if (in_row)
+          prod_a = $signed({{(C+1){didx_a[A-1]}}, didx_a}) * $signed({{A{dx_row[C]}}, dx_row});
+      end
       wire unused_prod_msbs = ^prod_a[MW-1:A];
       assign icur_row[a*A +: A]  = irow_q[a*A +: A] + prod_a[A-1:0];
       assign icur_step[a*A +: A] = icur_q[a*A +: A] + (didx_q[a*A +: A] << LOG2L);
@@ -376,30 +420,22 @@ module shd_span_unit #(
     end
   endgenerate
 
-  always @* begin
-    xg_d   = xg_q;
-    xe_d   = xe_q;
-    icur_d = icur_q;
+  // xg, icur load the row's start (span_load) or step (span_step), xe and wspan the row's span.
+  // The muxes sit in the clocked block, like the walker's, so that Verilator's input logic
+  // (span_step depends on out_ready_i) does not re-evaluate the row-start multiply.
+  always @(posedge clk_i) begin
     if (span_load) begin
-      xg_d   = xg_row;
-      xe_d   = xe_r;
-      icur_d = icur_row;
+      xg_q   <= xg_row;
+      icur_q <= icur_row;
     end else if (span_step) begin
-      xg_d   = xg_next[C-1:0];
-      icur_d = icur_step;
-    end
-  end
-
-  always @(posedge clk_i) begin
-    if (span_load || span_step) begin
-      xg_q   <= xg_d;
-      icur_q <= icur_d;
+      xg_q   <= xg_next[C-1:0];
+      icur_q <= icur_step;
     end
   end
 
   always @(posedge clk_i) begin
     if (span_load) begin
-      xe_q    <= xe_d;
+      xe_q    <= xe_r;
       wspan_q <= w_q;
     end
   end

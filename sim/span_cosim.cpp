@@ -1,8 +1,10 @@
 #include "span_cosim.h"
 
+#include <array>
 #include <chrono>
 #include <filesystem>
 #include <random>
+#include <stdexcept>
 #include <vector>
 
 #include <fmt/format.h>
@@ -27,17 +29,48 @@ nlohmann::json toJson(const SpanDesc& d) {
           {"iref", d.iref}, {"didx", d.didx},           {"didy", d.didy},         {"tri", tris}};
 }
 
+ReadyDraw::ReadyDraw(double p) {
+  // The distribution's answer when the generator returns x.
+  struct Fixed {
+    using result_type = std::mt19937_64::result_type;
+    static constexpr result_type min() { return std::mt19937_64::min(); }
+    static constexpr result_type max() { return std::mt19937_64::max(); }
+    result_type x;
+    result_type operator()() { return x; }
+  };
+  auto answer = [p](uint64_t x) {
+    Fixed g{x};
+    return std::bernoulli_distribution(p)(g);
+  };
+  if (answer(Fixed::max())) {
+    always_ = true;
+    return;
+  }
+  // answer(hi) is false; find the least such hi.
+  uint64_t lo = 0, hi = Fixed::max();
+  if (!answer(lo)) return;  // threshold 0: never
+  while (hi - lo > 1) {
+    const uint64_t mid = lo + (hi - lo) / 2;
+    (answer(mid) ? lo : hi) = mid;
+  }
+  threshold_ = hi;
+}
+
 std::string compareSpanOutputs(const SpanOut& exp, const SpanOut& got) {
   if (exp.desc_ready != got.desc_ready)
     return fmt::format("desc_ready: model {} rtl {}", exp.desc_ready, got.desc_ready);
   if (exp.out_valid != got.out_valid) return fmt::format("out_valid: model {} rtl {}", exp.out_valid, got.out_valid);
   if (exp.out_valid && exp.tag != got.tag) return fmt::format("tag: model {} rtl {}", exp.tag, got.tag);
+  if (exp.lane.size() != got.lane.size())
+    return fmt::format("lanes: model {} rtl {}", exp.lane.size(), got.lane.size());
   for (size_t l = 0; l < exp.lane.size(); ++l) {
     const SpanLaneOut &e = exp.lane[l], &g = got.lane[l];
     if (e.valid != g.valid) return fmt::format("lane {} valid: model {} rtl {}", l, e.valid, g.valid);
     if (!e.valid) continue;
     if (e.x != g.x || e.y != g.y)
       return fmt::format("lane {} pixel: model ({}, {}) rtl ({}, {})", l, e.x, e.y, g.x, g.y);
+    if (e.attr.size() != g.attr.size())
+      return fmt::format("lane {} attributes: model {} rtl {}", l, e.attr.size(), g.attr.size());
     for (size_t a = 0; a < e.attr.size(); ++a)
       if (e.attr[a] != g.attr[a])
         return fmt::format("lane {} pixel ({}, {}) attribute {}: model {} rtl {}", l, e.x, e.y, a, e.attr[a], g.attr[a]);
@@ -53,13 +86,18 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   const SpanParams model_params = opts.model_params ? *opts.model_params : dut->params();
   SpanUnitModel model(model_params);
   std::mt19937_64 rng(opts.seed);
-  std::bernoulli_distribution ready(opts.ready_prob), gap(opts.desc_gap_prob);
+  const ReadyDraw ready(opts.ready_prob);
+  std::bernoulli_distribution gap(opts.desc_gap_prob);
 
   dut->reset();
   model.reset();
-  SpanDesc cur, pending;
+  // The accepted descriptor and the pending one, in two buffers that swap roles on accepting
+  // (no copy per triangle).
+  std::array<SpanDesc, 2> desc_buf;
+  SpanDesc* cur = &desc_buf[0];
+  SpanDesc* pending = &desc_buf[1];
   bool have_cur = false;  // a descriptor has been accepted
-  bool have_pending = next(pending);
+  bool have_pending = next(*pending);
   int wait = have_pending && gap(rng) ? 1 + static_cast<int>(rng() % 3) : 0;
   // The inputs (desc_valid, out_ready) from the cycle that accepted `cur` (from reset before
   // the first one) to now: with `cur` and `pending` they reproduce the unit's state, because
@@ -75,33 +113,38 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
     SpanIn in;
     in.out_ready = ready(rng);
     in.desc_valid = have_pending && wait == 0;
-    in.desc = &pending;
+    in.desc = pending;
     if (wait > 0) --wait;
     model.tick(in, exp);
-    dut->tick(in, got);
+    // The comparison is done on the ports (SpanDut::tickCheck, equal to compareSpanOutputs);
+    // the RTL's outputs are read out for the message only when they differ.
+    const bool same = dut->tickCheck(in, exp, got);
     window.emplace_back(in.desc_valid, in.out_ready);
     if (exp.out_valid && in.out_ready)
       for (const SpanLaneOut& l : exp.lane) res.fragments += l.valid ? 1 : 0;
-    const std::string diff = compareSpanOutputs(exp, got);
-    if (!diff.empty()) {
+    if (!same) {
+      const std::string diff = compareSpanOutputs(exp, got);
+      if (diff.empty())
+        throw std::logic_error(fmt::format("span {}: tickCheck and compareSpanOutputs disagree at cycle {}", mode,
+                                           model.cycle()));
       ++res.mismatches;
       if (!res.first) {
-        res.first = SpanMismatch{model.cycle(), cur.tag, diff};
-        fail_desc = cur;
+        res.first = SpanMismatch{model.cycle(), cur->tag, diff};
+        fail_desc = *cur;
         fail_has_cur = have_cur;
-        fail_next = pending;
+        fail_next = *pending;
         fail_window = window;
         failed_triangle_saved = true;
       }
       if (res.mismatches >= opts.max_mismatches) break;
     }
     if (in.desc_valid && exp.desc_ready) {  // accepted at this edge
-      cur = pending;
+      std::swap(cur, pending);
       have_cur = true;
       window.assign(1, {true, in.out_ready});
       ++res.triangles;
       if (opts.progress && (res.triangles & 4095) == 0) opts.progress(res.triangles);
-      have_pending = next(pending);
+      have_pending = next(*pending);
       wait = have_pending && gap(rng) ? 1 + static_cast<int>(rng() % 3) : 0;
     }
   }

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <random>
 #include <string>
 
 #include <nlohmann/json_fwd.hpp>
@@ -50,6 +51,24 @@ struct SpanCosimResult {
   double seconds = 0;
   std::optional<SpanMismatch> first;
   std::string fst_path, case_path, vector_path;
+};
+
+// The co-simulation's out_ready draw: bit for bit std::bernoulli_distribution(p) on the same
+// generator (one rng() per draw), with an integer comparison instead of the conversion to
+// double. The distribution answers generate_canonical(x) < p for x = rng(), which is monotone in
+// x: it is x < threshold for the least x where it is false, found once by bisection on the
+// distribution itself.
+class ReadyDraw {
+ public:
+  explicit ReadyDraw(double p);
+  bool operator()(std::mt19937_64& rng) const {
+    const uint64_t x = rng();
+    return always_ || x < threshold_;
+  }
+
+ private:
+  bool always_ = false;  // true for every x (p >= 1)
+  uint64_t threshold_ = 0;
 };
 
 // next(d) fills the next descriptor and returns false at the end of the stream.

@@ -24,6 +24,13 @@ class SpanDut {
     tick(in, out);
     return out;
   }
+  // tick() with the checker's comparison done on the ports (the co-simulation's hot path):
+  // true when this cycle's outputs equal `expected` as compareSpanOutputs (span_cosim.h)
+  // compares them: desc_ready, out_valid, the tag while out_valid, each lane's valid bit and,
+  // on each lane valid in `expected`, the pixel and every attribute (also false when the lane
+  // or attribute counts differ). When false, `out` holds this cycle's outputs as tick() gives
+  // them, for compareSpanOutputs' message; when true, `out` is left as it was.
+  virtual bool tickCheck(const SpanIn& in, const SpanOut& expected, SpanOut& out) = 0;
   virtual uint64_t cycle() const = 0;
   virtual void finish() = 0;
 };

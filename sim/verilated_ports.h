@@ -42,17 +42,13 @@ std::enable_if_t<std::is_integral_v<T>, uint64_t> get(const T& port, int lsb, in
 
 template <std::size_t N>
 uint64_t get(const VlWide<N>& port, int lsb, int width) {
-  uint64_t v = 0;
-  int done = 0;
-  while (done < width) {
-    const std::size_t w = static_cast<std::size_t>(lsb / 32);
-    const int off = lsb % 32, n = std::min(width - done, 32 - off);
-    const uint64_t bits = (port[w] >> off) & (n == 32 ? ~uint32_t{0} : ((uint32_t{1} << n) - 1));
-    v |= bits << done;
-    done += n;
-    lsb += n;
-  }
-  return v;
+  // The field covers bits [lsb, lsb + width) of the 32-bit words: at most three of them.
+  std::size_t w = static_cast<unsigned>(lsb) / 32;
+  const unsigned off = static_cast<unsigned>(lsb) % 32;
+  uint64_t v = static_cast<uint64_t>(port[w]) >> off;
+  for (int done = 32 - static_cast<int>(off); done < width; done += 32)
+    v |= static_cast<uint64_t>(port[++w]) << done;
+  return width >= 64 ? v : v & ((uint64_t{1} << width) - 1);
 }
 
 inline int64_t signExtend(uint64_t v, int width) {

@@ -4,13 +4,20 @@
 
 #include "test_util.h"
 
+#include <array>
 #include <filesystem>
 #include <fstream>
+#include <random>
 
 #include "raster/desc_stream.h"
 #include "replay.h"
 #include "span_cosim.h"
 #include "vector_gen.h"
+// Verilator's own headers are not -Wextra clean (verilated_types.h:1127, an unused parameter).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#include "verilated_ports.h"
+#pragma GCC diagnostic pop
 
 using namespace shd;
 namespace fs = std::filesystem;
@@ -83,4 +90,145 @@ TEST(SpanCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
   EXPECT_EQ(rr.cycles, 2000u);
   EXPECT_GT(rr.results, 1000u);
   EXPECT_EQ(rr.mismatches, 0u) << (rr.first ? rr.first->describe() : "");
+}
+
+TEST(SpanCosim, TickCheckFindsEveryDifferenceTheComparisonFinds) {
+  // The co-simulation compares on the ports (SpanDut::tickCheck) and calls compareSpanOutputs
+  // only for the message: on real runs of every mode, each cycle's expected outputs are given
+  // either as the model has them (tickCheck must pass) or with one compared field changed, in
+  // turn: desc_ready, out_valid, the tag, a lane's valid bit, a valid lane's x, y, an
+  // attribute (by one, and by 2^AttrBits: the same low bits), the lane and attribute counts.
+  // tickCheck must then fail, and the outputs it reads out must show the difference to
+  // compareSpanOutputs and equal the model's.
+  enum Kind { kNone, kDescReady, kOutValid, kTag, kLaneValid, kX, kY, kAttr, kAttrHigh, kLanes, kAttrCount, kKinds };
+  for (const std::string& mode : rtlSpanConfigs()) {
+    auto dut = makeSpanDut(mode, "");
+    const SpanParams p = dut->params();
+    SpanUnitModel model(p);
+    dut->reset();
+    model.reset();
+    auto next = stream(parseSpanMode(mode), 9, 400);
+    SpanDesc pending;
+    bool have = next(pending);
+    std::mt19937_64 rng(4);
+    std::array<int, kKinds> changed{};
+    SpanOut exp, bad, got;
+    for (uint64_t c = 0; have || !model.idle(); ++c) {
+      SpanIn in;
+      in.desc_valid = have;
+      in.desc = &pending;
+      in.out_ready = rng() % 4 != 0;
+      model.tick(in, exp);
+      bad = exp;
+      SpanLaneOut* valid_lane = nullptr;  // the last valid lane of `bad`, if any
+      for (SpanLaneOut& l : bad.lane)
+        if (l.valid) valid_lane = &l;
+      Kind kind = static_cast<Kind>(c % kKinds);
+      const size_t a = c % static_cast<size_t>(p.NumAttr);
+      if ((kind == kTag && !exp.out_valid) || (kind >= kX && kind != kLanes && valid_lane == nullptr)) kind = kNone;
+      switch (kind) {
+        case kDescReady: bad.desc_ready = !bad.desc_ready; break;
+        case kOutValid: bad.out_valid = !bad.out_valid; break;
+        case kTag: bad.tag += 1; break;
+        case kLaneValid: bad.lane[c % bad.lane.size()].valid ^= true; break;
+        case kX: valid_lane->x += 1; break;
+        case kY: valid_lane->y ^= 1; break;
+        case kAttr: valid_lane->attr[a] -= 1; break;
+        case kAttrHigh: valid_lane->attr[a] += int64_t{1} << p.AttrBits; break;
+        case kLanes: bad.lane.pop_back(); break;
+        case kAttrCount: valid_lane->attr.resize(a); break;
+        default: break;
+      }
+      got = SpanOut{};
+      const bool same = dut->tickCheck(in, bad, got);
+      if (kind == kNone) {
+        ASSERT_TRUE(same) << mode << " cycle " << c << ": the model's own outputs do not pass";
+      } else {
+        ASSERT_FALSE(same) << mode << " cycle " << c << ": change " << kind << " not found";
+        EXPECT_NE(compareSpanOutputs(bad, got), "") << mode << " cycle " << c << " change " << kind;
+        ASSERT_EQ(compareSpanOutputs(exp, got), "") << mode << " cycle " << c;
+        ++changed[kind];
+      }
+      if (in.desc_valid && exp.desc_ready) have = next(pending);
+    }
+    for (int k = kDescReady; k < kKinds; ++k) EXPECT_GT(changed[static_cast<size_t>(k)], 10) << mode << " change " << k;
+  }
+}
+
+TEST(SpanCosim, OneEvalCyclesEqualTwoEvalCycles) {
+  // Untraced, the harness clocks a cycle with one eval (VerilatedHarness::cycle); traced, with
+  // a falling and a rising edge. On every mode, from reset, with back-pressure and descriptor
+  // gaps, both instances give the same outputs on every cycle, and those are the model's.
+  const fs::path dir = shd::testutil::freshTestDir("span_cosim");
+  for (const std::string& mode : rtlSpanConfigs()) {
+    auto fast = makeSpanDut(mode, "");
+    auto traced = makeSpanDut(mode, (dir / (mode + ".fst")).string());
+    SpanUnitModel model(fast->params());
+    fast->reset();
+    traced->reset();
+    model.reset();
+    auto next = stream(parseSpanMode(mode), 13, 150);
+    SpanDesc pending;
+    bool have = next(pending);
+    std::mt19937_64 rng(8);
+    SpanOut exp, a, b;
+    uint64_t cycles = 0;
+    while (have || !model.idle()) {
+      SpanIn in;
+      in.desc_valid = have && rng() % 5 != 0;
+      in.desc = &pending;
+      in.out_ready = rng() % 3 != 0;
+      model.tick(in, exp);
+      fast->tick(in, a);
+      traced->tick(in, b);
+      ++cycles;
+      ASSERT_EQ(compareSpanOutputs(exp, a), "") << mode << " untraced, cycle " << cycles;
+      ASSERT_EQ(compareSpanOutputs(exp, b), "") << mode << " traced, cycle " << cycles;
+      if (in.desc_valid && exp.desc_ready) have = next(pending);
+    }
+    EXPECT_EQ(fast->cycle(), traced->cycle());
+    traced->finish();
+    EXPECT_GT(fs::file_size(dir / (mode + ".fst")), 100u);
+    std::printf("%s: %llu cycles equal\n", mode.c_str(), static_cast<unsigned long long>(cycles));
+  }
+}
+
+TEST(SpanCosim, ReadyDrawEqualsTheBernoulliDistribution) {
+  for (double p : {0.0, 0.05, 0.3, 0.5, 0.8, 0.999, 1.0}) {
+    std::mt19937_64 a(11), b(11);
+    std::bernoulli_distribution ref(p);
+    const ReadyDraw fast(p);
+    uint64_t ones = 0;
+    for (int i = 0; i < 200000; ++i) {
+      const bool r = ref(a);
+      ASSERT_EQ(fast(b), r) << "p " << p << " draw " << i;
+      ones += r;
+    }
+    std::printf("p %.3f: %llu of 200000 draws true\n", p, static_cast<unsigned long long>(ones));
+  }
+}
+
+TEST(VerilatedPorts, WideFieldsReadBackAsWrittenAndLeaveTheRestAlone) {
+  // get/put on a 160-bit port against a bit-by-bit reference, fields of 1..64 bits anywhere.
+  VlWide<5> port;
+  std::array<bool, 160> ref{};
+  for (int w = 0; w < 5; ++w) port[static_cast<size_t>(w)] = 0;
+  std::mt19937_64 rng(3);
+  for (int i = 0; i < 20000; ++i) {
+    const int width = 1 + static_cast<int>(rng() % 64);
+    const int lsb = static_cast<int>(rng() % static_cast<uint64_t>(160 - width + 1));
+    const uint64_t v = rng();
+    ports::put(port, lsb, width, v);
+    for (int b = 0; b < width; ++b) ref[static_cast<size_t>(lsb + b)] = (v >> b) & 1;
+    const uint64_t mask = width == 64 ? ~uint64_t{0} : (uint64_t{1} << width) - 1;
+    ASSERT_EQ(ports::get(port, lsb, width), v & mask) << "lsb " << lsb << " width " << width;
+    for (int b = 0; b < 160; ++b)
+      ASSERT_EQ((port[static_cast<size_t>(b / 32)] >> (b % 32)) & 1, ref[static_cast<size_t>(b)] ? 1u : 0u) << b;
+    // A read of any other field agrees with the reference too.
+    const int w2 = 1 + static_cast<int>(rng() % 64);
+    const int l2 = static_cast<int>(rng() % static_cast<uint64_t>(160 - w2 + 1));
+    uint64_t expect = 0;
+    for (int b = 0; b < w2; ++b) expect |= uint64_t{ref[static_cast<size_t>(l2 + b)]} << b;
+    ASSERT_EQ(ports::get(port, l2, w2), expect) << "lsb " << l2 << " width " << w2;
+  }
 }

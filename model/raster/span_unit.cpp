@@ -85,12 +85,12 @@ int64_t SpanUnitModel::wrapCoord(int64_t v) const { return wrapTo(u(v), p_.Coord
 
 void SpanUnitModel::reset() {
   state_ = State::Idle;
-  e_.assign(static_cast<size_t>(p_.NumTri) * 3, SpanDdaState{});
-  irow_.assign(static_cast<size_t>(p_.NumAttr), 0);
-  icur_.assign(static_cast<size_t>(p_.NumAttr), 0);
-  lo_.assign(static_cast<size_t>(p_.NumTri), 0);
-  hi_.assign(static_cast<size_t>(p_.NumTri), 0);
-  ne_.assign(static_cast<size_t>(p_.NumTri), false);
+  e_.fill(SpanDdaState{});
+  irow_.fill(0);
+  icur_.fill(0);
+  lo_.fill(0);
+  hi_.fill(0);
+  ne_.fill(false);
   cycle_ = row_cycles_ = span_cycles_ = 0;
 }
 
@@ -98,19 +98,24 @@ void SpanUnitModel::outputs(SpanOut& o) const {
   o.desc_ready = state_ == State::Idle;
   o.out_valid = false;
   o.tag = 0;
-  o.lane.resize(static_cast<size_t>(p_.lanes()));
-  for (SpanLaneOut& l : o.lane) l.valid = false;
-  if (state_ != State::Span) return;
+  const size_t lanes = static_cast<size_t>(p_.lanes());
+  if (o.lane.size() != lanes) o.lane.resize(lanes);
+  if (state_ != State::Span) {
+    for (SpanLaneOut& l : o.lane) l.valid = false;
+    return;
+  }
   o.tag = d_.tag;
   const int L = p_.LanesPerTri;
+  const size_t K = static_cast<size_t>(p_.NumAttr);
   for (int j = 0; j < p_.NumTri; ++j) {
-    const SpanLaneTri& t = d_.tri[static_cast<size_t>(j)];
+    const size_t ju = static_cast<size_t>(j);
+    const SpanLaneTri& t = d_.tri[ju];
     for (int i = 0; i < L; ++i) {
       SpanLaneOut& lane = o.lane[static_cast<size_t>(j * L + i)];
       const int64_t x = xg_ + i;  // CoordBits + 1 bits: no wrap
-      lane.valid = ne_[static_cast<size_t>(j)] && lo_[static_cast<size_t>(j)] <= x && x <= hi_[static_cast<size_t>(j)];
+      lane.valid = ne_[ju] && lo_[ju] <= x && x <= hi_[ju];
       if (!lane.valid) continue;
-      lane.attr.resize(static_cast<size_t>(p_.NumAttr));
+      if (lane.attr.size() != K) lane.attr.resize(K);
       laneFragment(p_, d_, t, x, wspan_, icur_.data(), i, lane.x, lane.y, lane.attr.data());
       o.out_valid = true;
     }
@@ -140,7 +145,7 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
             const SpanEdge& e = d_.tri[static_cast<size_t>(j)].edge[s];
             e_[static_cast<size_t>(j * 3 + s)] = {e.q, e.r};
           }
-        irow_.assign(d_.iref.begin(), d_.iref.end());
+        std::copy(d_.iref.begin(), d_.iref.end(), irow_.begin());
         state_ = State::Row;
       }
       break;
@@ -208,8 +213,9 @@ SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d) {
   in.desc = &d;
   in.out_ready = true;
   bool accepted = false;
+  SpanOut o;  // reused: no allocation per cycle
   for (;;) {
-    const SpanOut o = m.tick(in);
+    m.tick(in, o);
     ++run.cycles;
     if (!accepted) {
       accepted = o.desc_ready;

@@ -76,6 +76,7 @@
 //   every value a valid lane shows fits, so wrapping only ever touches masked lanes.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -198,10 +199,12 @@ class SpanUnitModel {
   State state_ = State::Idle;
   SpanDesc d_;
   int64_t w_ = 0, wspan_ = 0, xg_ = 0, xe_ = 0;
-  std::vector<SpanDdaState> e_;      // NumTri*3
-  std::vector<int64_t> irow_, icur_;  // NumAttr
-  std::vector<int64_t> lo_, hi_;      // NumTri
-  std::vector<bool> ne_;
+  // Registers held in place, sized for the largest unit; the first NumTri*3, NumAttr and NumTri
+  // are used.
+  std::array<SpanDdaState, kMaxLaneTri * 3> e_{};
+  std::array<int64_t, kMaxAttr> irow_{}, icur_{};
+  std::array<int64_t, kMaxLaneTri> lo_{}, hi_{};
+  std::array<bool, kMaxLaneTri> ne_{};
   uint64_t cycle_ = 0, row_cycles_ = 0, span_cycles_ = 0;
 };
 
