@@ -319,7 +319,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   std::optional<PointShader> shader;  // the current object's material and lobe
 
   // A point's shade, with its device-lobe evaluations done by the specular unit right away
-  // (vertices: few; pixels are batched per triangle below).
+  // (vertices: few; pixels are batched per triangle below, or evaluated one by one on the model).
   auto shadeNow = [&](Vec3 n, Vec3 p) {
     point_requests.clear();
     Shade s = shader->shade(n, p, &point_requests);
