@@ -147,14 +147,14 @@ class SpanDutImpl final : public SpanDut {
     o.out_valid = h_.dut().out_valid_o;
     o.tag = static_cast<uint32_t>(get(h_.dut().out_tag_o, 0, kP.TagBits));
     constexpr int L = kLanes, PB = kP.PixBits, AB = kP.AttrBits, K = kP.NumAttr;
-    if (o.lane.size() != static_cast<size_t>(L)) o.lane.resize(static_cast<size_t>(L));
+    o.lane.resize(static_cast<size_t>(L));
     for (int l = 0; l < L; ++l) {
       SpanLaneOut& lane = o.lane[static_cast<size_t>(l)];
       lane.valid = get(h_.dut().out_lane_valid_o, l, 1) != 0;
       if (!lane.valid) continue;
       lane.x = static_cast<int32_t>(get(h_.dut().out_x_o, l * PB, PB));
       lane.y = static_cast<int32_t>(get(h_.dut().out_y_o, l * PB, PB));
-      if (lane.attr.size() != static_cast<size_t>(K)) lane.attr.resize(static_cast<size_t>(K));
+      lane.attr.resize(static_cast<size_t>(K));
       for (int a = 0; a < K; ++a)
         lane.attr[static_cast<size_t>(a)] = ports::signExtend(get(h_.dut().out_attr_o, (l * K + a) * AB, AB), AB);
     }

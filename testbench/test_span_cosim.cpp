@@ -32,6 +32,16 @@ std::function<bool(SpanDesc&)> stream(SpanMode mode, uint64_t seed, long count) 
   return [s](SpanDesc& d) { return s->next(d); };
 }
 
+// That stream offered to a unit cycle by cycle: the descriptor on offer, if any, and the next
+// one once the unit has accepted it.
+struct Offer {
+  Offer(SpanMode mode, uint64_t seed, long count) : next(stream(mode, seed, count)) { have = next(pending); }
+  void accepted() { have = next(pending); }
+  std::function<bool(SpanDesc&)> next;
+  SpanDesc pending;
+  bool have = false;
+};
+
 }  // namespace
 
 class SpanCosimModes : public testing::TestWithParam<std::string> {};
@@ -107,16 +117,14 @@ TEST(SpanCosim, TickCheckFindsEveryDifferenceTheComparisonFinds) {
     SpanUnitModel model(p);
     dut->reset();
     model.reset();
-    auto next = stream(parseSpanMode(mode), 9, 400);
-    SpanDesc pending;
-    bool have = next(pending);
+    Offer offer(parseSpanMode(mode), 9, 400);
     std::mt19937_64 rng(4);
     std::array<int, kKinds> changed{};
     SpanOut exp, bad, got;
-    for (uint64_t c = 0; have || !model.idle(); ++c) {
+    for (uint64_t c = 0; offer.have || !model.idle(); ++c) {
       SpanIn in;
-      in.desc_valid = have;
-      in.desc = &pending;
+      in.desc_valid = offer.have;
+      in.desc = &offer.pending;
       in.out_ready = rng() % 4 != 0;
       model.tick(in, exp);
       bad = exp;
@@ -149,7 +157,7 @@ TEST(SpanCosim, TickCheckFindsEveryDifferenceTheComparisonFinds) {
         ASSERT_EQ(compareSpanOutputs(exp, got), "") << mode << " cycle " << c;
         ++changed[kind];
       }
-      if (in.desc_valid && exp.desc_ready) have = next(pending);
+      if (in.desc_valid && exp.desc_ready) offer.accepted();
     }
     for (int k = kDescReady; k < kKinds; ++k) EXPECT_GT(changed[static_cast<size_t>(k)], 10) << mode << " change " << k;
   }
@@ -167,16 +175,14 @@ TEST(SpanCosim, OneEvalCyclesEqualTwoEvalCycles) {
     fast->reset();
     traced->reset();
     model.reset();
-    auto next = stream(parseSpanMode(mode), 13, 150);
-    SpanDesc pending;
-    bool have = next(pending);
+    Offer offer(parseSpanMode(mode), 13, 150);
     std::mt19937_64 rng(8);
     SpanOut exp, a, b;
     uint64_t cycles = 0;
-    while (have || !model.idle()) {
+    while (offer.have || !model.idle()) {
       SpanIn in;
-      in.desc_valid = have && rng() % 5 != 0;
-      in.desc = &pending;
+      in.desc_valid = offer.have && rng() % 5 != 0;
+      in.desc = &offer.pending;
       in.out_ready = rng() % 3 != 0;
       model.tick(in, exp);
       fast->tick(in, a);
@@ -184,7 +190,7 @@ TEST(SpanCosim, OneEvalCyclesEqualTwoEvalCycles) {
       ++cycles;
       ASSERT_EQ(compareSpanOutputs(exp, a), "") << mode << " untraced, cycle " << cycles;
       ASSERT_EQ(compareSpanOutputs(exp, b), "") << mode << " traced, cycle " << cycles;
-      if (in.desc_valid && exp.desc_ready) have = next(pending);
+      if (in.desc_valid && exp.desc_ready) offer.accepted();
     }
     EXPECT_EQ(fast->cycle(), traced->cycle());
     traced->finish();

@@ -43,29 +43,26 @@ int64_t floorDiv(i128 a, i128 b) {  // b > 0
 }
 int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
 
-// round-half-even(num / den), den > 0: in 64 bits with one division when both fit (the
-// common case, inlined), else in 128 bits.
-__attribute__((noinline)) i128 roundDivWide(i128 num, i128 den) {
-  i128 q = num / den, r = num % den;
+// round-half-even(num / den) from the truncated quotient q and remainder r of num / den
+// (|r| < den, den > 0): floor first, then up when the remainder is above half, or exactly half
+// with q odd (r vs den - r: no overflow of 2r).
+template <class T>
+T roundHalfEvenFrom(T q, T r, T den) {
   if (r < 0) {
     --q;
     r += den;
   }
-  const i128 twice = 2 * r;
-  if (twice > den || (twice == den && (q & 1) != 0)) ++q;
-  return q;
+  const T rest = den - r;
+  return r > rest || (r == rest && (q & 1) != 0) ? q + 1 : q;
 }
+
+// round-half-even(num / den), den > 0: in 64 bits with one division when both fit (the
+// common case, inlined), else in 128 bits.
+__attribute__((noinline)) i128 roundDivWide(i128 num, i128 den) { return roundHalfEvenFrom(num / den, num % den, den); }
 inline i128 roundDiv(i128 num, i128 den) {
   if (!fitsI64(num) || !fitsI64(den)) return roundDivWide(num, den);
   const int64_t n = static_cast<int64_t>(num), d = static_cast<int64_t>(den);
-  int64_t q = n / d, r = n % d;
-  if (r < 0) {
-    --q;
-    r += d;
-  }
-  const int64_t rest = d - r;  // 2r vs d without overflow: r vs d - r
-  if (r > rest || (r == rest && (q & 1) != 0)) ++q;
-  return q;
+  return roundHalfEvenFrom(n / d, n % d, d);
 }
 
 // round-half-even(num / den) for many numerators over one denominator den > 0: the quotient
@@ -81,7 +78,7 @@ class RoundingDivider {
     const int64_t n = static_cast<int64_t>(num);
     int64_t q = static_cast<int64_t>(static_cast<double>(n) * inv_);  // truncated estimate
     int64_t r = n - q * den_;                                          // exact: |q den| < 2^53 + den
-    while (r < 0) {
+    while (r <= -den_) {
       --q;
       r += den_;
     }
@@ -89,9 +86,7 @@ class RoundingDivider {
       ++q;
       r -= den_;
     }
-    const int64_t rest = den_ - r;  // 2r vs den: r vs den - r
-    if (r > rest || (r == rest && (q & 1) != 0)) ++q;
-    return q;
+    return roundHalfEvenFrom(q, r, den_);  // |r| < den
   }
 
  private:

@@ -99,7 +99,7 @@ void SpanUnitModel::outputs(SpanOut& o) const {
   o.out_valid = false;
   o.tag = 0;
   const size_t lanes = static_cast<size_t>(p_.lanes());
-  if (o.lane.size() != lanes) o.lane.resize(lanes);
+  o.lane.resize(lanes);  // no-op (no allocation) after the first cycle
   if (state_ != State::Span) {
     for (SpanLaneOut& l : o.lane) l.valid = false;
     return;
@@ -115,7 +115,7 @@ void SpanUnitModel::outputs(SpanOut& o) const {
       const int64_t x = xg_ + i;  // CoordBits + 1 bits: no wrap
       lane.valid = ne_[ju] && lo_[ju] <= x && x <= hi_[ju];
       if (!lane.valid) continue;
-      if (lane.attr.size() != K) lane.attr.resize(K);
+      lane.attr.resize(K);
       laneFragment(p_, d_, t, x, wspan_, icur_.data(), i, lane.x, lane.y, lane.attr.data());
       o.out_valid = true;
     }

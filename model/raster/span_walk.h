@@ -91,25 +91,20 @@ inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri&
   }
   const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
   const int32_t py = static_cast<int32_t>((t.flip ? t.oy - w : w + t.oy) & pix_mask);
-  if (!t.flip) {
+  // The loop instantiated per output map (flip is constant over the triangle).
+  auto row = [&](auto flip) {
+    constexpr bool kFlip = decltype(flip)::value;
     for (int64_t x = lo; x <= hi; ++x) {
       for (int a = 0; a < K; ++a) {
         const size_t ai = static_cast<size_t>(a);
-        attr[ai] = wrapTo(acc[ai] + off[ai], bits);
+        attr[ai] = wrapTo(kFlip ? off[ai] - acc[ai] : acc[ai] + off[ai], bits);
         acc[ai] += step[ai];
       }
-      emit(static_cast<int32_t>((x + t.ox) & pix_mask), py, static_cast<const int64_t*>(attr.data()));
+      emit(static_cast<int32_t>((kFlip ? t.ox - x : x + t.ox) & pix_mask), py, static_cast<const int64_t*>(attr.data()));
     }
-  } else {
-    for (int64_t x = lo; x <= hi; ++x) {
-      for (int a = 0; a < K; ++a) {
-        const size_t ai = static_cast<size_t>(a);
-        attr[ai] = wrapTo(off[ai] - acc[ai], bits);
-        acc[ai] += step[ai];
-      }
-      emit(static_cast<int32_t>((t.ox - x) & pix_mask), py, static_cast<const int64_t*>(attr.data()));
-    }
-  }
+  };
+  if (t.flip) row(std::true_type{});
+  else row(std::false_type{});
 }
 
 }  // namespace span_detail

@@ -312,7 +312,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     c.shin = static_cast<uint32_t>(a);
     return c;
   };
-  std::vector<std::array<uint32_t, 3>> device_out, direct_out;
+  std::vector<std::array<uint32_t, 3>> device_out;
   std::vector<SpecRequest> point_requests;
   SpecEngine* spec = nullptr;  // the current object's
   DeviceCoding coding;
@@ -641,12 +641,12 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                 return;
               }
               if (count > 0) {  // the model's results now (the cycles are counted per triangle below)
-                direct_out.resize(count);
+                device_out.resize(count);
                 for (size_t i = 0; i < count; ++i) {
                   const SpecRequest& r = requests[first + i];
-                  direct_out[i] = direct->evaluate(r.shin, r.cos, r.light).rgb;
+                  device_out[i] = direct->evaluate(r.shin, r.cos, r.light).rgb;
                 }
-                write(p, wcode, combine(lsb, direct_out.data(), count));
+                write(p, wcode, combine(lsb, device_out.data(), count));
                 return;
               }
               break;

@@ -83,13 +83,8 @@ double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v, Vec3 h) {
   throw std::logic_error("lobeValue: device lobes are evaluated by the specular unit");
 }
 
-Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n, Vec3 p_cam, const DeviceCoding* coding,
-                 std::vector<SpecRequest>* device) {
-  return PointShader(ctx, m, lobe, coding).shade(n, p_cam, device);
-}
-
 PointShader::PointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding)
-    : ctx_(ctx), m_(m), lobe_(lobe), device_lobe_(isDeviceLobe(lobe)), has_coding_(coding != nullptr) {
+    : ctx_(ctx), m_(m), lobe_(lobe), device_lobe_(isDeviceLobe(lobe)) {
   if (coding != nullptr) coding_ = *coding;
   const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
   const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
@@ -118,16 +113,16 @@ Shade PointShader::shade(Vec3 n, Vec3 p_cam, std::vector<SpecRequest>* device) c
     if (nl <= 0) continue;  // the surface faces away from this light
     for (size_t k = 0; k < 3; ++k) s.lsb[k] += pl.diffuse[k] * nl;
     if (device_lobe_) {
-      if (!has_coding_ || device == nullptr)
-        throw std::logic_error("shadePoint: a device lobe needs the specular unit's coding and a request list");
+      if (!coding_ || device == nullptr)
+        throw std::logic_error("PointShader: a device lobe needs the specular unit's coding and a request list");
       const double nh = std::clamp(dot(n, l.point ? normalize(ld + ctx_.view) : l.half), 0.0, 1.0);
       // round(nh 2^F), half away from zero (lround) for nh >= 0, without libm: the scaling by
       // 2^F is exact, and so is the fraction x - trunc(x).
-      const double x = nh * static_cast<double>(int64_t{1} << coding_.cos_frac_bits);
+      const double x = nh * static_cast<double>(int64_t{1} << coding_->cos_frac_bits);
       SpecRequest r;
       r.cos = static_cast<uint32_t>(x);
       if (x - r.cos >= 0.5) ++r.cos;
-      r.shin = coding_.shin;
+      r.shin = coding_->shin;
       r.light = pl.device_light;
       device->push_back(r);
     } else {

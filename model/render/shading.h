@@ -14,6 +14,7 @@
 #include <cmath>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -58,9 +59,7 @@ struct SpecRequest {
   std::array<uint32_t, 3> light{};
 };
 
-// Colour of a point in output LSBs (0..255 scale, unclamped, double): ambient + diffuse + the
-// analytic specular lobes. Device lobes add nothing here; for them one request per lit light
-// (N.H, shininess code, light colour) is appended to *device, to be added by combine().
+// How a material's device-lobe requests are coded for the specular unit.
 struct DeviceCoding {
   int cos_frac_bits = 15;
   uint32_t shin = 0;  // the PROM address of the material's shininess
@@ -68,18 +67,16 @@ struct DeviceCoding {
 struct Shade {
   std::array<double, 3> lsb{};  // ambient + diffuse + analytic specular, 0..255 scale
 };
-// coding and device may be null unless the lobe is a device lobe (std::logic_error then).
-Shade shadePoint(const ShadeContext& ctx, const Material& m, Lobe lobe, Vec3 n_unit, Vec3 p_cam,
-                 const DeviceCoding* coding, std::vector<SpecRequest>* device);
-
-// shadePoint for many points of one material: the per-material factors (ambient, k_d and k_s
-// times base and light colours, a device request's light codes) computed once, with the same
-// floating-point operations in the same order, so shade() equals shadePoint() bit for bit
-// (shadePoint is this class used once). ctx and m must outlive it.
+// The lighting of the points of one material and lobe. The per-material factors (ambient, k_d
+// and k_s times base and light colours, a device request's light codes) are computed once.
+// ctx and m must outlive it.
 class PointShader {
  public:
   // coding and device may be null unless the lobe is a device lobe (std::logic_error then).
   PointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding);
+  // Colour of a point in output LSBs (0..255 scale, unclamped, double): ambient + diffuse + the
+  // analytic specular lobes. Device lobes add nothing here; for them one request per lit light
+  // (N.H, shininess code, light colour) is appended to *device, to be added by combine().
   Shade shade(Vec3 n_unit, Vec3 p_cam, std::vector<SpecRequest>* device) const;
   // Whether shade() reads p_cam: only point lights depend on the position (the viewer is at
   // infinity), so with directional lights alone a caller may pass any point.
@@ -94,8 +91,8 @@ class PointShader {
   const ShadeContext& ctx_;
   const Material& m_;
   Lobe lobe_;
-  bool device_lobe_, has_coding_;
-  DeviceCoding coding_;
+  bool device_lobe_;
+  std::optional<DeviceCoding> coding_;
   bool needs_position_ = false;
   std::array<double, 3> ambient_{};  // 255 ambient base
   std::vector<PerLight> lights_;
