@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
@@ -483,11 +484,9 @@ struct RenderCmd {
 
   void add(CLI::App& app) {
     app.add_option("--scene", scene, "builtin:sphere | builtin:plane | builtin:torus | builtin:materials or a JSON file");
-    app.add_option("--method", method,
-                   "flat | gouraud | gouraud-classical | phong | phong-incremental | normal-bisection | biquadratic | "
-                   "modified-gouraud | adaptive | reference")
-        ->check(CLI::IsMember({"flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "normal-bisection",
-                               "biquadratic", "modified-gouraud", "adaptive", "reference"}));
+    std::vector<std::string> methods;
+    for (const Method m : allMethods()) methods.emplace_back(toString(m));
+    app.add_option("--method", method, fmt::format("{}", fmt::join(methods, " | ")))->check(CLI::IsMember(methods));
     app.add_option("--brdf", brdf, "override every material's brdf: phong | blinn | normalized-blinn | schlick | "
                                    "quadratic | cubic | cook-torrance | pow")
         ->check(CLI::IsMember({"phong", "blinn", "normalized-blinn", "schlick", "quadratic", "cubic", "cook-torrance", "pow"}));

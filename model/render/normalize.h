@@ -1,4 +1,4 @@
-// Normalising interpolated normals in hardware terms (phong-incremental).
+// Normalising interpolated normals in hardware terms (phong-incremental, phong-fixed).
 //
 // Squared norm along a span (paper 4.1, as corrected by the errata): with N_i = N_0 + i dN,
 //   F_i = |N_i|^2 = A + 2 i B + i^2 C,  A = |N_0|^2, B = N_0 . dN, C = |dN|^2,
@@ -50,7 +50,43 @@ class SquaredNormRecurrence {
 std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn,
                                             size_t count);
 
+// The integer core of the reciprocal square root: for v > 0, v = m 4^-shift with m in
+// [2^60, 2^62), and r ~ 1/sqrt(m 2^-62) in uQ2.16 (< 2^17.1): the seed of a 256-entry table of
+// 1/sqrt at the interval midpoints of m 2^-62 in [1/4, 1), then one Newton step
+// r1 = r0 (3 - m r0^2) / 2 in integers. So 1/sqrt(v 2^-f) = r 2^-16 2^((f - 62) / 2 + shift).
+struct RsqrtCore {
+  int64_t r = 0;
+  int shift = 0;
+};
+extern const std::array<uint32_t, 256> kRsqrtSeed;  // round(2^16 / sqrt(1/4 + (i + 1/2) 3/1024))
+inline RsqrtCore rsqrtCore(uint64_t v) {
+  // The shift that brings the bit length of m to 61 or 62 (v < 2^60 up, v >= 2^62 down by 4).
+  const int bits = 64 - __builtin_clzll(v);
+  const int shift = bits <= 62 ? (62 - bits) / 2 : -1;
+  const uint64_t m = shift >= 0 ? v << (2 * shift) : v >> 2;
+  const uint64_t mq = m >> 30;  // m 2^-62 in Q32, in [2^30, 2^32)
+  const size_t idx = static_cast<size_t>(((mq - (uint64_t{1} << 30)) * 256) / (3 * (uint64_t{1} << 30)));  // < 256
+  const uint64_t r0 = kRsqrtSeed[idx];                                                                   // Q16, < 2^17
+  const uint64_t mr = static_cast<uint64_t>((static_cast<unsigned __int128>(mq) * (r0 * r0)) >> 32);  // m r0^2, Q32
+  return {static_cast<int64_t>(r0) * ((int64_t{3} << 32) - static_cast<int64_t>(mr)) >> 33, shift};  // Q16
+}
+
 // 1/sqrt(v * 2^-frac_bits) for v > 0 (0 for v == 0), 16 significant fraction bits.
 double rsqrtFixed(uint64_t v, int frac_bits);
 
+// phong-fixed's cosines: the dot product d of an interpolated normal (28 fraction bits per
+// component) with a Q1.16 unit vector, divided by |N|: with sqnorm = |N|^2 (56 fraction bits,
+// exact from the recurrence) and (r, shift) = rsqrtCore(sqnorm), d / |N| in Q2.32 is
+// d r 2^(shift - 31), rounded half up. shift <= 30 for sqnorm >= 1, so the shift right is
+// 31 - shift in [1, 32]; |d r| < 2^62 for |N| <= 1.5.
+struct CosineScale {
+  int64_t r = 0;
+  int s = 1;  // shift right
+};
+inline CosineScale cosineScale(uint64_t sqnorm) {
+  if (sqnorm == 0) return {0, 1};  // a zero normal: every cosine 0
+  const RsqrtCore c = rsqrtCore(sqnorm);
+  return {c.r, 31 - c.shift};
+}
+inline int64_t scaleCosine(int64_t d, CosineScale c) { return (d * c.r + (int64_t{1} << (c.s - 1))) >> c.s; }
 }  // namespace shd

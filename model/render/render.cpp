@@ -11,6 +11,7 @@
 
 #include "approx/brdf.h"
 #include "raster/span_walk.h"
+#include "render/fixed_shading.h"
 #include "render/normalize.h"
 
 namespace shd {
@@ -26,6 +27,7 @@ constexpr MethodName kMethods[] = {{Method::Flat, "flat"},
                                    {Method::GouraudClassical, "gouraud-classical"},
                                    {Method::Phong, "phong"},
                                    {Method::PhongIncremental, "phong-incremental"},
+                                   {Method::PhongFixed, "phong-fixed"},
                                    {Method::NormalBisection, "normal-bisection"},
                                    {Method::Biquadratic, "biquadratic"},
                                    {Method::ModifiedGouraud, "modified-gouraud"},
@@ -223,7 +225,8 @@ Method parseMethod(const std::string& s) {
   for (const MethodName& m : kMethods)
     if (s == m.name) return m.m;
   throw std::invalid_argument(fmt::format(
-      "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental, normal-bisection, "
+      "unknown method '{}' (expected flat, gouraud, gouraud-classical, phong, phong-incremental, phong-fixed, "
+      "normal-bisection, "
       "biquadratic, modified-gouraud, adaptive or reference)",
       s));
 }
@@ -317,6 +320,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   SpecEngine* spec = nullptr;  // the current object's
   DeviceCoding coding;
   std::optional<PointShader> shader;  // the current object's material and lobe
+  std::optional<FixedPointShader> fixed;  // the same, phong-fixed
 
   // A point's shade, with its device-lobe evaluations done by the specular unit right away
   // (vertices: few; pixels are batched per triangle below, or evaluated one by one on the model).
@@ -378,14 +382,15 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
       throw std::invalid_argument(fmt::format("object '{}': brdf {} needs the specular unit", obj.name, toString(lobe)));
     coding = codingFor(spec, mat);
     shader.emplace(ctx, mat, lobe, &coding);
+    // Per-pixel device lobes on the model: each request evaluated as it is made.
+    const SpecUnitModel* direct = spec != nullptr ? spec->model() : nullptr;
+    if (opt.method == Method::PhongFixed) fixed.emplace(ctx, mat, lobe, &coding, direct != nullptr ? spec->memo() : nullptr);
     // The reference: the exact lobes (the Blinn lobe a device lobe approximates), and the same
     // without k_s for the specular part alone (highlight masks).
     const Lobe ref_lobe = isDeviceLobe(lobe) ? Lobe::Blinn : lobe;
     Material nospec = mat;
     nospec.ks = 0;
     const PointShader ref_shader(ctx, mat, ref_lobe, nullptr), ref_diffuse(ctx, nospec, ref_lobe, nullptr);
-    // Per-pixel device lobes on the model: each request evaluated as it is made.
-    const SpecUnitModel* direct = spec != nullptr ? spec->model() : nullptr;
     // Object -> camera space and the projection of the vertices in front of the near plane.
     verts.assign(obj.mesh.positions.size(), PVertex{});
     const NormalTransform to_world(obj.transform);
@@ -520,9 +525,11 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // A fragment's colour is written at once, or (per-pixel device lobes) once the specular
         // unit has evaluated the triangle's batch of requests.
         const bool batched = !reference && direct == nullptr && isDeviceLobe(lobe) &&
-                             (m == Method::Phong || m == Method::PhongIncremental || m == Method::NormalBisection);
+                             (m == Method::Phong || m == Method::PhongIncremental || m == Method::PhongFixed ||
+                              m == Method::NormalBisection);
         pend.clear();
         requests.clear();
+        size_t memo_requests = 0;  // phong-fixed on the unit's model: requests its memo answered
         // A written fragment has w > 0 (the z-test), so depth 0 marks a pixel not yet covered.
         auto write = [rgb = fb.rgb.data(), depth = fb.depth.data(), tri_of = fb.tri.data(), tag,
                       &covered = st.pixels_covered](size_t p, int64_t w, const std::array<uint8_t, 3>& c) {
@@ -540,12 +547,38 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
                              unorm8FromCode(attr[2], kColourFrac)});
         };
-        // phong-incremental: |N|^2 along each run of consecutive pixels of a row by the
-        // recurrence, restarted (three products) where the stream is not the next pixel. The
-        // recurrence is exact, so the values do not depend on where it restarts.
+        // phong-incremental, phong-fixed: |N|^2 along each run of consecutive pixels of a row
+        // by the recurrence, restarted (three products) where the stream is not the next pixel.
+        // The recurrence is exact, so the values do not depend on where it restarts.
         SquaredNormRecurrence sqn;
         int32_t run_y = -1, run_next_x = 0;
         const std::array<int64_t, 3> dn{s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]};
+        auto squaredNorm = [&](int32_t x, int32_t y, const int64_t* attr) {
+          const uint64_t f = y == run_y && x == run_next_x ? sqn.next() : sqn.start({attr[0], attr[1], attr[2]}, dn);
+          run_y = y;
+          run_next_x = x + 1;
+          return f;
+        };
+        // phong-fixed: the recurrence (before the z-test, as the hardware runs it on every
+        // fragment), the z-test, the fixed-point datapath, write.
+        auto fixedFragment = [&](int32_t x, int32_t y, const int64_t* attr) {
+          const uint64_t sqnorm = squaredNorm(x, y, attr);
+          const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x);
+          const int64_t wcode = attr[3];
+          __builtin_prefetch(fb.depth.data() + p + W);  // as colourFragment
+          if (wcode <= fb.depth[p]) return;
+          const Vec3 pc = fixed->needsPosition() ? pixelCam(x, y, static_cast<double>(wcode) * kUnitLsb) : Vec3{};
+          const size_t first = requests.size();
+          const FixedShade fs = fixed->shade(attr, sqnorm, pc, &requests);
+          if (batched) {
+            std::array<double, 3> lsb{};  // exact: the codes are far below 2^53
+            for (size_t k = 0; k < 3; ++k) lsb[k] = std::ldexp(static_cast<double>(fs.code[k]), -kFixedColourFrac);
+            pend.push_back({p, wcode, lsb, first, requests.size() - first});
+            return;
+          }
+          memo_requests += fs.device_requests;
+          write(p, wcode, fixedColour(fs));
+        };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
         if (m == Method::Biquadratic)
@@ -565,13 +598,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // One fragment: z-test against the triangles drawn before this one, shade, write.
         // (bisected: normal-bisection's normal of this fragment.)
         auto shadeFragment = [&](int32_t x, int32_t y, const int64_t* attr, const Vec3* bisected_n) {
-          uint64_t sqnorm = 0;
-          if (m == Method::PhongIncremental) {
-            if (y == run_y && x == run_next_x) sqnorm = sqn.next();
-            else sqnorm = sqn.start({attr[0], attr[1], attr[2]}, dn);
-            run_y = y;
-            run_next_x = x + 1;
-          }
+          const uint64_t sqnorm = m == Method::PhongIncremental ? squaredNorm(x, y, attr) : 0;
           const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x);
           const int64_t wcode = attr[3];
           if (wcode <= fb.depth[p]) return;
@@ -654,6 +681,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             case Method::ModifiedGouraud:
             case Method::Adaptive:
               throw std::logic_error("render: split and adaptive triangles are drawn as gouraud or phong");
+            case Method::PhongFixed: throw std::logic_error("render: phong-fixed fragments are drawn by fixedFragment");
             case Method::Biquadratic: {
               // The quadratic Lagrange basis: vertices c_i, edge midpoints c_ij (edge e = i..i+1).
               const auto l = barycentric(x, y);
@@ -692,6 +720,10 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           const SpanWalk wk = walkSpanUnit(*walker, *s.desc, colourFragment);
           st.span_cycles += wk.cycles;
           st.fragments += wk.fragments;
+        } else if (!reference && walker != nullptr && m == Method::PhongFixed) {
+          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, fixedFragment);
+          st.span_cycles += wk.cycles;
+          st.fragments += wk.fragments;
         } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
           const SpanWalk wk = walkSpanUnit(*walker, *s.desc, [&](int32_t x, int32_t y, const int64_t* attr) {
             shadeFragment(x, y, attr, nullptr);
@@ -704,16 +736,18 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           else st.span_cycles += span.run(*s.desc, frags).cycles;
           st.fragments += frags.size();
           if (m == Method::NormalBisection) bisectNormals(frags, opt.bisection_threshold, order, bisected, st.normalisations);
-          for (size_t fi = 0; fi < frags.size(); ++fi)
-            shadeFragment(frags[fi].x, frags[fi].y, frags[fi].attr.data(),
-                          m == Method::NormalBisection ? &bisected[fi] : nullptr);
+          for (size_t fi = 0; fi < frags.size(); ++fi) {
+            const SpanFragment& fr = frags[fi];
+            if (m == Method::PhongFixed) fixedFragment(fr.x, fr.y, fr.attr.data());
+            else shadeFragment(fr.x, fr.y, fr.attr.data(), m == Method::NormalBisection ? &bisected[fi] : nullptr);
+          }
         }
         for (int32_t row : divided_rows) row_divided[static_cast<size_t>(row)] = 0;
         divided_rows.clear();
-        if (!requests.empty()) {
-          st.spec_cycles += direct != nullptr ? batchCycles(requests.size(), direct->params().latency())
-                                              : spec->evaluate(requests, device_out);
-          st.spec_evaluations += requests.size();
+        if (!requests.empty() || memo_requests > 0) {
+          const size_t n = requests.size() + memo_requests;
+          st.spec_cycles += direct != nullptr ? batchCycles(n, direct->params().latency()) : spec->evaluate(requests, device_out);
+          st.spec_evaluations += n;
         }
         for (const Pending& pd : pend)
           write(pd.pixel, pd.w, combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count));

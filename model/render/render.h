@@ -25,6 +25,11 @@
 //   phong-incremental  the same normals; |N|^2 along each span by the recurrence of errata 4.1
 //                      (F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, C_1 = C: additions
 //                      only) and a fixed-point reciprocal square root (table + one Newton step)
+//   phong-fixed        the same normals and recurrence, and the whole per-pixel lighting as a
+//                      fixed-point datapath (render/fixed_shading.h): unit normal, L, H, V in
+//                      Q1.16, integer dot products, the diffuse and specular factors as codes,
+//                      the lobe from a table over its cosine (16 fraction bits) or the specular
+//                      unit; no floating point and no pow per pixel with directional lights
 //   normal-bisection   the listing NormalVector: along each span the unit normal is computed
 //                      exactly only at nodes found by recursive bisection (ends first, then the
 //                      middle of a segment while 1 - |(N_a + N_b)/2|, the listing's error
@@ -67,6 +72,7 @@
 #include "device/prom.h"
 #include "device/spec_unit.h"
 #include "raster/setup.h"
+#include "render/fixed_shading.h"
 #include "render/shading.h"
 #include "scene/scene.h"
 
@@ -78,6 +84,7 @@ enum class Method {
   GouraudClassical,
   Phong,
   PhongIncremental,
+  PhongFixed,
   NormalBisection,
   Biquadratic,
   ModifiedGouraud,
@@ -122,6 +129,8 @@ class SpecEngine {
   // Non-null when the engine is the bit-exact model: the renderer may then evaluate each
   // request as it is made (the results are the same; batchCycles() counts the cycles).
   virtual const SpecUnitModel* model() const { return nullptr; }
+  // Non-null with model(): its results by request, kept from frame to frame (phong-fixed).
+  virtual SpecResultMemo* memo() { return nullptr; }
 };
 
 // The cycles of a batch of n requests through a pipelined unit of the given latency: the last
@@ -130,14 +139,16 @@ inline uint64_t batchCycles(size_t n, int latency) { return n == 0 ? 0 : n + sta
 
 class ModelSpecEngine final : public SpecEngine {
  public:
-  explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words) {}
+  explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words), memo_(unit_) {}
   const PromTable& table() const override { return t_; }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
   const SpecUnitModel* model() const override { return &unit_; }
+  SpecResultMemo* memo() override { return &memo_; }
 
  private:
   PromTable t_;
   SpecUnitModel unit_;
+  SpecResultMemo memo_;
 };
 
 struct RenderOptions {

@@ -1,0 +1,144 @@
+#include "render/fixed_shading.h"
+
+#include <cmath>
+#include <mutex>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "approx/brdf.h"
+#include "render/normalize.h"
+
+namespace shd {
+
+namespace {
+constexpr int64_t kFactorMax = (int64_t{1} << 30) - 1;
+constexpr double kLobeScale = 1 << 24;  // f_code = round(f 2^24)
+
+// round(lsb 2^12), saturated at kFactorMax (lsb >= 0: colours, k_d, k_s are validated >= 0)
+int64_t factorCode(double lsb) {
+  const double x = lsb * (1 << kFixedColourFrac);
+  if (!(x >= 0)) throw std::logic_error(fmt::format("phong-fixed: a lighting factor of {} LSB", lsb));
+  return x >= static_cast<double>(kFactorMax) ? kFactorMax : std::llround(x);
+}
+
+std::array<int32_t, 3> unitCodes(Vec3 v) {
+  auto c = [](double x) { return static_cast<int32_t>(std::lround(std::ldexp(x, kFixedUnitFrac))); };
+  return {c(v.x), c(v.y), c(v.z)};
+}
+
+// round(f 2^24), saturated at 2^32 - 1
+uint32_t lobeFactorCode(double f) {
+  if (!(f >= 0)) throw std::logic_error(fmt::format("phong-fixed: a lobe value of {}", f));
+  const double x = f * kLobeScale;
+  return x >= 4294967295.0 ? 0xFFFFFFFFu : static_cast<uint32_t>(std::llround(x));
+}
+}  // namespace
+
+std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shininess) {
+  double (*f)(double, double) = nullptr;
+  switch (lobe) {
+    case Lobe::Phong: f = phongLobe; break;
+    case Lobe::Blinn:
+    case Lobe::Pow: f = blinnLobe; break;
+    case Lobe::NormalizedBlinn: f = normalizedBlinn; break;
+    case Lobe::Schlick: f = schlickLobe; break;
+    case Lobe::CookTorrance:
+    case Lobe::Quadratic:
+    case Lobe::Cubic: throw std::logic_error(fmt::format("lobeTable: {} is not a lobe of one cosine", toString(lobe)));
+  }
+  static std::mutex mutex;
+  static std::map<std::pair<double (*)(double, double), double>, std::shared_ptr<const std::vector<uint32_t>>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{f, shininess}];
+  if (!slot) {
+    if (cache.size() > 64) {  // a long run over many exponents: start over (tables in use live on)
+      cache.clear();
+      return lobeTable(lobe, shininess);
+    }
+    auto t = std::make_shared<std::vector<uint32_t>>((size_t{1} << kFixedCosFrac) + 1);
+    for (size_t c = 0; c < t->size(); ++c)
+      (*t)[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
+    slot = std::move(t);
+  }
+  return slot;
+}
+
+uint64_t* SpecResultMemo::row(uint32_t shin, const std::array<uint32_t, 3>& light) {
+  std::vector<uint64_t>& r = rows_[{shin, light[0], light[1], light[2]}];
+  if (r.empty()) r.assign(static_cast<size_t>(model_.params().cosOne()) + 1, 0);
+  return r.data();
+}
+
+uint64_t SpecResultMemo::fill(uint64_t* row, uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
+  const SpecOut o = model_.evaluate(shin, cos, light);
+  uint64_t e = kValid;
+  for (size_t k = 0; k < 3; ++k) {
+    if (o.rgb[k] > 0xFFFFFu) throw std::logic_error("SpecResultMemo: a specular unit output wider than 20 bits");
+    e |= uint64_t{o.rgb[k]} << (20 * k);
+  }
+  return row[cos] = e;
+}
+
+FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding,
+                                   SpecResultMemo* memo)
+    : ctx_(ctx), m_(m), memo_(memo) {
+  switch (lobe) {
+    case Lobe::Quadratic:
+    case Lobe::Cubic: cosine_ = Cosine::Device; break;
+    case Lobe::Phong: cosine_ = Cosine::RV; break;
+    case Lobe::CookTorrance: cosine_ = Cosine::CookTorrance; break;
+    case Lobe::Blinn:
+    case Lobe::Pow:
+    case Lobe::NormalizedBlinn:
+    case Lobe::Schlick: cosine_ = Cosine::NH; break;
+  }
+  if (cosine_ == Cosine::Device) {
+    if (coding == nullptr) throw std::logic_error("FixedPointShader: a device lobe needs the specular unit's coding");
+    coding_ = *coding;
+    if (coding_->cos_frac_bits < 1 || coding_->cos_frac_bits > 30)
+      throw std::invalid_argument(
+          fmt::format("phong-fixed: the specular unit's CosFracBits {} is outside 1..30", coding_->cos_frac_bits));
+    if (memo_ != nullptr && memo_->model().params().CosFracBits != coding_->cos_frac_bits)
+      throw std::logic_error("FixedPointShader: the memo's unit is not the coding's");
+  }
+  if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) {
+    table_ = lobeTable(lobe, m.shininess);
+    f_ = table_->data();
+  }
+  v_ = unitCodes(ctx.view);
+  const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
+  const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
+  for (size_t k = 0; k < 3; ++k) ambient_[k] = factorCode(255.0 * amb[k] * base[k]);
+  lights_.resize(ctx.lights.size());
+  for (size_t i = 0; i < ctx.lights.size(); ++i) {
+    const CameraLight& l = ctx.lights[i];
+    PerLight& pl = lights_[i];
+    pl.light = &l;
+    needs_position_ = needs_position_ || l.point;
+    if (!l.point) setDirections(pl, l.dir);
+    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
+    for (size_t k = 0; k < 3; ++k) {
+      pl.diffuse[k] = factorCode(255.0 * m.kd * base[k] * lc[k]);
+      pl.specular[k] = factorCode(255.0 * m.ks * lc[k]);
+      pl.device_light[k] = static_cast<uint32_t>(std::lround(255.0 * std::clamp(m.ks * lc[k], 0.0, 1.0)));
+    }
+    if (cosine_ == Cosine::Device && memo_ != nullptr) pl.memo = memo_->row(coding_->shin, pl.device_light);
+  }
+}
+
+void FixedPointShader::setDirections(PerLight& pl, Vec3 l) const {
+  const Vec3 h = normalize(l + ctx_.view);
+  pl.l = unitCodes(l);
+  pl.h = unitCodes(h);
+  pl.lv = fixed_detail::dotQ32(pl.l, v_);
+  pl.vh = dot(ctx_.view, h);
+}
+
+uint32_t FixedPointShader::cookTorranceCode(int64_t nl, int64_t nv, int64_t nh, const PerLight& pl) const {
+  constexpr double kQ32 = 1.0 / 4294967296.0;
+  return lobeFactorCode(cookTorrance(static_cast<double>(nl) * kQ32, static_cast<double>(nv) * kQ32,
+                                     static_cast<double>(nh) * kQ32, pl.vh, CookTorranceParams{m_.roughness, m_.f0}));
+}
+
+}  // namespace shd
