@@ -56,9 +56,10 @@ std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shinine
       cache.clear();
       return lobeTable(lobe, shininess);
     }
-    auto t = std::make_shared<std::vector<uint32_t>>((size_t{1} << kFixedCosFrac) + 1);
-    for (size_t c = 0; c < t->size(); ++c)
+    auto t = std::make_shared<std::vector<uint32_t>>((size_t{1} << kFixedCosFrac) + 2);
+    for (size_t c = 0; c + 1 < t->size(); ++c)
       (*t)[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
+    t->back() = (*t)[t->size() - 2];
     slot = std::move(t);
   }
   return slot;
@@ -131,7 +132,8 @@ void FixedPointShader::setDirections(PerLight& pl, Vec3 l) const {
   const Vec3 h = normalize(l + ctx_.view);
   pl.l = unitCodes(l);
   pl.h = unitCodes(h);
-  pl.lv = fixed_detail::dotQ32(pl.l, v_);
+  const int64_t lv = int64_t{pl.l[0]} * v_[0] + int64_t{pl.l[1]} * v_[1] + int64_t{pl.l[2]} * v_[2];  // Q2.60
+  pl.lv = fixed_detail::roundShift(lv, 28);
   pl.vh = dot(ctx_.view, h);
 }
 

@@ -2,7 +2,7 @@
 // paper's hardware would compute it: no floating point and no pow per pixel (with directional
 // lights), every step an integer operation with a stated format.
 //
-//   L, H, V      Q1.16, rounded once per object for directional lights (per pixel for point
+//   L, H, V      Q1.30, rounded once per object for directional lights (per pixel for point
 //                lights, from the double direction at the pixel's camera-space point)
 //   cosines      N.L, N.H, N.V of the interpolated normal N (28 fraction bits): integer dot
 //                products, then times 1/|N| from the squared-norm recurrence and the table +
@@ -11,8 +11,9 @@
 //   diffuse      D_k (N.L) 2^-32 rounded half up to 12 fraction bits, D_k = round(255 k_d base_k
 //                light_k 2^12) (the output LSB scale)
 //   specular     lobes of one cosine look the lobe up in a table over that cosine at 16 fraction
-//                bits, the exact lobe at each code (f_code = round(f 2^24), lobeTable): N.H for
-//                blinn, pow, normalized-blinn and schlick; R.V = 2 (N.L)(N.V) - L.V for phong. The term is S_k f_code 2^-24 rounded half up to 12 fraction bits,
+//                bits, the exact lobe at each code (f_code = round(f 2^24), lobeTable), and
+//                interpolate linearly with the cosine's next 16 bits: N.H for blinn, pow,
+//                normalized-blinn and schlick; R.V = 2 (N.L)(N.V) - L.V for phong. The term is S_k f_code 2^-24 rounded half up to 12 fraction bits,
 //                S_k = round(255 k_s light_k 2^12). cook-torrance (three cosines) is evaluated
 //                in double from the fixed-point cosines and then coded the same way.
 //                Device lobes: one request per lit light to the specular unit, N.H rounded to
@@ -44,7 +45,7 @@ namespace shd {
 
 constexpr int kFixedColourFrac = 12;  // colour codes: output LSBs with 12 fraction bits
 constexpr int kFixedCosFrac = 16;     // the lobe tables' cosine codes
-constexpr int kFixedUnitFrac = 16;    // L, H, V: Q1.16
+constexpr int kFixedUnitFrac = 30;    // L, H, V: Q1.30
 
 // The colour of one point: 12-fraction-bit codes and, on the specular unit's model, the sum of
 // its results (the unit's outputs, added after rounding, as combine() does) and how many
@@ -66,7 +67,8 @@ inline std::array<uint8_t, 3> fixedColour(const FixedShade& s) {
 }
 
 // A lobe of one cosine (phong over R.V; blinn, pow, normalized-blinn, schlick over N.H) at every
-// cosine code c / 2^16, c = 0..2^16: f_code = round(f 2^24), saturated at 2^32 - 1 (f < 256).
+// cosine code c / 2^16, c = 0..2^16: f_code = round(f 2^24), saturated at 2^32 - 1 (f < 256),
+// and a copy of the last entry (the interpolation's right neighbour at c = 1).
 // A pure function of the lobe and the shininess, so the tables are built once per process
 // (65,537 evaluations each) and shared; std::logic_error for a lobe of several cosines.
 std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shininess);
@@ -107,7 +109,7 @@ class FixedPointShader {
   enum class Cosine { NH, RV, CookTorrance, Device };
   struct PerLight {
     const CameraLight* light = nullptr;
-    std::array<int32_t, 3> l{}, h{};  // Q1.16 (point lights: this pixel's)
+    std::array<int32_t, 3> l{}, h{};  // Q1.30 (point lights: this pixel's)
     int64_t lv = 0;                   // L.V, Q2.32
     double vh = 0;                    // V.H (cook-torrance), double
     std::array<int64_t, 3> diffuse{}, specular{};
@@ -127,7 +129,7 @@ class FixedPointShader {
   std::shared_ptr<const std::vector<uint32_t>> table_;  // lobes of one cosine
   const uint32_t* f_ = nullptr;                         // table_'s codes
   bool needs_position_ = false;
-  std::array<int32_t, 3> v_{};  // the view direction, Q1.16
+  std::array<int32_t, 3> v_{};  // the view direction, Q1.30
   std::array<int64_t, 3> ambient_{};
   std::vector<PerLight> lights_;
 };
@@ -135,18 +137,27 @@ class FixedPointShader {
 // ---- the per-pixel path, inline (it runs once per fragment) ----
 
 namespace fixed_detail {
-inline int64_t dotQ32(const std::array<int32_t, 3>& a, const std::array<int32_t, 3>& b) {
-  return int64_t{a[0]} * b[0] + int64_t{a[1]} * b[1] + int64_t{a[2]} * b[2];
-}
-// N (28 fraction bits) . u (Q1.16): 44 fraction bits
-inline int64_t dot44(const int64_t* n28, const std::array<int32_t, 3>& u) {
-  return n28[0] * u[0] + n28[1] * u[1] + n28[2] * u[2];
+// N (28 fraction bits) . u (Q1.30): 58 fraction bits, in 64-bit modular arithmetic (the
+// partial sums may wrap; the result, |N.u| <= |N| 2^58, fits)
+inline int64_t dot58(const int64_t* n28, const std::array<int32_t, 3>& u) {
+  uint64_t d = 0;
+  for (size_t k = 0; k < 3; ++k) d += static_cast<uint64_t>(n28[k]) * static_cast<uint64_t>(int64_t{u[k]});
+  return static_cast<int64_t>(d);
 }
 // round(x 2^-s), half up
 inline int64_t roundShift(int64_t x, int s) { return (x + (int64_t{1} << (s - 1))) >> s; }
 // A Q2.32 cosine as a code with `frac` fraction bits, rounded half up, clamped to [0, 1].
 inline uint32_t cosCode(int64_t c32, int frac) {
   return static_cast<uint32_t>(std::clamp<int64_t>(roundShift(c32, 32 - frac), 0, int64_t{1} << frac));
+}
+// A lobe table (kFixedCosFrac-bit entries and the copy of the last) at a Q2.32 cosine clamped
+// to [0, 1]: the entry below and the linear step to the next with the cosine's next 16 bits,
+// rounded half up.
+inline uint32_t lobeAt(const uint32_t* t, int64_t c32) {
+  const uint64_t c = static_cast<uint64_t>(std::clamp<int64_t>(c32, 0, int64_t{1} << 32));
+  const uint64_t i = c >> (32 - kFixedCosFrac), frac = c & ((uint64_t{1} << (32 - kFixedCosFrac)) - 1);
+  const int64_t step = int64_t{t[i + 1]} - int64_t{t[i]};
+  return static_cast<uint32_t>(t[i] + roundShift(step * static_cast<int64_t>(frac), 32 - kFixedCosFrac));
 }
 }  // namespace fixed_detail
 
@@ -157,13 +168,13 @@ inline FixedShade FixedPointShader::shade(const int64_t* n28, uint64_t sqnorm, V
   s.code = ambient_;
   const CosineScale sc = cosineScale(sqnorm);
   const bool needs_nv = cosine_ == Cosine::RV || cosine_ == Cosine::CookTorrance;
-  const int64_t nv = needs_nv ? scaleCosine(dot44(n28, v_), sc) : 0;
+  const int64_t nv = needs_nv ? scaleCosine(dot58(n28, v_), sc) : 0;
   for (PerLight& pl : lights_) {
     if (pl.light->point) setDirections(pl, lightDirection(*pl.light, p_cam));
-    const int64_t nl = scaleCosine(dot44(n28, pl.l), sc);
+    const int64_t nl = scaleCosine(dot58(n28, pl.l), sc);
     if (nl <= 0) continue;  // the surface faces away from this light
     for (size_t k = 0; k < 3; ++k) s.code[k] += roundShift(pl.diffuse[k] * nl, 32);
-    const int64_t nh = scaleCosine(dot44(n28, pl.h), sc);
+    const int64_t nh = scaleCosine(dot58(n28, pl.h), sc);
     uint32_t f = 0;
     switch (cosine_) {
       case Cosine::Device: {
@@ -177,11 +188,12 @@ inline FixedShade FixedPointShader::shade(const int64_t* n28, uint64_t sqnorm, V
         ++s.device_requests;
         continue;
       }
-      case Cosine::NH: f = f_[cosCode(nh, kFixedCosFrac)]; break;
+      case Cosine::NH: f = lobeAt(f_, nh); break;
       case Cosine::RV: {
-        // R.V = 2 (N.L)(N.V) - L.V: (N.L 2^-16)(N.V) is Q2.48, back to Q2.32
-        const int64_t rv = 2 * ((roundShift(nl, 16) * nv) >> 16) - pl.lv;
-        f = f_[cosCode(rv, kFixedCosFrac)];
+        // R.V = 2 (N.L)(N.V) - L.V: the product of two Q2.32 is Q4.64, 2 x it back to Q2.32
+        const __int128 p = static_cast<__int128>(nl) * nv;
+        const int64_t rv = static_cast<int64_t>((p + (__int128{1} << 30)) >> 31) - pl.lv;
+        f = lobeAt(f_, rv);
         break;
       }
       case Cosine::CookTorrance: f = cookTorranceCode(nl, nv, nh, pl); break;

@@ -34,7 +34,7 @@ double rsqrtFixed(uint64_t v, int frac_bits) {
   if (v == 0) return 0;
   const RsqrtCore c = rsqrtCore(v);
   const int shift = c.shift;
-  const int64_t r1 = c.r;
+  const int64_t r1 = c.r >> 16;  // Q16
   // value = (m / 2^62) * 2^e with e = 62 - 2 shift - frac_bits
   const int e = 62 - 2 * shift - frac_bits;
   // 2^(-e/2): a power of two, times sqrt(2) when e is odd (what pow(2, -e/2) rounds to).

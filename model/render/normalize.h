@@ -51,9 +51,10 @@ std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, co
                                             size_t count);
 
 // The integer core of the reciprocal square root: for v > 0, v = m 4^-shift with m in
-// [2^60, 2^62), and r ~ 1/sqrt(m 2^-62) in uQ2.16 (< 2^17.1): the seed of a 256-entry table of
+// [2^60, 2^62), and r ~ 1/sqrt(m 2^-62) in uQ2.32 (< 2^33.1): the seed of a 256-entry table of
 // 1/sqrt at the interval midpoints of m 2^-62 in [1/4, 1), then one Newton step
-// r1 = r0 (3 - m r0^2) / 2 in integers. So 1/sqrt(v 2^-f) = r 2^-16 2^((f - 62) / 2 + shift).
+// r1 = r0 (3 - m r0^2) / 2 in integers (relative error below 2^-18 before the truncation to 32
+// fraction bits). So 1/sqrt(v 2^-f) = r 2^-32 2^((f - 62) / 2 + shift).
 struct RsqrtCore {
   int64_t r = 0;
   int shift = 0;
@@ -68,17 +69,18 @@ inline RsqrtCore rsqrtCore(uint64_t v) {
   const size_t idx = static_cast<size_t>(((mq - (uint64_t{1} << 30)) * 256) / (3 * (uint64_t{1} << 30)));  // < 256
   const uint64_t r0 = kRsqrtSeed[idx];                                                                   // Q16, < 2^17
   const uint64_t mr = static_cast<uint64_t>((static_cast<unsigned __int128>(mq) * (r0 * r0)) >> 32);  // m r0^2, Q32
-  return {static_cast<int64_t>(r0) * ((int64_t{3} << 32) - static_cast<int64_t>(mr)) >> 33, shift};  // Q16
+  return {static_cast<int64_t>(r0) * ((int64_t{3} << 32) - static_cast<int64_t>(mr)) >> 17, shift};  // Q32
 }
 
-// 1/sqrt(v * 2^-frac_bits) for v > 0 (0 for v == 0), 16 significant fraction bits.
+// 1/sqrt(v * 2^-frac_bits) for v > 0 (0 for v == 0), rsqrtCore's r truncated to 16 fraction
+// bits (phong-incremental).
 double rsqrtFixed(uint64_t v, int frac_bits);
 
 // phong-fixed's cosines: the dot product d of an interpolated normal (28 fraction bits per
-// component) with a Q1.16 unit vector, divided by |N|: with sqnorm = |N|^2 (56 fraction bits,
-// exact from the recurrence) and (r, shift) = rsqrtCore(sqnorm), d / |N| in Q2.32 is
-// d r 2^(shift - 31), rounded half up. shift <= 30 for sqnorm >= 1, so the shift right is
-// 31 - shift in [1, 32]; |d r| < 2^62 for |N| <= 1.5.
+// component) with a Q1.30 unit vector (58 fraction bits), divided by |N|: with sqnorm = |N|^2
+// (56 fraction bits, exact from the recurrence) and (r, shift) = rsqrtCore(sqnorm), d / |N| in
+// Q2.32 is d r 2^(shift - 61), rounded half up, in 128 bits. shift <= 30 for sqnorm >= 1, so
+// the shift right is 61 - shift in [31, 62].
 struct CosineScale {
   int64_t r = 0;
   int s = 1;  // shift right
@@ -86,7 +88,9 @@ struct CosineScale {
 inline CosineScale cosineScale(uint64_t sqnorm) {
   if (sqnorm == 0) return {0, 1};  // a zero normal: every cosine 0
   const RsqrtCore c = rsqrtCore(sqnorm);
-  return {c.r, 31 - c.shift};
+  return {c.r, 61 - c.shift};
 }
-inline int64_t scaleCosine(int64_t d, CosineScale c) { return (d * c.r + (int64_t{1} << (c.s - 1))) >> c.s; }
+inline int64_t scaleCosine(int64_t d, CosineScale c) {
+  return static_cast<int64_t>((static_cast<__int128>(d) * c.r + (__int128{1} << (c.s - 1))) >> c.s);
+}
 }  // namespace shd
