@@ -43,7 +43,7 @@ cat "$out/span_cycles.txt"
 
 echo "== 6. builtin:sphere rendered with the main methods, by the model and with the RTL in the loop (out/render/)"
 mkdir -p "$out/render"
-for method in flat gouraud gouraud-classical phong phong-incremental; do
+for method in flat gouraud gouraud-classical phong phong-incremental phong-fixed; do
   for brdf in blinn quadratic; do
     "$S" render --scene builtin:sphere --method "$method" --brdf "$brdf" --rtl --quiet \
       -o "$out/render/sphere_${method}_${brdf}.png" --json "$out/render/sphere_${method}_${brdf}.json" > /dev/null

@@ -57,3 +57,66 @@ TEST(RsqrtFixed, RelativeErrorBelowTwoToMinus14) {
   RecordProperty("worst_relative_error", std::to_string(worst));
   EXPECT_EQ(rsqrtFixed(0, 56), 0.0);
 }
+
+// rsqrtCore's normalisation (by the bit length, no loop) against the definition: m = v 4^shift
+// in [2^60, 2^62); and its relative error against 1/sqrt of the Q32 mantissa it reads.
+template <int SeedBits>
+double rsqrtCoreWorst() {
+  std::mt19937_64 rng(5);
+  double worst = 0;
+  for (int bits = 1; bits <= 64; ++bits)
+    for (int t = 0; t < 5000; ++t) {
+      const uint64_t v = (rng() >> (64 - bits)) | (uint64_t{1} << (bits - 1));
+      const RsqrtCore c = rsqrtCore<SeedBits>(v);
+      const long double m = std::ldexp(static_cast<long double>(v), 2 * c.shift);
+      EXPECT_GE(m, std::ldexp(1.0L, 60)) << v;
+      EXPECT_LT(m, std::ldexp(1.0L, 62)) << v;
+      // the first version's loops: up by 4 while v < 2^60, down by 4 while v >= 2^62
+      EXPECT_EQ(c.shift, bits >= 63 ? -1 : (62 - bits) / 2) << v;
+      const long double exact = 1 / std::sqrt(std::ldexp(std::floor(m / std::ldexp(1.0L, 30)), -32));
+      worst = std::max(worst, static_cast<double>(std::fabs(std::ldexp(static_cast<long double>(c.r), -32) / exact - 1)));
+    }
+  return worst;
+}
+
+TEST(RsqrtCore, NormalisesByTheBitLengthWithinItsSeedsError) {
+  const double w8 = rsqrtCoreWorst<8>(), w10 = rsqrtCoreWorst<10>();
+  // One Newton step squares the seed's relative error e0 (1.5 e0^2): e0 <= 2^-8.4 with 256
+  // entries over [1/4, 1), a quarter of it with 1024.
+  EXPECT_LT(w8, 1.3e-5) << w8;
+  EXPECT_LT(w10, 1e-6) << w10;
+  RecordProperty("worst_relative_error_seed8", std::to_string(w8));
+  RecordProperty("worst_relative_error_seed10", std::to_string(w10));
+}
+
+// phong-fixed's cosines: (N.u) / |N| from the integer dot product, the exact squared norm and
+// the 10-bit-seed rsqrtCore, against the exact value of the same codes, for normals of length
+// 1/16 to 1.2 (interpolation shortens them).
+TEST(CosineScale, WithinTheRsqrtErrorOfTheExactCosineOfTheCodes) {
+  std::mt19937_64 rng(6);
+  std::normal_distribution<double> g;
+  double worst = 0;
+  for (int t = 0; t < 200000; ++t) {
+    const double len = 0.0625 + 1.1375 * std::ldexp(static_cast<double>(rng() >> 11), -53);
+    std::array<double, 3> n{g(rng), g(rng), g(rng)}, u{g(rng), g(rng), g(rng)};
+    const double nn = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double un = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    int64_t d = 0;
+    uint64_t sq = 0;
+    long double dl = 0, sql = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      const int64_t n28 = std::llround(std::ldexp(n[k] / nn * len, 28));
+      const int64_t u30 = std::llround(std::ldexp(u[k] / un, 30));
+      d += n28 * u30;
+      sq += static_cast<uint64_t>(n28 * n28);
+      dl += static_cast<long double>(n28) * u30;
+      sql += static_cast<long double>(n28) * n28;
+    }
+    const long double exact = dl / std::sqrt(sql) * 4;  // d 2^-58 / (|N| 2^-28), in Q2.32
+    const int64_t got = scaleCosine(d, cosineScale(sq));
+    worst = std::max(worst, static_cast<double>(std::fabs(got - exact) / std::ldexp(1.0L, 32)));
+  }
+  EXPECT_LT(worst, 1e-6) << worst;
+  RecordProperty("worst_abs_error", std::to_string(worst));
+  EXPECT_EQ(scaleCosine(int64_t{1} << 58, cosineScale(0)), 0);  // a zero normal: cosine 0
+}

@@ -35,6 +35,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 #include "device/spec_unit.h"
@@ -180,6 +181,7 @@ inline FixedShade FixedPointShader::shade(const int64_t* n28, uint64_t sqnorm, V
       case Cosine::Device: {
         const uint32_t cos = cosCode(nh, coding_->cos_frac_bits);
         if (memo_ == nullptr) {
+          if (requests == nullptr) throw std::logic_error("FixedPointShader: device requests need a list");
           requests->push_back(SpecRequest{coding_->shin, cos, pl.device_light});
         } else {
           const uint64_t r = deviceResult(pl, cos);

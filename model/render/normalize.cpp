@@ -21,14 +21,17 @@ namespace {
 constexpr int kScaleRange = 256;  // |e| of the result's scale 2^(-e/2)
 }  // namespace
 
-const std::array<uint32_t, 256> kRsqrtSeed = [] {
-  std::array<uint32_t, 256> t{};
-  for (int i = 0; i < 256; ++i) {
-    const double mid = 0.25 + (i + 0.5) * (0.75 / 256);
-    t[static_cast<size_t>(i)] = static_cast<uint32_t>(std::lround(std::ldexp(1.0 / std::sqrt(mid), 16)));
+template <int SeedBits>
+const std::array<uint32_t, size_t{1} << SeedBits> RsqrtSeed<SeedBits>::table = [] {
+  std::array<uint32_t, size_t{1} << SeedBits> t{};
+  for (size_t i = 0; i < t.size(); ++i) {
+    const double mid = 0.25 + (static_cast<double>(i) + 0.5) * (0.75 / static_cast<double>(t.size()));
+    t[i] = static_cast<uint32_t>(std::lround(std::ldexp(1.0 / std::sqrt(mid), 16)));
   }
   return t;
 }();
+template struct RsqrtSeed<8>;
+template struct RsqrtSeed<10>;
 
 double rsqrtFixed(uint64_t v, int frac_bits) {
   if (v == 0) return 0;

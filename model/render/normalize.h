@@ -51,23 +51,31 @@ std::vector<uint64_t> squaredNormsAlongSpan(const std::array<int64_t, 3>& n0, co
                                             size_t count);
 
 // The integer core of the reciprocal square root: for v > 0, v = m 4^-shift with m in
-// [2^60, 2^62), and r ~ 1/sqrt(m 2^-62) in uQ2.32 (< 2^33.1): the seed of a 256-entry table of
-// 1/sqrt at the interval midpoints of m 2^-62 in [1/4, 1), then one Newton step
-// r1 = r0 (3 - m r0^2) / 2 in integers (relative error below 2^-18 before the truncation to 32
-// fraction bits). So 1/sqrt(v 2^-f) = r 2^-32 2^((f - 62) / 2 + shift).
+// [2^60, 2^62), and r ~ 1/sqrt(m 2^-62) in uQ2.32 (< 2^33.1): the seed of a table of 2^SeedBits
+// values of 1/sqrt at the interval midpoints of m 2^-62 in [1/4, 1), then one Newton step
+// r1 = r0 (3 - m r0^2) / 2 in integers. So 1/sqrt(v 2^-f) = r 2^-32 2^((f - 62) / 2 + shift).
+// Relative error (test RsqrtCore.*): below 1.3e-5 (2^-16.2) with the 8-bit seed of
+// phong-incremental, below 1e-6 with phong-fixed's 10-bit seed (the Newton step squares the
+// seed's error: 4 times the entries, 1/16 of the error).
 struct RsqrtCore {
   int64_t r = 0;
   int shift = 0;
 };
-extern const std::array<uint32_t, 256> kRsqrtSeed;  // round(2^16 / sqrt(1/4 + (i + 1/2) 3/1024))
+template <int SeedBits>
+struct RsqrtSeed {  // round(2^16 / sqrt(1/4 + (i + 1/2) 3/4 2^-SeedBits))
+  static const std::array<uint32_t, size_t{1} << SeedBits> table;
+};
+extern template struct RsqrtSeed<8>;
+extern template struct RsqrtSeed<10>;
+template <int SeedBits = 8>
 inline RsqrtCore rsqrtCore(uint64_t v) {
   // The shift that brings the bit length of m to 61 or 62 (v < 2^60 up, v >= 2^62 down by 4).
   const int bits = 64 - __builtin_clzll(v);
   const int shift = bits <= 62 ? (62 - bits) / 2 : -1;
   const uint64_t m = shift >= 0 ? v << (2 * shift) : v >> 2;
   const uint64_t mq = m >> 30;  // m 2^-62 in Q32, in [2^30, 2^32)
-  const size_t idx = static_cast<size_t>(((mq - (uint64_t{1} << 30)) * 256) / (3 * (uint64_t{1} << 30)));  // < 256
-  const uint64_t r0 = kRsqrtSeed[idx];                                                                   // Q16, < 2^17
+  const size_t idx = static_cast<size_t>(((mq - (uint64_t{1} << 30)) << SeedBits) / (3 * (uint64_t{1} << 30)));
+  const uint64_t r0 = RsqrtSeed<SeedBits>::table[idx];  // Q16, < 2^17
   const uint64_t mr = static_cast<uint64_t>((static_cast<unsigned __int128>(mq) * (r0 * r0)) >> 32);  // m r0^2, Q32
   return {static_cast<int64_t>(r0) * ((int64_t{3} << 32) - static_cast<int64_t>(mr)) >> 17, shift};  // Q32
 }
@@ -79,15 +87,16 @@ double rsqrtFixed(uint64_t v, int frac_bits);
 // phong-fixed's cosines: the dot product d of an interpolated normal (28 fraction bits per
 // component) with a Q1.30 unit vector (58 fraction bits), divided by |N|: with sqnorm = |N|^2
 // (56 fraction bits, exact from the recurrence) and (r, shift) = rsqrtCore(sqnorm), d / |N| in
-// Q2.32 is d r 2^(shift - 61), rounded half up, in 128 bits. shift <= 30 for sqnorm >= 1, so
+// Q2.32 is d r 2^(shift - 61), rounded half up, in 128 bits (rsqrtCore with the 10-bit seed). shift <= 30 for sqnorm >= 1, so
 // the shift right is 61 - shift in [31, 62].
 struct CosineScale {
   int64_t r = 0;
   int s = 1;  // shift right
 };
+constexpr int kFixedSeedBits = 10;
 inline CosineScale cosineScale(uint64_t sqnorm) {
   if (sqnorm == 0) return {0, 1};  // a zero normal: every cosine 0
-  const RsqrtCore c = rsqrtCore(sqnorm);
+  const RsqrtCore c = rsqrtCore<kFixedSeedBits>(sqnorm);
   return {c.r, 61 - c.shift};
 }
 inline int64_t scaleCosine(int64_t d, CosineScale c) {
