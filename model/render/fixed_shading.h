@@ -13,9 +13,10 @@
 //   specular     lobes of one cosine look the lobe up in a table over that cosine at 16 fraction
 //                bits, the exact lobe at each code (f_code = round(f 2^24), lobeTable), and
 //                interpolate linearly with the cosine's next 16 bits: N.H for blinn, pow,
-//                normalized-blinn and schlick; R.V = 2 (N.L)(N.V) - L.V for phong. The term is S_k f_code 2^-24 rounded half up to 12 fraction bits,
-//                S_k = round(255 k_s light_k 2^12). cook-torrance (three cosines) is evaluated
-//                in double from the fixed-point cosines and then coded the same way.
+//                normalized-blinn and schlick; R.V = 2 (N.L)(N.V) - L.V for phong. The term is
+//                S_k f_code 2^-24 rounded half up to 12 fraction bits, S_k = round(255 k_s
+//                light_k 2^12). cook-torrance (three cosines) is evaluated in double from the
+//                fixed-point cosines and then coded the same way.
 //                Device lobes: one request per lit light to the specular unit, N.H rounded to
 //                its cos_frac_bits; on the unit's bit-exact model the results come from a memo
 //                filled from the model (SpecResultMemo: exact, the unit being a function of

@@ -716,20 +716,17 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // reference walks the same pixel set by direct edge evaluation; the RTL's stream;
         // normal-bisection needs whole rows).
         const SpanParams* walker = span.walker();
+        auto walkWith = [&](auto&& sink) {
+          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, sink);
+          st.span_cycles += wk.cycles;
+          st.fragments += wk.fragments;
+        };
         if (!reference && walker != nullptr && (m == Method::Flat || m == Method::Gouraud)) {
-          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, colourFragment);
-          st.span_cycles += wk.cycles;
-          st.fragments += wk.fragments;
+          walkWith(colourFragment);
         } else if (!reference && walker != nullptr && m == Method::PhongFixed) {
-          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, fixedFragment);
-          st.span_cycles += wk.cycles;
-          st.fragments += wk.fragments;
+          walkWith(fixedFragment);
         } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
-          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, [&](int32_t x, int32_t y, const int64_t* attr) {
-            shadeFragment(x, y, attr, nullptr);
-          });
-          st.span_cycles += wk.cycles;
-          st.fragments += wk.fragments;
+          walkWith([&](int32_t x, int32_t y, const int64_t* attr) { shadeFragment(x, y, attr, nullptr); });
         } else {
           frags.clear();
           if (reference) frags = rasterizeReference(s, rcm);
