@@ -84,6 +84,10 @@ TEST(FixedShading, LobeTablesHoldTheLobeAtEveryCode) {
     EXPECT_EQ(lobeTable(Lobe::Pow, n), blinn);  // the same function: one table
     EXPECT_EQ(lobeTable(Lobe::Blinn, n), blinn);
   }
+  // More exponents than the cache keeps (64): it starts over, and tables in use live on.
+  const auto held = lobeTable(Lobe::Schlick, 7);
+  for (int n = 1; n <= 70; ++n) ASSERT_EQ((*lobeTable(Lobe::Schlick, n))[1u << 15], std::llround(std::ldexp(schlickLobe(0.5, n), 24)));
+  EXPECT_EQ((*held)[1u << 15], std::llround(std::ldexp(schlickLobe(0.5, 7), 24)));
   EXPECT_THROW(lobeTable(Lobe::CookTorrance, 32), std::logic_error);
   EXPECT_THROW(lobeTable(Lobe::Quadratic, 32), std::logic_error);
 }

@@ -50,19 +50,15 @@ std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shinine
   static std::mutex mutex;
   static std::map<std::pair<double (*)(double, double), double>, std::shared_ptr<const std::vector<uint32_t>>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[{f, shininess}];
-  if (!slot) {
-    if (cache.size() > 64) {  // a long run over many exponents: start over (tables in use live on)
-      cache.clear();
-      return lobeTable(lobe, shininess);
-    }
-    auto t = std::make_shared<std::vector<uint32_t>>((size_t{1} << kFixedCosFrac) + 2);
-    for (size_t c = 0; c + 1 < t->size(); ++c)
-      (*t)[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
-    t->back() = (*t)[t->size() - 2];
-    slot = std::move(t);
-  }
-  return slot;
+  const auto key = std::make_pair(f, shininess);
+  if (const auto it = cache.find(key); it != cache.end()) return it->second;
+  if (cache.size() >= 64) cache.clear();  // a long run over many exponents: start over (tables in use live on)
+  auto t = std::make_shared<std::vector<uint32_t>>((size_t{1} << kFixedCosFrac) + 2);
+  for (size_t c = 0; c + 1 < t->size(); ++c)
+    (*t)[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
+  t->back() = (*t)[t->size() - 2];
+  cache.emplace(key, t);
+  return t;
 }
 
 uint64_t* SpecResultMemo::row(uint32_t shin, const std::array<uint32_t, 3>& light) {
@@ -122,7 +118,7 @@ FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, L
     for (size_t k = 0; k < 3; ++k) {
       pl.diffuse[k] = factorCode(255.0 * m.kd * base[k] * lc[k]);
       pl.specular[k] = factorCode(255.0 * m.ks * lc[k]);
-      pl.device_light[k] = static_cast<uint32_t>(std::lround(255.0 * std::clamp(m.ks * lc[k], 0.0, 1.0)));
+      pl.device_light[k] = deviceLightCode(m.ks * lc[k]);
     }
     if (cosine_ == Cosine::Device && memo_ != nullptr) pl.memo = memo_->row(coding_->shin, pl.device_light);
   }

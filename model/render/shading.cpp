@@ -96,7 +96,7 @@ PointShader::PointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, 
     for (size_t k = 0; k < 3; ++k) {
       pl.diffuse[k] = 255.0 * m.kd * base[k] * lc[k];
       pl.specular[k] = 255.0 * m.ks * lc[k];
-      pl.device_light[k] = static_cast<uint32_t>(std::lround(255.0 * std::clamp(m.ks * lc[k], 0.0, 1.0)));
+      pl.device_light[k] = deviceLightCode(m.ks * lc[k]);
     }
     lights_.push_back(pl);
   }

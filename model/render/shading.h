@@ -59,6 +59,11 @@ struct SpecRequest {
   std::array<uint32_t, 3> light{};
 };
 
+// A device request's light code of one channel: k_s times the light colour as unorm8.
+inline uint32_t deviceLightCode(double ks_light) {
+  return static_cast<uint32_t>(std::lround(255.0 * std::clamp(ks_light, 0.0, 1.0)));
+}
+
 // How a material's device-lobe requests are coded for the specular unit.
 struct DeviceCoding {
   int cos_frac_bits = 15;
