@@ -140,6 +140,8 @@ inline uint64_t batchCycles(size_t n, int latency) { return n == 0 ? 0 : n + sta
 class ModelSpecEngine final : public SpecEngine {
  public:
   explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words), memo_(unit_) {}
+  ModelSpecEngine(const ModelSpecEngine&) = delete;  // memo_ refers to unit_
+  ModelSpecEngine& operator=(const ModelSpecEngine&) = delete;
   const PromTable& table() const override { return t_; }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
   const SpecUnitModel* model() const override { return &unit_; }
