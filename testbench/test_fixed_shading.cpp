@@ -112,6 +112,38 @@ TEST(FixedShading, SpecResultMemoEqualsTheUnitsModel) {
     ASSERT_NE(e & SpecResultMemo::kValid, 0u);
     for (size_t k = 0; k < 3; ++k) ASSERT_EQ((e >> (20 * k)) & 0xFFFFF, want.rgb[k]) << "cos " << cos;
   }
+  // A unit too wide for rows (CosFracBits 21: 16 MB a row) gets none; evaluate() still works.
+  SpecUnitParams wide = cfg.rtl;
+  wide.CosFracBits = SpecResultMemo::kMaxCosFracBits + 1;
+  wide.SpecFracBits = std::max(wide.SpecFracBits, wide.CosFracBits);
+  const PromTable wt = buildPromTable(PromRequest::fromContent(cfg.prom), wide);
+  const SpecUnitModel wunit(wt.unit, wt.words);
+  SpecResultMemo wmemo(wunit);
+  EXPECT_EQ(wmemo.row(shin, light), nullptr);
+  const uint32_t cos = 1u << 20;  // 0.5
+  const SpecOut want = wunit.evaluate(shin, cos, light);
+  EXPECT_EQ(wmemo.evaluate(shin, cos, light),
+            SpecResultMemo::kValid | want.rgb[0] | uint64_t{want.rgb[1]} << 20 | uint64_t{want.rgb[2]} << 40);
+  // and a shader on that unit adds what the unit gives for the request it would send
+  const Scene s = loadScene("builtin:sphere");
+  const ShadeContext ctx = makeShadeContext(s);
+  DeviceCoding coding;
+  coding.cos_frac_bits = wide.CosFracBits;
+  coding.shin = shin;
+  FixedPointShader direct(ctx, s.materials.at(0), Lobe::Quadratic, &coding, &wmemo);
+  FixedPointShader requesting(ctx, s.materials.at(0), Lobe::Quadratic, &coding, nullptr);
+  const Vec3 n = normalize(ctx.lights.at(0).half + Vec3{0.05, 0.02, 0});
+  const std::array<int64_t, 3> c{std::llround(std::ldexp(n.x, 28)), std::llround(std::ldexp(n.y, 28)),
+                                 std::llround(std::ldexp(n.z, 28))};
+  uint64_t sq = 0;
+  for (int64_t x : c) sq += static_cast<uint64_t>(x * x);
+  std::vector<SpecRequest> req;
+  requesting.shade(c.data(), sq, Vec3{}, &req);
+  ASSERT_EQ(req.size(), 1u);
+  const SpecOut unit_out = wunit.evaluate(req[0].shin, req[0].cos, req[0].light);
+  const FixedShade got = direct.shade(c.data(), sq, Vec3{}, nullptr);
+  EXPECT_EQ(got.device, unit_out.rgb);
+  EXPECT_GT(unit_out.rgb[0], 0u);
 }
 
 // A device lobe's request: N.H rounded to the unit's cos_frac_bits, one per lit light, with

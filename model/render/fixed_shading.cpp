@@ -62,19 +62,20 @@ std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shinine
 }
 
 uint64_t* SpecResultMemo::row(uint32_t shin, const std::array<uint32_t, 3>& light) {
+  if (model_.params().CosFracBits > kMaxCosFracBits) return nullptr;
   std::vector<uint64_t>& r = rows_[{shin, light[0], light[1], light[2]}];
   if (r.empty()) r.assign(static_cast<size_t>(model_.params().cosOne()) + 1, 0);
   return r.data();
 }
 
-uint64_t SpecResultMemo::fill(uint64_t* row, uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
+uint64_t SpecResultMemo::evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
   const SpecOut o = model_.evaluate(shin, cos, light);
   uint64_t e = kValid;
   for (size_t k = 0; k < 3; ++k) {
     if (o.rgb[k] > 0xFFFFFu) throw std::logic_error("SpecResultMemo: a specular unit output wider than 20 bits");
     e |= uint64_t{o.rgb[k]} << (20 * k);
   }
-  return row[cos] = e;
+  return e;
 }
 
 FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding,

@@ -82,10 +82,16 @@ class SpecResultMemo {
  public:
   explicit SpecResultMemo(const SpecUnitModel& model) : model_(model) {}
   // The row of (shin, light): 2^CosFracBits + 1 entries, 0 where not yet evaluated, else
-  // kValid | r | g << 20 | b << 40. The row stays valid as long as the memo.
+  // evaluate()'s word. The row stays valid as long as the memo. Null for a unit with more than
+  // kMaxCosFracBits (a row would take 8 MB and more): evaluate() directly then.
   uint64_t* row(uint32_t shin, const std::array<uint32_t, 3>& light);
-  uint64_t fill(uint64_t* row, uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const;
+  // The unit's result as one word: kValid | r | g << 20 | b << 40.
+  uint64_t evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const;
+  uint64_t fill(uint64_t* row, uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
+    return row[cos] = evaluate(shin, cos, light);
+  }
   static constexpr uint64_t kValid = uint64_t{1} << 60;
+  static constexpr int kMaxCosFracBits = 20;
   const SpecUnitModel& model() const { return model_; }
 
  private:
@@ -207,6 +213,7 @@ inline FixedShade FixedPointShader::shade(const int64_t* n28, uint64_t sqnorm, V
 }
 
 inline uint64_t FixedPointShader::deviceResult(const PerLight& pl, uint32_t cos) const {
+  if (pl.memo == nullptr) return memo_->evaluate(coding_->shin, cos, pl.device_light);
   const uint64_t e = pl.memo[cos];
   return __builtin_expect(e == 0, 0) ? memo_->fill(pl.memo, coding_->shin, cos, pl.device_light) : e;
 }
