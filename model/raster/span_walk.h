@@ -131,6 +131,35 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
     }
   std::array<int64_t, kMaxAttr> irow, icur;  // the first K are set before they are read
   std::copy(d.iref.begin(), d.iref.end(), irow.begin());
+  auto stepRow = [&](int64_t w) {  // the ROW cycle's updates: the edges, the row's attribute base
+    for (int j = 0; j < T; ++j)
+      stepEdges(d.tri[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
+    for (int a = 0; a < K; ++a) {
+      const size_t ai = static_cast<size_t>(a);
+      irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
+    }
+  };
+  if (T == 1) {
+    // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
+    // successive columns, so the fragments come in x order, and lane i of the cycle at xg
+    // shows the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
+    const SpanLaneTri& t = d.tri[0];
+    for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
+      ++walk.row_cycles;
+      int64_t lo = 0, hi = 0;
+      if (laneRowBounds(t, w, e.data(), lo, hi)) {
+        const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
+        walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
+        if (K == 4) singleRow<4>(p, d, t, w, lo, hi, irow.data(), emit);
+        else singleRow<0>(p, d, t, w, lo, hi, irow.data(), emit);
+        walk.fragments += static_cast<uint64_t>(hi - lo + 1);
+      }
+      stepRow(w);
+      if (w == d.row_last) break;
+    }
+    walk.cycles += walk.row_cycles + walk.span_cycles;
+    return walk;
+  }
   std::array<int64_t, kMaxLaneTri> lo{}, hi{};
   std::array<bool, kMaxLaneTri> ne{};
   std::array<int64_t, kMaxAttr> attr;
@@ -147,17 +176,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
         any = true;
       }
     }
-    if (any && T == 1) {
-      // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
-      // successive columns, so the fragments come in x order, and lane i of the cycle at xg
-      // shows the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
-      const SpanLaneTri& t = d.tri[0];
-      const int64_t xg0 = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
-      walk.span_cycles += static_cast<uint64_t>(L == 1 ? xe - xg0 + 1 : (xe - xg0) / L + 1);  // no division in serial
-      if (K == 4) singleRow<4>(p, d, t, w, lo[0], hi[0], irow.data(), emit);
-      else singleRow<0>(p, d, t, w, lo[0], hi[0], irow.data(), emit);
-      walk.fragments += static_cast<uint64_t>(hi[0] - lo[0] + 1);
-    } else if (any) {
+    if (any) {  // several lane-triangles: lane by lane, cycle by cycle
       int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
       for (int a = 0; a < K; ++a) {
         const size_t ai = static_cast<size_t>(a);
@@ -185,12 +204,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
         }
       }
     }
-    for (int j = 0; j < T; ++j)
-      stepEdges(d.tri[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
-    for (int a = 0; a < K; ++a) {
-      const size_t ai = static_cast<size_t>(a);
-      irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
-    }
+    stepRow(w);
     if (w == d.row_last) break;
   }
   walk.cycles += walk.row_cycles + walk.span_cycles;
