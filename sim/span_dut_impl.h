@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "raster/span_walk.h"
 #include "span_dut.h"
 #include "verilated_harness.h"
 #include "verilated_ports.h"
@@ -79,6 +80,7 @@ class SpanDutImpl final : public SpanDut {
 
   void drive(const SpanDesc& d) {
     using ports::put;
+    span_detail::checkDescriptor(kP, d);  // the ports below read NumAttr codes and NumTri lane-triangles
     constexpr int CB = kP.CoordBits, AB = kP.AttrBits, RB = kP.RemBits, K = kP.NumAttr;
     put(h_.dut().desc_tag_i, 0, kP.TagBits, d.tag);
     put(h_.dut().desc_row_first_i, 0, CB, static_cast<uint64_t>(d.row_first));

@@ -132,6 +132,9 @@ struct SpanLaneTri {
 };
 
 struct SpanDesc {
+  // User-provided: value-initialisation (std::optional::emplace()) then runs the member
+  // initialisers alone, instead of first zeroing the 1.7 KB of the lane-triangles' storage.
+  SpanDesc() {}
   uint32_t tag = 0;
   // Walker rows: the union of the lane-triangles' rows; never empty (row_first <= row_last):
   // setup drops a triangle without rows, and the unit, which stops at w == row_last, would
