@@ -27,6 +27,18 @@ ShadeContext twoLights() {
   return makeShadeContext(s);
 }
 
+// A normal as the span unit interpolates it (28 fraction bits per component) and its exact
+// squared norm (56 fraction bits), the shader's inputs.
+struct NormalCode {
+  std::array<int64_t, 3> n{};
+  uint64_t sq = 0;
+  explicit NormalCode(Vec3 v) : n{std::llround(std::ldexp(v.x, 28)), std::llround(std::ldexp(v.y, 28)),
+                                  std::llround(std::ldexp(v.z, 28))} {
+    for (int64_t x : n) sq += static_cast<uint64_t>(x * x);
+  }
+  Vec3 unit() const { return normalize(Vec3{double(n[0]), double(n[1]), double(n[2])}); }
+};
+
 }  // namespace
 
 // Every pixel's colour within 1 LSB (a rounding boundary) of the double-precision shader's
@@ -52,14 +64,10 @@ TEST(FixedShading, WithinOneLsbOfTheDoubleShader) {
         Vec3 v{g(rng), g(rng), g(rng)};
         if (t % 2 != 0) v = normalize(normalize(v) + 3.0 * ctx.lights[0].half);
         v = ((0.3 + 0.9 * u01(rng)) / length(v)) * v;
-        const std::array<int64_t, 3> c{std::llround(std::ldexp(v.x, 28)), std::llround(std::ldexp(v.y, 28)),
-                                       std::llround(std::ldexp(v.z, 28))};
-        uint64_t sq = 0;
-        for (int64_t x : c) sq += static_cast<uint64_t>(x * x);
+        const NormalCode c(v);
         const Vec3 p{u01(rng) - 0.5, u01(rng) - 0.5, 2 + u01(rng)};  // on the sphere's side of the camera
-        const auto want = combine(ref.shade(normalize(Vec3{double(c[0]), double(c[1]), double(c[2])}), p, nullptr).lsb,
-                                  nullptr, 0);
-        const auto got = fixedColour(fixed.shade(c.data(), sq, p, nullptr));
+        const auto want = combine(ref.shade(c.unit(), p, nullptr).lsb, nullptr, 0);
+        const auto got = fixedColour(fixed.shade(c.n.data(), c.sq, p, nullptr));
         for (size_t k = 0; k < 3; ++k) worst = std::max(worst, std::abs(int{want[k]} - int{got[k]}));
       }
       EXPECT_LE(worst, 1) << toString(lobe) << " n = " << n;
@@ -132,16 +140,12 @@ TEST(FixedShading, SpecResultMemoEqualsTheUnitsModel) {
   coding.shin = shin;
   FixedPointShader direct(ctx, s.materials.at(0), Lobe::Quadratic, &coding, &wmemo);
   FixedPointShader requesting(ctx, s.materials.at(0), Lobe::Quadratic, &coding, nullptr);
-  const Vec3 n = normalize(ctx.lights.at(0).half + Vec3{0.05, 0.02, 0});
-  const std::array<int64_t, 3> c{std::llround(std::ldexp(n.x, 28)), std::llround(std::ldexp(n.y, 28)),
-                                 std::llround(std::ldexp(n.z, 28))};
-  uint64_t sq = 0;
-  for (int64_t x : c) sq += static_cast<uint64_t>(x * x);
+  const NormalCode c(normalize(ctx.lights.at(0).half + Vec3{0.05, 0.02, 0}));
   std::vector<SpecRequest> req;
-  requesting.shade(c.data(), sq, Vec3{}, &req);
+  requesting.shade(c.n.data(), c.sq, Vec3{}, &req);
   ASSERT_EQ(req.size(), 1u);
   const SpecOut unit_out = wunit.evaluate(req[0].shin, req[0].cos, req[0].light);
-  const FixedShade got = direct.shade(c.data(), sq, Vec3{}, nullptr);
+  const FixedShade got = direct.shade(c.n.data(), c.sq, Vec3{}, nullptr);
   EXPECT_EQ(got.device, unit_out.rgb);
   EXPECT_GT(unit_out.rgb[0], 0u);
 }
@@ -157,12 +161,9 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
   FixedPointShader fixed(ctx, s.materials.at(0), Lobe::Quadratic, &coding, nullptr);
   const Vec3 h = ctx.lights.at(0).half;
   for (const Vec3 n : {h, normalize(h + Vec3{0.3, 0, 0}), -1.0 * ctx.lights.at(0).dir}) {
-    const std::array<int64_t, 3> c{std::llround(std::ldexp(n.x, 28)), std::llround(std::ldexp(n.y, 28)),
-                                   std::llround(std::ldexp(n.z, 28))};
-    uint64_t sq = 0;
-    for (int64_t x : c) sq += static_cast<uint64_t>(x * x);
+    const NormalCode c(n);
     std::vector<SpecRequest> req;
-    const FixedShade sh = fixed.shade(c.data(), sq, Vec3{}, &req);
+    const FixedShade sh = fixed.shade(c.n.data(), c.sq, Vec3{}, &req);
     if (dot(n, ctx.lights.at(0).dir) <= 0) {
       EXPECT_TRUE(req.empty());
       continue;

@@ -139,32 +139,24 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
       irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
     }
   };
-  if (T == 1) {
-    // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
-    // successive columns, so the fragments come in x order, and lane i of the cycle at xg
-    // shows the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
+  // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
+  // successive columns, so the fragments come in x order, and lane i of the cycle at xg shows
+  // the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
+  auto singleLaneRow = [&](int64_t w) {
     const SpanLaneTri& t = d.tri[0];
-    for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
-      ++walk.row_cycles;
-      int64_t lo = 0, hi = 0;
-      if (laneRowBounds(t, w, e.data(), lo, hi)) {
-        const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
-        walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
-        if (K == 4) singleRow<4>(p, d, t, w, lo, hi, irow.data(), emit);
-        else singleRow<0>(p, d, t, w, lo, hi, irow.data(), emit);
-        walk.fragments += static_cast<uint64_t>(hi - lo + 1);
-      }
-      stepRow(w);
-      if (w == d.row_last) break;
-    }
-    walk.cycles += walk.row_cycles + walk.span_cycles;
-    return walk;
-  }
+    int64_t lo = 0, hi = 0;
+    if (!laneRowBounds(t, w, e.data(), lo, hi)) return;
+    const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
+    walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
+    if (K == 4) singleRow<4>(p, d, t, w, lo, hi, irow.data(), emit);
+    else singleRow<0>(p, d, t, w, lo, hi, irow.data(), emit);
+    walk.fragments += static_cast<uint64_t>(hi - lo + 1);
+  };
+  // Several lane-triangles (sierpinski): lane by lane, cycle by cycle.
   std::array<int64_t, kMaxLaneTri> lo{}, hi{};
   std::array<bool, kMaxLaneTri> ne{};
   std::array<int64_t, kMaxAttr> attr;
-  for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
-    ++walk.row_cycles;
+  auto laneTrianglesRow = [&](int64_t w) {
     bool any = false;
     int64_t xs = 0, xe = 0;
     for (int j = 0; j < T; ++j) {
@@ -176,34 +168,38 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
         any = true;
       }
     }
-    if (any) {  // several lane-triangles: lane by lane, cycle by cycle
-      int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+    if (!any) return;
+    int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+    for (int a = 0; a < K; ++a) {
+      const size_t ai = static_cast<size_t>(a);
+      icur[ai] = wrapTo(u(irow[ai]) + u(d.didx[ai]) * u(xg - d.xref), p.AttrBits);
+    }
+    for (;;) {  // SPAN cycles
+      ++walk.span_cycles;
+      for (int j = 0; j < T; ++j) {
+        const size_t ju = static_cast<size_t>(j);
+        if (!ne[ju]) continue;
+        for (int i = 0; i < L; ++i) {
+          const int64_t x = xg + i;
+          if (x < lo[ju] || x > hi[ju]) continue;
+          int32_t px = 0, py = 0;
+          laneFragment(p, d, d.tri[ju], x, w, icur.data(), i, px, py, attr.data());
+          emit(px, py, static_cast<const int64_t*>(attr.data()));
+          ++walk.fragments;
+        }
+      }
+      if (xg + L > xe) break;
+      xg += L;
       for (int a = 0; a < K; ++a) {
         const size_t ai = static_cast<size_t>(a);
-        icur[ai] = wrapTo(u(irow[ai]) + u(d.didx[ai]) * u(xg - d.xref), p.AttrBits);
-      }
-      for (;;) {  // SPAN cycles
-        ++walk.span_cycles;
-        for (int j = 0; j < T; ++j) {
-          const size_t ju = static_cast<size_t>(j);
-          if (!ne[ju]) continue;
-          for (int i = 0; i < L; ++i) {
-            const int64_t x = xg + i;
-            if (x < lo[ju] || x > hi[ju]) continue;
-            int32_t px = 0, py = 0;
-            laneFragment(p, d, d.tri[ju], x, w, icur.data(), i, px, py, attr.data());
-            emit(px, py, static_cast<const int64_t*>(attr.data()));
-            ++walk.fragments;
-          }
-        }
-        if (xg + L > xe) break;
-        xg += L;
-        for (int a = 0; a < K; ++a) {
-          const size_t ai = static_cast<size_t>(a);
-          icur[ai] = wrapTo(u(icur[ai]) + static_cast<uint64_t>(L) * u(d.didx[ai]), p.AttrBits);
-        }
+        icur[ai] = wrapTo(u(icur[ai]) + static_cast<uint64_t>(L) * u(d.didx[ai]), p.AttrBits);
       }
     }
+  };
+  for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {  // ROW cycles
+    ++walk.row_cycles;
+    if (T == 1) singleLaneRow(w);
+    else laneTrianglesRow(w);
     stepRow(w);
     if (w == d.row_last) break;
   }

@@ -100,10 +100,7 @@ FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, L
     if (memo_ != nullptr && memo_->model().params().CosFracBits != coding_->cos_frac_bits)
       throw std::logic_error("FixedPointShader: the memo's unit is not the coding's");
   }
-  if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) {
-    table_ = lobeTable(lobe, m.shininess);
-    f_ = table_->data();
-  }
+  if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) table_ = lobeTable(lobe, m.shininess);
   v_ = unitCodes(ctx.view);
   const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
   const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};

@@ -135,7 +135,6 @@ class FixedPointShader {
   std::optional<DeviceCoding> coding_;
   SpecResultMemo* memo_;
   std::shared_ptr<const std::vector<uint32_t>> table_;  // lobes of one cosine
-  const uint32_t* f_ = nullptr;                         // table_'s codes
   bool needs_position_ = false;
   std::array<int32_t, 3> v_{};  // the view direction, Q1.30
   std::array<int64_t, 3> ambient_{};
@@ -197,12 +196,12 @@ inline FixedShade FixedPointShader::shade(const int64_t* n28, uint64_t sqnorm, V
         ++s.device_requests;
         continue;
       }
-      case Cosine::NH: f = lobeAt(f_, nh); break;
+      case Cosine::NH: f = lobeAt(table_->data(), nh); break;
       case Cosine::RV: {
         // R.V = 2 (N.L)(N.V) - L.V: the product of two Q2.32 is Q4.64, 2 x it back to Q2.32
         const __int128 p = static_cast<__int128>(nl) * nv;
         const int64_t rv = static_cast<int64_t>((p + (__int128{1} << 30)) >> 31) - pl.lv;
-        f = lobeAt(f_, rv);
+        f = lobeAt(table_->data(), rv);
         break;
       }
       case Cosine::CookTorrance: f = cookTorranceCode(nl, nv, nh, pl); break;

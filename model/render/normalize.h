@@ -86,9 +86,9 @@ double rsqrtFixed(uint64_t v, int frac_bits);
 
 // phong-fixed's cosines: the dot product d of an interpolated normal (28 fraction bits per
 // component) with a Q1.30 unit vector (58 fraction bits), divided by |N|: with sqnorm = |N|^2
-// (56 fraction bits, exact from the recurrence) and (r, shift) = rsqrtCore(sqnorm), d / |N| in
-// Q2.32 is d r 2^(shift - 61), rounded half up, in 128 bits (rsqrtCore with the 10-bit seed). shift <= 30 for sqnorm >= 1, so
-// the shift right is 61 - shift in [31, 62].
+// (56 fraction bits, exact from the recurrence) and (r, shift) = rsqrtCore<10>(sqnorm), d / |N|
+// in Q2.32 is d r 2^(shift - 61), rounded half up, in 128 bits. shift <= 30 for sqnorm >= 1,
+// so the shift right is 61 - shift in [31, 62].
 struct CosineScale {
   int64_t r = 0;
   int s = 1;  // shift right

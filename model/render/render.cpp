@@ -384,7 +384,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     shader.emplace(ctx, mat, lobe, &coding);
     // Per-pixel device lobes on the model: each request evaluated as it is made.
     const SpecUnitModel* direct = spec != nullptr ? spec->model() : nullptr;
-    if (opt.method == Method::PhongFixed) fixed.emplace(ctx, mat, lobe, &coding, direct != nullptr ? spec->memo() : nullptr);
+    if (opt.method == Method::PhongFixed) fixed.emplace(ctx, mat, lobe, &coding, spec != nullptr ? spec->memo() : nullptr);
     // The reference: the exact lobes (the Blinn lobe a device lobe approximates), and the same
     // without k_s for the specular part alone (highlight masks).
     const Lobe ref_lobe = isDeviceLobe(lobe) ? Lobe::Blinn : lobe;
