@@ -120,3 +120,28 @@ TEST(CosineScale, WithinTheRsqrtErrorOfTheExactCosineOfTheCodes) {
   RecordProperty("worst_abs_error", std::to_string(worst));
   EXPECT_EQ(scaleCosine(int64_t{1} << 58, cosineScale(0)), 0);  // a zero normal: cosine 0
 }
+
+// scaleCosine evaluates (d r + 2^(s-1)) >> s for s >= 35 as the high word of d r 2^(64-s) plus
+// 2^63: the same value as the 128-bit definition, for every squared norm's bit length (every s
+// from 31 to 62) and dot products of either sign up to the largest a normal of AttrBits 32
+// codes gives, and the definition's own path below s = 35.
+TEST(CosineScale, HighWordEvaluationEqualsTheDefinition) {
+  std::mt19937_64 rng(7);
+  uint64_t fast = 0, full = 0;
+  for (int bits = 1; bits <= 64; ++bits) {
+    for (int t = 0; t < 20000; ++t) {
+      const uint64_t top = uint64_t{1} << (bits - 1);
+      const uint64_t sq = top | (bits > 1 ? rng() & (top - 1) : 0);
+      const CosineScale c = cosineScale(sq);
+      // |d| <= |N| |u| with |u| <= 2^30 (Q1.30) and |N| = sqrt(sq): up to 2^(bits/2 + 30)
+      const int shift = std::min(62, bits / 2 + 31);
+      const int64_t d = static_cast<int64_t>(rng() >> (64 - shift)) * ((rng() & 1) != 0 ? 1 : -1);
+      const int64_t want =
+          static_cast<int64_t>((static_cast<__int128>(d) * c.r + (static_cast<__int128>(1) << (c.s - 1))) >> c.s);
+      ASSERT_EQ(scaleCosine(d, c), want) << "sqnorm " << sq << " d " << d;
+      ++(c.r64 != 0 ? fast : full);
+    }
+  }
+  EXPECT_GT(fast, 0u);
+  EXPECT_GT(full, 0u);
+}

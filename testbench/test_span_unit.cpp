@@ -4,6 +4,7 @@
 #include "fixed/fixed.h"
 #include "raster/setup.h"
 #include "raster/span_unit.h"
+#include "raster/span_walk.h"
 #include "raster/desc_stream.h"
 #include "raster/trigen.h"
 
@@ -40,6 +41,43 @@ std::vector<SpanFragment> sorted(std::vector<SpanFragment> f) {
     return a.y != b.y ? a.y < b.y : a.x < b.x;
   });
   return f;
+}
+
+// walkSpanUnit with a run consumer (the renderer's path), its runs expanded into fragments
+// (fragment i at x0 + i dx with a0 + i da): the rows it took as runs and fragment by fragment
+// are counted.
+struct RunWalk {
+  SpanWalk walk;
+  uint64_t run_rows = 0, fragment_rows = 0;
+};
+RunWalk walkWithRuns(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out) {
+  RunWalk rw;
+  int32_t last_y = INT32_MIN;
+  rw.walk = walkSpanUnit(
+      p, d,
+      [&](int32_t x, int32_t y, const int64_t* attr) {
+        if (y != last_y) ++rw.fragment_rows;
+        last_y = y;
+        SpanFragment f;
+        f.tag = d.tag;
+        f.x = x;
+        f.y = y;
+        for (int a = 0; a < p.NumAttr; ++a) f.attr.push_back(attr[a]);
+        out.push_back(f);
+      },
+      [&](const RowRun& r) {
+        ++rw.run_rows;
+        last_y = INT32_MIN;
+        for (int64_t i = 0; i < r.count; ++i) {
+          SpanFragment f;
+          f.tag = d.tag;
+          f.x = static_cast<int32_t>(r.x0 + i * r.dx);
+          f.y = r.y;
+          for (int a = 0; a < p.NumAttr; ++a) f.attr.push_back(r.a0[a] + i * r.da[a]);
+          out.push_back(f);
+        }
+      });
+  return rw;
 }
 
 std::vector<SpanFragment> runMode(SpanMode m, const std::array<SetupVertex, 3>& v, const RasterConfig& base,
@@ -123,6 +161,20 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
               << mode << " walker fragment " << i << " (" << a.x << ", " << a.y << ") vs the cycle model's (" << b.x
               << ", " << b.y << "), " << describe(t);
         }
+        // The same with runs: setup's descriptors never wrap, so every row of a single
+        // lane-triangle is one run (in the same order: x ascending, or descending when flipped).
+        walked.clear();
+        const RunWalk rw = walkWithRuns(cfgs[mi].unit, *s.desc, walked);
+        ASSERT_EQ(rw.walk.cycles, run.cycles) << mode << " run walker cycles, " << describe(t);
+        ASSERT_EQ(walked.size(), run.fragments.size()) << mode << " run walker fragments, " << describe(t);
+        for (size_t i = 0; i < walked.size(); ++i) {
+          const SpanFragment &a = walked[i], &b = run.fragments[i];
+          ASSERT_TRUE(a.x == b.x && a.y == b.y && a.attr == b.attr)
+              << mode << " run walker fragment " << i << " (" << a.x << ", " << a.y << ") vs the cycle model's ("
+              << b.x << ", " << b.y << "), " << describe(t);
+        }
+        if (cfgs[mi].unit.NumTri == 1) ASSERT_EQ(rw.fragment_rows, 0u) << mode << " " << describe(t);
+        else ASSERT_EQ(rw.run_rows, 0u) << mode << " " << describe(t);
         got = sorted(run.fragments);
       }
       if (mi == 0) {
@@ -368,7 +420,7 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
     RasterConfig c;
     c.unit = SpanParams::forMode(m);
     DescriptorStream stream(5, 2000, c);
-    uint64_t fragments = 0, wrapped = 0;
+    uint64_t fragments = 0, wrapped = 0, run_rows = 0, fragment_rows = 0;
     SpanDesc d;
     std::vector<SpanFragment> walked, wide;
     while (stream.next(d)) {
@@ -397,11 +449,27 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
             wrapped += walked[i].attr != wide[i].attr ? 1 : 0;
           }
           fragments += walked.size();
+          // With runs: a row whose values wrap inside it goes fragment by fragment; one whose
+          // values all lie in one window of 2^AttrBits (wrapped or not) is a run.
+          walked.clear();
+          const RunWalk rw = walkWithRuns(p, x, walked);
+          run_rows += rw.run_rows;
+          fragment_rows += rw.fragment_rows;
+          ASSERT_EQ(walked.size(), run.fragments.size()) << toString(m) << " AttrBits " << bits << " runs";
+          for (size_t i = 0; i < walked.size(); ++i)
+            ASSERT_TRUE(walked[i].x == run.fragments[i].x && walked[i].y == run.fragments[i].y &&
+                        walked[i].attr == run.fragments[i].attr)
+                << toString(m) << " AttrBits " << bits << " flip " << flip << " run fragment " << i << " of triangle "
+                << d.tag;
         }
       }
     }
     EXPECT_GT(wrapped, fragments / 2) << toString(m);  // both loops ran: most rows wrap, some fit
     EXPECT_LT(wrapped, fragments) << toString(m);
+    if (c.unit.NumTri == 1) {  // both paths ran: rows within one window and rows across windows
+      EXPECT_GT(run_rows, 0u) << toString(m);
+      EXPECT_GT(fragment_rows, 0u) << toString(m);
+    }
   }
 }
 

@@ -222,6 +222,16 @@ struct SpanRun {
 };
 SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d);
 
+// A row's fragments as one run (walkSpanUnit's run consumer): count fragments, fragment i at
+// pixel (x0 + i dx, y) with attribute a equal to a0[a] + i da[a] exactly (nothing wraps in
+// the run; da is 0 for a run of one). a0 and da: NumAttr values, valid during the call.
+struct RowRun {
+  int32_t x0 = 0, y = 0, dx = 1;  // dx: +1 or -1
+  int64_t count = 0;
+  const int64_t* a0 = nullptr;
+  const int64_t* da = nullptr;
+};
+
 // The same unit without the cycle-by-cycle machinery: the fragments of one descriptor in the
 // order SpanUnitModel hands them over with out_ready always 1 (cycle by cycle, lane by lane
 // within a cycle), appended to `out`, and the cycles it takes, counted as runSpanUnit counts

@@ -107,18 +107,58 @@ inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri&
   else row(std::false_type{});
 }
 
+// singleRow's fragments as one RowRun when they form one: the values singleRow emits at the
+// row's ends, x = lo and x = hi, differ by exactly (hi - lo) times the step. The emitted value
+// is the plane (affine in x) mod 2^AttrBits, so that holds exactly when both ends lie in the
+// same window of 2^AttrBits values; then, the plane being monotonic, so does every value in
+// between, and fragment i shows a0 + i da with no further wrap. (Setup makes every value fit,
+// so a row that is not one run is a descriptor that setup would not make.) Pixel coordinates:
+// both ends within PixBits, so that the mask changes none.
+template <int KC, class RunSink>
+inline bool runRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t w, int64_t lo, int64_t hi,
+                   const int64_t* irow, RunSink& emit_run) {
+  const int K = KC > 0 ? KC : p.NumAttr, bits = p.AttrBits;
+  const int64_t pix_lim = int64_t{1} << p.PixBits;
+  const int64_t px_lo = t.flip ? t.ox - lo : lo + t.ox, px_hi = t.flip ? t.ox - hi : hi + t.ox;
+  const int64_t py = t.flip ? t.oy - w : w + t.oy;
+  if (px_lo < 0 || px_lo >= pix_lim || px_hi < 0 || px_hi >= pix_lim || py < 0 || py >= pix_lim) return false;
+  const int64_t n1 = hi - lo;
+  std::array<int64_t, kMaxAttr> a0, da;  // the first K are set
+  for (int a = 0; a < K; ++a) {
+    const size_t ai = static_cast<size_t>(a);
+    const uint64_t acc = u(irow[ai]) + u(d.didx[ai]) * u(lo - d.xref);
+    const uint64_t step = t.flip ? 0 - u(d.didx[ai]) : u(d.didx[ai]);  // in emission order
+    const int64_t v_lo = wrapTo(t.flip ? u(t.aoff[ai]) - acc : acc + u(t.aoff[ai]), bits);
+    const int64_t v_hi = wrapTo(u(v_lo) + step * u(n1), bits);
+    int64_t span = 0;
+    if (__builtin_mul_overflow(static_cast<int64_t>(step), n1, &span) || v_hi - v_lo != span) return false;
+    a0[ai] = v_lo;
+    da[ai] = n1 > 0 ? static_cast<int64_t>(step) : 0;
+  }
+  emit_run(RowRun{static_cast<int32_t>(px_lo), static_cast<int32_t>(py), t.flip ? -1 : 1, n1 + 1, a0.data(),
+                  da.data()});
+  return true;
+}
+
+// No run consumer: every row fragment by fragment.
+struct NoRuns {};
+
 }  // namespace span_detail
 
 // The fragments of one descriptor, in the order SpanUnitModel hands them over with out_ready
 // always 1, each passed to emit(x, y, attr) (attr: NumAttr codes, valid during the call), and
 // the cycles counted as runSpanUnit counts them. See walkSpanUnit in raster/span_unit.h.
-template <class Sink>
-SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
+// With a run consumer, a row of a single lane-triangle (serial, evenodd, segments) whose
+// values provably do not wrap goes to run_consumer(const RowRun&) instead, as one run (the
+// same fragments; the consumer's own loop over them; see RowRun); other rows as above.
+template <class Sink, class RunSink = span_detail::NoRuns>
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, RunSink&& run_consumer = {}) {
   using namespace span_detail;
   // A local copy of the consumer (a closure of pointers and references): the compiler may then
   // keep what it captured in registers across the consumer's own stores (a byte store may
   // alias any object whose address has escaped, such as the caller's closure).
   std::decay_t<Sink> emit(consumer);
+  std::decay_t<RunSink> emit_run(run_consumer);
   checkDescriptor(p, d);
   const int L = p.LanesPerTri, T = p.NumTri, K = p.NumAttr;
   SpanWalk walk;
@@ -148,8 +188,12 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer) {
     if (!laneRowBounds(t, w, e.data(), lo, hi)) return;
     const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
     walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
-    if (K == 4) singleRow<4>(p, d, t, w, lo, hi, irow.data(), emit);
-    else singleRow<0>(p, d, t, w, lo, hi, irow.data(), emit);
+    bool ran = false;
+    if constexpr (!std::is_same_v<std::decay_t<RunSink>, NoRuns>)
+      ran = K == 4 ? runRow<4>(p, d, t, w, lo, hi, irow.data(), emit_run)
+                   : runRow<0>(p, d, t, w, lo, hi, irow.data(), emit_run);
+    if (!ran && K == 4) singleRow<4>(p, d, t, w, lo, hi, irow.data(), emit);
+    else if (!ran) singleRow<0>(p, d, t, w, lo, hi, irow.data(), emit);
     walk.fragments += static_cast<uint64_t>(hi - lo + 1);
   };
   // Several lane-triangles (sierpinski): lane by lane, cycle by cycle.

@@ -99,50 +99,7 @@ class SpecResultMemo {
   std::map<std::array<uint32_t, 4>, std::vector<uint64_t>> rows_;
 };
 
-class FixedPointShader {
- public:
-  // coding: the specular unit's request coding (device lobes; std::logic_error if null then).
-  // memo: the unit's results from its model, or null when requests go to `requests` of
-  // shade() (the RTL in the loop). ctx, m and memo must outlive the shader.
-  FixedPointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding,
-                   SpecResultMemo* memo);
-
-  // The colour at a point with interpolated normal n28 (28 fraction bits per component) of
-  // squared norm sqnorm (56 fraction bits). p_cam is read only when needsPosition(). Device
-  // requests go to *requests when there is no memo (one per lit light).
-  FixedShade shade(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam, std::vector<SpecRequest>* requests);
-  bool needsPosition() const { return needs_position_; }
-
- private:
-  enum class Cosine { NH, RV, CookTorrance, Device };
-  struct PerLight {
-    const CameraLight* light = nullptr;
-    std::array<int32_t, 3> l{}, h{};  // Q1.30 (point lights: this pixel's)
-    int64_t lv = 0;                   // L.V, Q2.32
-    double vh = 0;                    // V.H (cook-torrance), double
-    std::array<int64_t, 3> diffuse{}, specular{};
-    std::array<uint32_t, 3> device_light{};
-    uint64_t* memo = nullptr;  // the memo's row of this light's requests
-  };
-
-  void setDirections(PerLight& pl, Vec3 l) const;
-  uint32_t cookTorranceCode(int64_t nl, int64_t nv, int64_t nh, const PerLight& pl) const;
-  uint64_t deviceResult(const PerLight& pl, uint32_t cos) const;  // the memo entry, evaluated on first use
-
-  const ShadeContext& ctx_;
-  const Material& m_;
-  Cosine cosine_;
-  std::optional<DeviceCoding> coding_;
-  SpecResultMemo* memo_;
-  std::shared_ptr<const std::vector<uint32_t>> table_;  // lobes of one cosine
-  bool needs_position_ = false;
-  std::array<int32_t, 3> v_{};  // the view direction, Q1.30
-  std::array<int64_t, 3> ambient_{};
-  std::vector<PerLight> lights_;
-};
-
-// ---- the per-pixel path, inline (it runs once per fragment) ----
-
+// The per-pixel arithmetic (inline: it runs once per fragment).
 namespace fixed_detail {
 // N (28 fraction bits) . u (Q1.30): 58 fraction bits, in 64-bit modular arithmetic (the
 // partial sums may wrap; the result, |N.u| <= |N| 2^58, fits)
@@ -168,47 +125,218 @@ inline uint32_t lobeAt(const uint32_t* t, int64_t c32) {
 }
 }  // namespace fixed_detail
 
+class FixedPointShader {
+ public:
+  // coding: the specular unit's request coding (device lobes; std::logic_error if null then).
+  // memo: the unit's results from its model, or null when requests go to `requests` of
+  // shade() (the RTL in the loop). ctx, m and memo must outlive the shader.
+  FixedPointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding,
+                   SpecResultMemo* memo);
+
+  // The colour at a point with interpolated normal n28 (28 fraction bits per component) of
+  // squared norm sqnorm (56 fraction bits). p_cam is read only when needsPosition(). Device
+  // requests go to *requests when there is no memo (one per lit light).
+  FixedShade shade(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam, std::vector<SpecRequest>* requests);
+  bool needsPosition() const { return needs_position_; }
+
+  // Runs of fragments along a row, normal n0 + i dn at fragment i: the integer dot products
+  // of shade() are affine in i, so they step by constant increments (exact: the same values
+  // modulo 2^64, hence the same colours as shade()). For directional lights, at most
+  // kMaxRunLights of them, and device lobes answered by the memo (takesRuns()).
+  static constexpr size_t kMaxRunLights = 4;
+  bool takesRuns() const {
+    return !needs_position_ && lights_.size() <= kMaxRunLights && (cosine_ != Cosine::Device || memo_ != nullptr);
+  }
+  template <class F>
+  void withRunKernel(F&& f);  // f(kernel), kernel a RunKernel<C, NL> for this shader (takesRuns())
+
+ private:
+  enum class Cosine { NH, RV, CookTorrance, Device };
+  struct PerLight {
+    const CameraLight* light = nullptr;
+    std::array<int32_t, 3> l{}, h{};  // Q1.30 (point lights: this pixel's)
+    int64_t lv = 0;                   // L.V, Q2.32
+    double vh = 0;                    // V.H (cook-torrance), double
+    std::array<int64_t, 3> diffuse{}, specular{};
+    std::array<uint32_t, 3> device_light{};
+    uint64_t* memo = nullptr;  // the memo's row of this light's requests
+  };
+  // What the datapath reads: the shader's members, or a run kernel's copies of them.
+  struct Consts {
+    std::array<int64_t, 3> ambient;
+    const uint32_t* table;  // the lobe table (lobes of one cosine)
+    PerLight* lights;
+    size_t count;
+  };
+
+ public:
+  // The datapath for the fragments of one run with the lobe kind C and the light count NL
+  // fixed at compile time, and the constants it reads copied into the kernel (a local object:
+  // the run's loop keeps them in registers, where the shader's members would be read again
+  // after every store of a pixel). start() at the run's first fragment, shade() the colour of
+  // the current fragment of squared norm sqnorm, step() to the next.
+  template <Cosine C, size_t NL>
+  class RunKernel {
+   public:
+    explicit RunKernel(FixedPointShader& sh) : sh_(sh) {
+      for (size_t i = 0; i < NL; ++i) lights_[i] = sh.lights_[i];
+      ambient_ = sh.ambient_;
+      table_ = sh.table_ ? sh.table_->data() : nullptr;
+    }
+    void start(const int64_t* n0, const int64_t* dn) {
+      using fixed_detail::dot58;
+      v_ = static_cast<uint64_t>(dot58(n0, sh_.v_));
+      dv_ = static_cast<uint64_t>(dot58(dn, sh_.v_));
+      for (size_t i = 0; i < NL; ++i) {
+        l_[i] = static_cast<uint64_t>(dot58(n0, lights_[i].l));
+        dl_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].l));
+        h_[i] = static_cast<uint64_t>(dot58(n0, lights_[i].h));
+        dh_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].h));
+      }
+    }
+    FixedShade shade(uint64_t sqnorm) {
+      return sh_.shadeDots<C>(
+          Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
+          [&](size_t i, PerLight&) { return static_cast<int64_t>(l_[i]); },
+          [&](size_t i, const PerLight&) { return static_cast<int64_t>(h_[i]); }, nullptr);
+    }
+    void step() {
+      v_ += dv_;
+      for (size_t i = 0; i < NL; ++i) {
+        l_[i] += dl_[i];
+        h_[i] += dh_[i];
+      }
+    }
+
+   private:
+    FixedPointShader& sh_;
+    std::array<PerLight, NL> lights_;
+    std::array<int64_t, 3> ambient_;
+    const uint32_t* table_;
+    uint64_t v_ = 0, dv_ = 0;
+    std::array<uint64_t, NL> l_{}, dl_{}, h_{}, dh_{};
+  };
+
+ private:
+
+  // The lighting from the integer dot products N.V (raw_nv), N.L (nl_of(i, light i), which may
+  // first set a point light's directions) and N.H (nh_of(i, light i)), 58 fraction bits.
+  template <Cosine C, class NL, class NH>
+  FixedShade shadeDots(const Consts& k, uint64_t sqnorm, int64_t raw_nv, NL nl_of, NH nh_of,
+                       std::vector<SpecRequest>* requests);
+  template <Cosine C>
+  FixedShade shadeAs(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam, std::vector<SpecRequest>* requests);
+  template <Cosine C, class F>
+  void withLightCount(F&& f);
+  void setDirections(PerLight& pl, Vec3 l) const;
+  uint32_t cookTorranceCode(int64_t nl, int64_t nv, int64_t nh, const PerLight& pl) const;
+  uint64_t deviceResult(const PerLight& pl, uint32_t cos) const;  // the memo entry, evaluated on first use
+
+  const ShadeContext& ctx_;
+  const Material& m_;
+  Cosine cosine_;
+  std::optional<DeviceCoding> coding_;
+  SpecResultMemo* memo_;
+  std::shared_ptr<const std::vector<uint32_t>> table_;  // lobes of one cosine
+  bool needs_position_ = false;
+  std::array<int32_t, 3> v_{};  // the view direction, Q1.30
+  std::array<int64_t, 3> ambient_{};
+  std::vector<PerLight> lights_;
+};
+
+// ---- the per-pixel path, inline (it runs once per fragment) ----
+
 inline FixedShade FixedPointShader::shade(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam,
                                           std::vector<SpecRequest>* requests) {
+  switch (cosine_) {
+    case Cosine::NH: return shadeAs<Cosine::NH>(n28, sqnorm, p_cam, requests);
+    case Cosine::RV: return shadeAs<Cosine::RV>(n28, sqnorm, p_cam, requests);
+    case Cosine::CookTorrance: return shadeAs<Cosine::CookTorrance>(n28, sqnorm, p_cam, requests);
+    case Cosine::Device: break;
+  }
+  return shadeAs<Cosine::Device>(n28, sqnorm, p_cam, requests);
+}
+
+template <FixedPointShader::Cosine C>
+inline FixedShade FixedPointShader::shadeAs(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam,
+                                            std::vector<SpecRequest>* requests) {
+  using fixed_detail::dot58;
+  constexpr bool needs_nv = C == Cosine::RV || C == Cosine::CookTorrance;
+  return shadeDots<C>(
+      Consts{ambient_, table_ ? table_->data() : nullptr, lights_.data(), lights_.size()}, sqnorm,
+      needs_nv ? dot58(n28, v_) : 0,
+      [&](size_t, PerLight& pl) {
+        if (pl.light->point) setDirections(pl, lightDirection(*pl.light, p_cam));
+        return dot58(n28, pl.l);
+      },
+      [&](size_t, const PerLight& pl) { return dot58(n28, pl.h); }, requests);
+}
+
+template <FixedPointShader::Cosine C, class NL, class NH>
+inline FixedShade FixedPointShader::shadeDots(const Consts& k, uint64_t sqnorm, int64_t raw_nv, NL nl_of, NH nh_of,
+                                              std::vector<SpecRequest>* requests) {
   using namespace fixed_detail;
   FixedShade s;
-  s.code = ambient_;
+  s.code = k.ambient;
   const CosineScale sc = cosineScale(sqnorm);
-  const bool needs_nv = cosine_ == Cosine::RV || cosine_ == Cosine::CookTorrance;
-  const int64_t nv = needs_nv ? scaleCosine(dot58(n28, v_), sc) : 0;
-  for (PerLight& pl : lights_) {
-    if (pl.light->point) setDirections(pl, lightDirection(*pl.light, p_cam));
-    const int64_t nl = scaleCosine(dot58(n28, pl.l), sc);
+  constexpr bool needs_nv = C == Cosine::RV || C == Cosine::CookTorrance;
+  const int64_t nv = needs_nv ? scaleCosine(raw_nv, sc) : 0;
+  for (size_t li = 0; li < k.count; ++li) {
+    PerLight& pl = k.lights[li];
+    const int64_t nl = scaleCosine(nl_of(li, pl), sc);
     if (nl <= 0) continue;  // the surface faces away from this light
-    for (size_t k = 0; k < 3; ++k) s.code[k] += roundShift(pl.diffuse[k] * nl, 32);
-    const int64_t nh = scaleCosine(dot58(n28, pl.h), sc);
-    uint32_t f = 0;
-    switch (cosine_) {
-      case Cosine::Device: {
-        const uint32_t cos = cosCode(nh, coding_->cos_frac_bits);
-        if (memo_ == nullptr) {
-          if (requests == nullptr) throw std::logic_error("FixedPointShader: device requests need a list");
-          requests->push_back(SpecRequest{coding_->shin, cos, pl.device_light});
-        } else {
-          const uint64_t r = deviceResult(pl, cos);
-          for (size_t k = 0; k < 3; ++k) s.device[k] += static_cast<uint32_t>(r >> (20 * k)) & 0xFFFFFu;
-        }
-        ++s.device_requests;
-        continue;
+    for (size_t c = 0; c < 3; ++c) s.code[c] += roundShift(pl.diffuse[c] * nl, 32);
+    const int64_t nh = scaleCosine(nh_of(li, pl), sc);
+    if constexpr (C == Cosine::Device) {
+      const uint32_t cos = cosCode(nh, coding_->cos_frac_bits);
+      if (memo_ == nullptr) {
+        if (requests == nullptr) throw std::logic_error("FixedPointShader: device requests need a list");
+        requests->push_back(SpecRequest{coding_->shin, cos, pl.device_light});
+      } else {
+        const uint64_t r = deviceResult(pl, cos);
+        for (size_t c = 0; c < 3; ++c) s.device[c] += static_cast<uint32_t>(r >> (20 * c)) & 0xFFFFFu;
       }
-      case Cosine::NH: f = lobeAt(table_->data(), nh); break;
-      case Cosine::RV: {
+      ++s.device_requests;
+    } else {
+      uint32_t f = 0;
+      if constexpr (C == Cosine::NH) {
+        f = lobeAt(k.table, nh);
+      } else if constexpr (C == Cosine::RV) {
         // R.V = 2 (N.L)(N.V) - L.V: the product of two Q2.32 is Q4.64, 2 x it back to Q2.32
         const __int128 p = static_cast<__int128>(nl) * nv;
         const int64_t rv = static_cast<int64_t>((p + (__int128{1} << 30)) >> 31) - pl.lv;
-        f = lobeAt(table_->data(), rv);
-        break;
+        f = lobeAt(k.table, rv);
+      } else {
+        f = cookTorranceCode(nl, nv, nh, pl);
       }
-      case Cosine::CookTorrance: f = cookTorranceCode(nl, nv, nh, pl); break;
+      for (size_t c = 0; c < 3; ++c) s.code[c] += roundShift(pl.specular[c] * f, 24);
     }
-    for (size_t k = 0; k < 3; ++k) s.code[k] += roundShift(pl.specular[k] * f, 24);
   }
   return s;
+}
+
+template <FixedPointShader::Cosine C, class F>
+inline void FixedPointShader::withLightCount(F&& f) {
+  static_assert(kMaxRunLights == 4, "one case per light count");
+  switch (lights_.size()) {
+    case 0: f(RunKernel<C, 0>(*this)); break;
+    case 1: f(RunKernel<C, 1>(*this)); break;
+    case 2: f(RunKernel<C, 2>(*this)); break;
+    case 3: f(RunKernel<C, 3>(*this)); break;
+    case 4: f(RunKernel<C, 4>(*this)); break;
+    default: throw std::logic_error("FixedPointShader: a run with more lights than kMaxRunLights");
+  }
+}
+
+template <class F>
+inline void FixedPointShader::withRunKernel(F&& f) {
+  if (!takesRuns()) throw std::logic_error("FixedPointShader: runs need directional lights and the memo");
+  switch (cosine_) {
+    case Cosine::NH: withLightCount<Cosine::NH>(f); break;
+    case Cosine::RV: withLightCount<Cosine::RV>(f); break;
+    case Cosine::CookTorrance: withLightCount<Cosine::CookTorrance>(f); break;
+    case Cosine::Device: withLightCount<Cosine::Device>(f); break;
+  }
 }
 
 inline uint64_t FixedPointShader::deviceResult(const PerLight& pl, uint32_t cos) const {

@@ -89,17 +89,25 @@ double rsqrtFixed(uint64_t v, int frac_bits);
 // (56 fraction bits, exact from the recurrence) and (r, shift) = rsqrtCore<10>(sqnorm), d / |N|
 // in Q2.32 is d r 2^(shift - 61), rounded half up, in 128 bits. shift <= 30 for sqnorm >= 1,
 // so the shift right is 61 - shift in [31, 62].
+// Evaluation (the same values): for s >= 35, r 2^(64 - s) < 2^63 (r < 2^33.1), and
+// (d r + 2^(s-1)) >> s = (d r 2^(64-s) + 2^63) >> 64, the high word of one product and a
+// carry, with no shift by a variable amount; smaller s (sqnorm below 2^10, |N| < 2^-23) in
+// full.
 struct CosineScale {
   int64_t r = 0;
-  int s = 1;  // shift right
+  int s = 1;  // shift right, 1..62
+  int64_t r64 = 0;  // r 2^(64 - s) for s >= 35, else 0
 };
 constexpr int kFixedSeedBits = 10;
 inline CosineScale cosineScale(uint64_t sqnorm) {
-  if (sqnorm == 0) return {0, 1};  // a zero normal: every cosine 0
+  if (sqnorm == 0) return {0, 1, 0};  // a zero normal: every cosine 0
   const RsqrtCore c = rsqrtCore<kFixedSeedBits>(sqnorm);
-  return {c.r, 61 - c.shift};
+  const int s = 61 - c.shift;
+  return {c.r, s, s >= 35 ? c.r << (64 - s) : 0};
 }
 inline int64_t scaleCosine(int64_t d, CosineScale c) {
+  if (__builtin_expect(c.r64 != 0, 1))
+    return static_cast<int64_t>((static_cast<__int128>(d) * c.r64 + (__int128{1} << 63)) >> 64);
   return static_cast<int64_t>((static_cast<__int128>(d) * c.r + (__int128{1} << (c.s - 1))) >> c.s);
 }
 }  // namespace shd

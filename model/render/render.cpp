@@ -547,6 +547,54 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
                              unorm8FromCode(attr[2], kColourFrac)});
         };
+        // The same for a whole run of a row (walkSpanUnit's run consumer): the loop in
+        // registers, the newly covered pixels counted once per run. When the colour codes at
+        // both ends of the run lie in [0, 255 2^12] so do all between (they are affine), and
+        // unorm8FromCode is the rounding shift alone.
+        auto colourRun = [rgb_ = fb.rgb.data(), depth_ = fb.depth.data(), tri_ = fb.tri.data(), tag, W,
+                          &covered = st.pixels_covered](const RowRun& r) {
+          // Locals, not the closure's members or r's: a byte store may alias those, and the
+          // loop would reload them at every pixel.
+          uint8_t* const rgb = rgb_;
+          int32_t* const depth = depth_;
+          int32_t* const tri_of = tri_;
+          const int32_t tag32 = static_cast<int32_t>(tag);
+          const int64_t count = r.count;
+          std::array<uint64_t, 4> a, da;
+          bool in_range = true;
+          for (size_t k = 0; k < 4; ++k) {
+            a[k] = static_cast<uint64_t>(r.a0[k]);
+            da[k] = static_cast<uint64_t>(r.da[k]);
+            const int64_t end = static_cast<int64_t>(a[k] + da[k] * static_cast<uint64_t>(count - 1));
+            if (k < 3) in_range = in_range && std::min(r.a0[k], end) >= 0 && std::max(r.a0[k], end) <= (255 << kColourFrac);
+          }
+          const size_t p0 = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
+          const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
+          uint64_t newly = 0;
+          auto loop = [&](auto clamp) {
+            auto unorm8 = [](uint64_t c) {
+              if constexpr (decltype(clamp)::value) return unorm8FromCode(static_cast<int64_t>(c), kColourFrac);
+              else return static_cast<uint8_t>((c + (1u << (kColourFrac - 1))) >> kColourFrac);
+            };
+            size_t p = p0;
+            for (int64_t i = 0; i < count; ++i, p += step) {
+              __builtin_prefetch(depth + p + W);  // as colourFragment
+              const int64_t z = static_cast<int64_t>(a[3]);
+              if (z > depth[p]) {
+                rgb[p * 3 + 0] = unorm8(a[0]);
+                rgb[p * 3 + 1] = unorm8(a[1]);
+                rgb[p * 3 + 2] = unorm8(a[2]);
+                newly += depth[p] == 0;
+                depth[p] = static_cast<int32_t>(z);
+                tri_of[p] = tag32;
+              }
+              for (size_t k = 0; k < 4; ++k) a[k] += da[k];
+            }
+          };
+          if (in_range) loop(std::false_type{});
+          else loop(std::true_type{});
+          covered += newly;
+        };
         // phong-incremental, phong-fixed: |N|^2 along each run of consecutive pixels of a row
         // by the recurrence, restarted (three products) where the stream is not the next pixel.
         // The recurrence is exact, so the values do not depend on where it restarts.
@@ -578,6 +626,47 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           }
           memo_requests += fs.device_requests;
           write(p, wcode, fixedColour(fs));
+        };
+        // phong-fixed for a whole run: the recurrence and the dot products stepped along it
+        // (FixedPointShader::Run), the same colours as fixedFragment's; fragment by fragment
+        // where the shader takes no runs (point lights, requests batched for the unit).
+        auto fixedRun = [&](const RowRun& r) {
+          if (batched || !fixed->takesRuns()) {
+            std::array<int64_t, 4> attr;
+            for (int64_t i = 0; i < r.count; ++i) {
+              for (size_t k = 0; k < 4; ++k)
+                attr[k] = static_cast<int64_t>(static_cast<uint64_t>(r.a0[k]) + static_cast<uint64_t>(i) * static_cast<uint64_t>(r.da[k]));
+              fixedFragment(static_cast<int32_t>(r.x0 + i * r.dx), r.y, attr.data());
+            }
+            return;
+          }
+          int32_t* const depth = fb.depth.data();
+          const int64_t count = r.count;
+          SquaredNormRecurrence run_sqn;
+          uint64_t sqnorm = run_sqn.start({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
+          uint64_t z = static_cast<uint64_t>(r.a0[3]);
+          const uint64_t dz = static_cast<uint64_t>(r.da[3]);
+          size_t p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
+          const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
+          size_t requests_answered = 0;
+          fixed->withRunKernel([&](auto kernel) {
+            kernel.start(r.a0, r.da);
+            for (int64_t i = 0;;) {
+              __builtin_prefetch(depth + p + W);  // as colourFragment
+              const int64_t wcode = static_cast<int64_t>(z);
+              if (wcode > depth[p]) {
+                const FixedShade fs = kernel.shade(sqnorm);
+                requests_answered += fs.device_requests;
+                write(p, wcode, fixedColour(fs));
+              }
+              if (++i == count) break;
+              sqnorm = run_sqn.next();
+              kernel.step();
+              z += dz;
+              p += step;
+            }
+          });
+          memo_requests += requests_answered;
         };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
@@ -716,15 +805,15 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // reference walks the same pixel set by direct edge evaluation; the RTL's stream;
         // normal-bisection needs whole rows).
         const SpanParams* walker = span.walker();
-        auto walkWith = [&](auto&& sink) {
-          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, sink);
+        auto walkWith = [&](auto&& sink, auto&&... runs) {
+          const SpanWalk wk = walkSpanUnit(*walker, *s.desc, sink, runs...);
           st.span_cycles += wk.cycles;
           st.fragments += wk.fragments;
         };
         if (!reference && walker != nullptr && (m == Method::Flat || m == Method::Gouraud)) {
-          walkWith(colourFragment);
+          walkWith(colourFragment, colourRun);
         } else if (!reference && walker != nullptr && m == Method::PhongFixed) {
-          walkWith(fixedFragment);
+          walkWith(fixedFragment, fixedRun);
         } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
           walkWith([&](int32_t x, int32_t y, const int64_t* attr) { shadeFragment(x, y, attr, nullptr); });
         } else {
