@@ -33,9 +33,8 @@ bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }
 int64_t floorDiv(i128 a, i128 b) {  // b > 0
   if (fitsI64(a) && fitsI64(b)) {  // the common case, without the slow 128-bit division
     const int64_t a64 = static_cast<int64_t>(a), b64 = static_cast<int64_t>(b);
-    int64_t q = a64 / b64;
-    if ((a64 % b64) != 0 && a64 < 0) --q;
-    return q;
+    const int64_t q = a64 / b64;
+    return q - static_cast<int64_t>(((a64 % b64) != 0) & (a64 < 0));  // without a branch, as roundHalfEvenFrom
   }
   i128 q = a / b;
   if ((a % b) != 0 && a < 0) --q;
@@ -46,14 +45,15 @@ int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
 // round-half-even(num / den) from the truncated quotient q and remainder r of num / den
 // (|r| < den, den > 0): floor first, then up when the remainder is above half, or exactly half
 // with q odd (r vs den - r: no overflow of 2r).
+// Without branches: the remainder's sign and the rounding are data, not a pattern (setup
+// runs a dozen of these per triangle; mispredicted branches cost more than the arithmetic).
 template <class T>
 T roundHalfEvenFrom(T q, T r, T den) {
-  if (r < 0) {
-    --q;
-    r += den;
-  }
+  const T neg = r < 0 ? 1 : 0;
+  q -= neg;
+  r += den * neg;
   const T rest = den - r;
-  return r > rest || (r == rest && (q & 1) != 0) ? q + 1 : q;
+  return q + static_cast<T>((r > rest) | ((r == rest) & ((q & 1) != 0)));
 }
 
 // round-half-even(num / den), den > 0: in 64 bits with one division when both fit (the
@@ -68,8 +68,9 @@ inline i128 roundDiv(i128 num, i128 den) {
 // round-half-even(num / den) for many numerators over one denominator den > 0: the quotient
 // estimated from one reciprocal, trunc(num * (1/den)), then corrected in exact integers. For
 // |num| < 2^52 and den < 2^52 the estimate is within 2 of the exact quotient (the reciprocal
-// and the product each err by at most 2^-53 relatively, and |num / den| < 2^52), so the
-// correction takes at most two steps; other numerators and denominators take roundDiv.
+// and the product each err by at most 2^-53 relatively, and |num / den| < 2^52: below 1, and
+// the truncation below 1 more), so one correction step suffices; other numerators and
+// denominators take roundDiv.
 class RoundingDivider {
  public:
   explicit RoundingDivider(int64_t den) : den_(den), inv_(1.0 / static_cast<double>(den)) {}
@@ -78,14 +79,11 @@ class RoundingDivider {
     const int64_t n = static_cast<int64_t>(num);
     int64_t q = static_cast<int64_t>(static_cast<double>(n) * inv_);  // truncated estimate
     int64_t r = n - q * den_;                                          // exact: |q den| < 2^53 + den
-    while (r <= -den_) {
-      --q;
-      r += den_;
-    }
-    while (r >= den_) {
-      ++q;
-      r -= den_;
-    }
+    // The estimate is within 2 of num / den (open interval), so r lies in (-2 den, 2 den) and
+    // one correction step, without a branch, brings it into (-den, den).
+    const int64_t down = r <= -den_ ? 1 : 0, up = r >= den_ ? 1 : 0;
+    q += up - down;
+    r += (down - up) * den_;
     return roundHalfEvenFrom(q, r, den_);  // |r| < den
   }
 

@@ -531,35 +531,34 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         requests.clear();
         size_t memo_requests = 0;  // phong-fixed on the unit's model: requests its memo answered
         // A written fragment has w > 0 (the z-test), so depth 0 marks a pixel not yet covered.
-        auto write = [rgb = fb.rgb.data(), depth = fb.depth.data(), tri_of = fb.tri.data(), tag,
-                      &covered = st.pixels_covered](size_t p, int64_t w, const std::array<uint8_t, 3>& c) {
+        // Returns 1 for a pixel not covered before (for pixels_covered). A run's loop writes
+        // through a local copy (const auto put = write): its pointers then stay in registers,
+        // where the closure's members would be read again after each byte store.
+        const auto write = [rgb = fb.rgb.data(), depth = fb.depth.data(), tri_of = fb.tri.data(),
+                            tag = static_cast<int32_t>(tag)](size_t p, int64_t w, const std::array<uint8_t, 3>& c) {
           for (size_t k = 0; k < 3; ++k) rgb[p * 3 + k] = c[k];
-          if (depth[p] == 0) ++covered;
+          const uint64_t fresh = depth[p] == 0 ? 1 : 0;
           depth[p] = static_cast<int32_t>(w);
-          tri_of[p] = static_cast<int32_t>(tag);
+          tri_of[p] = tag;
+          return fresh;
         };
         // Flat and Gouraud: z-test, then the interpolated colour codes straight to unorm8 (what
         // combine() gives them).
-        auto colourFragment = [write, depth = fb.depth.data(), W](int32_t x, int32_t y, const int64_t* attr) {
+        auto colourFragment = [write, depth = fb.depth.data(), W, &covered = st.pixels_covered](int32_t x, int32_t y,
+                                                                                                const int64_t* attr) {
           const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
           __builtin_prefetch(depth + p + W);  // the row below: most likely this triangle's next
           if (attr[3] <= depth[p]) return;
-          write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
-                             unorm8FromCode(attr[2], kColourFrac)});
+          covered += write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
+                                        unorm8FromCode(attr[2], kColourFrac)});
         };
         // The same for a whole run of a row (walkSpanUnit's run consumer): the loop in
         // registers, the newly covered pixels counted once per run. When the colour codes at
         // both ends of the run lie in [0, 255 2^12] so do all between (they are affine), and
         // unorm8FromCode is the rounding shift alone.
-        auto colourRun = [rgb_ = fb.rgb.data(), depth_ = fb.depth.data(), tri_ = fb.tri.data(), tag, W,
-                          &covered = st.pixels_covered](const RowRun& r) {
-          // Locals, not the closure's members or r's: a byte store may alias those, and the
-          // loop would reload them at every pixel.
-          uint8_t* const rgb = rgb_;
-          int32_t* const depth = depth_;
-          int32_t* const tri_of = tri_;
-          const int32_t tag32 = static_cast<int32_t>(tag);
-          const int64_t count = r.count;
+        auto colourRun = [write, depth = fb.depth.data(), W, &covered = st.pixels_covered](const RowRun& r) {
+          const auto put = write;
+          const int64_t count = r.count;  // a local: r may alias the pixels' byte stores
           std::array<uint64_t, 4> a, da;
           bool in_range = true;
           for (size_t k = 0; k < 4; ++k) {
@@ -580,14 +579,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             for (int64_t i = 0; i < count; ++i, p += step) {
               __builtin_prefetch(depth + p + W);  // as colourFragment
               const int64_t z = static_cast<int64_t>(a[3]);
-              if (z > depth[p]) {
-                rgb[p * 3 + 0] = unorm8(a[0]);
-                rgb[p * 3 + 1] = unorm8(a[1]);
-                rgb[p * 3 + 2] = unorm8(a[2]);
-                newly += depth[p] == 0;
-                depth[p] = static_cast<int32_t>(z);
-                tri_of[p] = tag32;
-              }
+              if (z > depth[p]) newly += put(p, z, {unorm8(a[0]), unorm8(a[1]), unorm8(a[2])});
               for (size_t k = 0; k < 4; ++k) a[k] += da[k];
             }
           };
@@ -625,21 +617,13 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             return;
           }
           memo_requests += fs.device_requests;
-          write(p, wcode, fixedColour(fs));
+          st.pixels_covered += write(p, wcode, fixedColour(fs));
         };
         // phong-fixed for a whole run: the recurrence and the dot products stepped along it
-        // (FixedPointShader::Run), the same colours as fixedFragment's; fragment by fragment
-        // where the shader takes no runs (point lights, requests batched for the unit).
-        auto fixedRun = [&](const RowRun& r) {
-          if (batched || !fixed->takesRuns()) {
-            std::array<int64_t, 4> attr;
-            for (int64_t i = 0; i < r.count; ++i) {
-              for (size_t k = 0; k < 4; ++k)
-                attr[k] = static_cast<int64_t>(static_cast<uint64_t>(r.a0[k]) + static_cast<uint64_t>(i) * static_cast<uint64_t>(r.da[k]));
-              fixedFragment(static_cast<int32_t>(r.x0 + i * r.dx), r.y, attr.data());
-            }
-            return;
-          }
+        // by the shader's run kernel, the same colours as fixedFragment's. The kernel is held by
+        // value in the walker's run consumer (one copy per triangle), so that its constants stay
+        // in registers across the stores of the pixels.
+        auto fixedRun = [&](auto& kernel, const RowRun& r) {
           int32_t* const depth = fb.depth.data();
           const int64_t count = r.count;
           SquaredNormRecurrence run_sqn;
@@ -649,24 +633,25 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           size_t p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
           const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
           size_t requests_answered = 0;
-          fixed->withRunKernel([&](auto kernel) {
-            kernel.start(r.a0, r.da);
-            for (int64_t i = 0;;) {
-              __builtin_prefetch(depth + p + W);  // as colourFragment
-              const int64_t wcode = static_cast<int64_t>(z);
-              if (wcode > depth[p]) {
-                const FixedShade fs = kernel.shade(sqnorm);
-                requests_answered += fs.device_requests;
-                write(p, wcode, fixedColour(fs));
-              }
-              if (++i == count) break;
-              sqnorm = run_sqn.next();
-              kernel.step();
-              z += dz;
-              p += step;
+          uint64_t newly = 0;
+          const auto put = write;
+          kernel.start(r.a0, r.da);
+          for (int64_t i = 0;;) {
+            __builtin_prefetch(depth + p + W);  // as colourFragment
+            const int64_t wcode = static_cast<int64_t>(z);
+            if (wcode > depth[p]) {
+              const FixedShade fs = kernel.shade(sqnorm);
+              requests_answered += fs.device_requests;
+              newly += put(p, wcode, fixedColour(fs));
             }
-          });
+            if (++i == count) break;
+            sqnorm = run_sqn.next();
+            kernel.step();
+            z += dz;
+            p += step;
+          }
           memo_requests += requests_answered;
+          st.pixels_covered += newly;
         };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
@@ -762,7 +747,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                   const SpecRequest& r = requests[first + i];
                   device_out[i] = direct->evaluate(r.shin, r.cos, r.light).rgb;
                 }
-                write(p, wcode, combine(lsb, device_out.data(), count));
+                st.pixels_covered += write(p, wcode, combine(lsb, device_out.data(), count));
                 return;
               }
               break;
@@ -798,7 +783,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
               break;
             }
           }
-          write(p, wcode, combine(lsb, nullptr, 0));
+          st.pixels_covered += write(p, wcode, combine(lsb, nullptr, 0));
         };
 
         // The fragments: shaded as the model's walk produces them, or collected first (the
@@ -813,7 +798,13 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         if (!reference && walker != nullptr && (m == Method::Flat || m == Method::Gouraud)) {
           walkWith(colourFragment, colourRun);
         } else if (!reference && walker != nullptr && m == Method::PhongFixed) {
-          walkWith(fixedFragment, fixedRun);
+          // Runs where the shader takes them (directional lights; device lobes on the memo).
+          if (batched || !fixed->takesRuns())
+            walkWith(fixedFragment);
+          else
+            fixed->withRunKernel([&](auto kernel) {
+              walkWith(fixedFragment, [&fixedRun, kernel](const RowRun& r) mutable { fixedRun(kernel, r); });
+            });
         } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
           walkWith([&](int32_t x, int32_t y, const int64_t* attr) { shadeFragment(x, y, attr, nullptr); });
         } else {
@@ -836,7 +827,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           st.spec_evaluations += n;
         }
         for (const Pending& pd : pend)
-          write(pd.pixel, pd.w, combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count));
+          st.pixels_covered +=
+              write(pd.pixel, pd.w, combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count));
       }
     }
   }
