@@ -35,7 +35,7 @@ uint32_t lobeFactorCode(double f) {
 }
 }  // namespace
 
-std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shininess) {
+std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess) {
   double (*f)(double, double) = nullptr;
   switch (lobe) {
     case Lobe::Phong: f = phongLobe; break;
@@ -48,15 +48,18 @@ std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shinine
     case Lobe::Cubic: throw std::logic_error(fmt::format("lobeTable: {} is not a lobe of one cosine", toString(lobe)));
   }
   static std::mutex mutex;
-  static std::map<std::pair<double (*)(double, double), double>, std::shared_ptr<const std::vector<uint32_t>>> cache;
+  static std::map<std::pair<double (*)(double, double), double>, std::shared_ptr<const LobeTable>> cache;
   const std::lock_guard<std::mutex> lock(mutex);
   const auto key = std::make_pair(f, shininess);
   if (const auto it = cache.find(key); it != cache.end()) return it->second;
   if (cache.size() >= 64) cache.clear();  // a long run over many exponents: start over (tables in use live on)
-  auto t = std::make_shared<std::vector<uint32_t>>((size_t{1} << kFixedCosFrac) + 2);
-  for (size_t c = 0; c + 1 < t->size(); ++c)
-    (*t)[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
-  t->back() = (*t)[t->size() - 2];
+  auto t = std::make_shared<LobeTable>();
+  std::vector<uint32_t>& code = t->code;
+  code.resize((size_t{1} << kFixedCosFrac) + 2);
+  for (size_t c = 0; c + 1 < code.size(); ++c)
+    code[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
+  code.back() = code[code.size() - 2];
+  while (t->zero_below + 1 < code.size() && code[t->zero_below] == 0 && code[t->zero_below + 1] == 0) ++t->zero_below;
   cache.emplace(key, t);
   return t;
 }

@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "device/spec_unit.h"
+#include "render/fixed_simd.h"
 #include "render/normalize.h"
 #include "render/shading.h"
 
@@ -73,7 +74,13 @@ inline std::array<uint8_t, 3> fixedColour(const FixedShade& s) {
 // and a copy of the last entry (the interpolation's right neighbour at c = 1).
 // A pure function of the lobe and the shininess, so the tables are built once per process
 // (65,537 evaluations each) and shared; std::logic_error for a lobe of several cosines.
-std::shared_ptr<const std::vector<uint32_t>> lobeTable(Lobe lobe, double shininess);
+struct LobeTable {
+  std::vector<uint32_t> code;  // 2^16 + 2 entries
+  // The first i with code[i] or code[i + 1] nonzero: below it the lobe is 0 (for a high
+  // exponent, most of the table), so a kernel may skip the reads there.
+  uint32_t zero_below = 0;
+};
+std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess);
 
 // The specular unit's results by cos code for each (shininess code, light codes) it is asked
 // about, filled on first use from the unit's bit-exact model: exact, because the unit is a
@@ -181,7 +188,31 @@ class FixedPointShader {
     explicit RunKernel(FixedPointShader& sh) : sh_(sh) {
       for (size_t i = 0; i < NL; ++i) lights_[i] = sh.lights_[i];
       ambient_ = sh.ambient_;
-      table_ = sh.table_ ? sh.table_->data() : nullptr;
+      table_ = sh.table_ ? sh.table_->code.data() : nullptr;
+      if constexpr (kGroups) {
+        simd_ = fixed_simd::available();
+        simd_params_ = {table_, sh.table_->zero_below, ambient_, lights_[0].diffuse, lights_[0].specular};
+      }
+    }
+    // The vector kernel's case (fixed_simd.h): one light, a lobe of N.H.
+    static constexpr bool kGroups = C == Cosine::NH && NL == 1;
+    // The vector case's fragments are shaded away from the run: their raw dot products
+    // (dotL, dotH at the current fragment) are kept, and shadeLanes gives the colours of up
+    // to 8 of them at once (rgb[channel][j], as shade() gives them; false where the vector
+    // kernel does not run them: then shadeDots each).
+    bool vectorised() const { return simd_; }
+    uint64_t dotL() const { return l_[0]; }
+    uint64_t dotH() const { return h_[0]; }
+    bool shadeLanes(const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n, uint8_t rgb[3][8],
+                    int64_t (*codes)[8] = nullptr) const {
+      if constexpr (kGroups) return simd_ && fixed_simd::shadeNh8(simd_params_, sq, l, h, n, rgb, codes);
+      return false;
+    }
+    FixedShade shadeDots(uint64_t sqnorm, uint64_t l, uint64_t h) {
+      return sh_.shadeDots<C>(
+          Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
+          [&](size_t, PerLight&) { return static_cast<int64_t>(l); },
+          [&](size_t, const PerLight&) { return static_cast<int64_t>(h); }, nullptr);
     }
     void start(const int64_t* n0, const int64_t* dn) {
       using fixed_detail::dot58;
@@ -215,6 +246,8 @@ class FixedPointShader {
     const uint32_t* table_;
     uint64_t v_ = 0, dv_ = 0;
     std::array<uint64_t, NL> l_{}, dl_{}, h_{}, dh_{};
+    bool simd_ = false;
+    fixed_simd::NhParams simd_params_;
   };
 
  private:
@@ -237,7 +270,7 @@ class FixedPointShader {
   Cosine cosine_;
   std::optional<DeviceCoding> coding_;
   SpecResultMemo* memo_;
-  std::shared_ptr<const std::vector<uint32_t>> table_;  // lobes of one cosine
+  std::shared_ptr<const LobeTable> table_;  // lobes of one cosine
   bool needs_position_ = false;
   std::array<int32_t, 3> v_{};  // the view direction, Q1.30
   std::array<int64_t, 3> ambient_{};
@@ -263,7 +296,7 @@ inline FixedShade FixedPointShader::shadeAs(const int64_t* n28, uint64_t sqnorm,
   using fixed_detail::dot58;
   constexpr bool needs_nv = C == Cosine::RV || C == Cosine::CookTorrance;
   return shadeDots<C>(
-      Consts{ambient_, table_ ? table_->data() : nullptr, lights_.data(), lights_.size()}, sqnorm,
+      Consts{ambient_, table_ ? table_->code.data() : nullptr, lights_.data(), lights_.size()}, sqnorm,
       needs_nv ? dot58(n28, v_) : 0,
       [&](size_t, PerLight& pl) {
         if (pl.light->point) setDirections(pl, lightDirection(*pl.light, p_cam));

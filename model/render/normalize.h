@@ -91,7 +91,7 @@ double rsqrtFixed(uint64_t v, int frac_bits);
 // so the shift right is 61 - shift in [31, 62].
 // Evaluation (the same values): for s >= 35, r 2^(64 - s) < 2^63 (r < 2^33.1), and
 // (d r + 2^(s-1)) >> s = (d r 2^(64-s) + 2^63) >> 64, the high word of one product and a
-// carry, with no shift by a variable amount; smaller s (sqnorm below 2^10, |N| < 2^-23) in
+// carry, with no shift by a variable amount; smaller s (sqnorm below 2^8, |N| < 2^-24) in
 // full.
 struct CosineScale {
   int64_t r = 0;

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -79,6 +80,15 @@ Poly clipPolygon(const Poly& in, Dist dist) {
 double area2(const PVertex& a, const PVertex& b, const PVertex& c) {
   return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
 }
+
+// phong-fixed's fragments buffered for the shader's vector case (see render()).
+struct FixedBatch {
+  static constexpr size_t kCap = 256;
+  std::array<uint64_t, kCap + 8> sq{}, l{}, h{};
+  std::array<size_t, kCap> pixel{};
+  std::array<int64_t, kCap> z{};
+  size_t n = 0;
+};
 
 // A screen triangle to draw: its vertices (in the object's vertex array, the clipped polygon
 // or a split) and the method that draws it.
@@ -364,6 +374,11 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     size_t dev_first, dev_count;
   };
   std::vector<Pending> pend;
+  // phong-fixed's fragments in the shader's vector case (one light, a lobe of N.H), buffered
+  // from the runs of a triangle and shaded 8 at a time (FixedPointShader::RunKernel::shadeLanes):
+  // the groups are independent, so the processor overlaps them, where one group per row of
+  // 5 or 6 pixels would wait out its own latency. Padded by 8: a group reads 8 entries.
+  auto batch = std::make_unique<FixedBatch>();
   std::vector<SpecRequest> requests;
   std::vector<size_t> order;
   std::vector<Vec3> bisected;
@@ -653,6 +668,56 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           memo_requests += requests_answered;
           st.pixels_covered += newly;
         };
+        // The batch: shaded 8 at a time, then written where the z-test passes (the datapath is a
+        // pure function; no two fragments of a triangle share a pixel, so the order of the
+        // writes within it does not matter).
+        auto flushBatch = [&](auto& kernel) {
+          FixedBatch& b = *batch;
+          int32_t* const depth = fb.depth.data();
+          const auto put = write;
+          uint64_t newly = 0;
+          uint8_t rgb[3][8];
+          for (size_t i = 0; i < b.n; i += 8) {
+            const int m = static_cast<int>(std::min<size_t>(8, b.n - i));
+            if (!kernel.shadeLanes(&b.sq[i], &b.l[i], &b.h[i], m, rgb))
+              for (int j = 0; j < m; ++j) {
+                const size_t f = i + static_cast<size_t>(j);
+                const std::array<uint8_t, 3> c = fixedColour(kernel.shadeDots(b.sq[f], b.l[f], b.h[f]));
+                for (size_t k = 0; k < 3; ++k) rgb[k][j] = c[k];
+              }
+            for (int j = 0; j < m; ++j) {
+              const size_t f = i + static_cast<size_t>(j), p = b.pixel[f];
+              if (b.z[f] > depth[p]) newly += put(p, b.z[f], {rgb[0][j], rgb[1][j], rgb[2][j]});
+            }
+          }
+          st.pixels_covered += newly;
+          b.n = 0;
+        };
+        // A run into the batch: the recurrence and the dot products stepped along it.
+        auto batchRun = [&](auto& kernel, const RowRun& r) {
+          FixedBatch& b = *batch;
+          SquaredNormRecurrence run_sqn;
+          uint64_t sqnorm = run_sqn.start({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
+          uint64_t z = static_cast<uint64_t>(r.a0[3]);
+          const uint64_t dz = static_cast<uint64_t>(r.da[3]);
+          size_t p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
+          const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
+          kernel.start(r.a0, r.da);
+          for (int64_t i = 0;;) {
+            if (b.n == FixedBatch::kCap) flushBatch(kernel);
+            b.sq[b.n] = sqnorm;
+            b.l[b.n] = kernel.dotL();
+            b.h[b.n] = kernel.dotH();
+            b.pixel[b.n] = p;
+            b.z[b.n] = static_cast<int64_t>(z);
+            ++b.n;
+            if (++i == r.count) break;
+            sqnorm = run_sqn.next();
+            kernel.step();
+            z += dz;
+            p += step;
+          }
+        };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
         if (m == Method::Biquadratic)
@@ -803,7 +868,16 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             walkWith(fixedFragment);
           else
             fixed->withRunKernel([&](auto kernel) {
-              walkWith(fixedFragment, [&fixedRun, kernel](const RowRun& r) mutable { fixedRun(kernel, r); });
+              bool batched_runs = false;
+              if constexpr (decltype(kernel)::kGroups) {
+                if (kernel.vectorised()) {
+                  walkWith(fixedFragment, [&batchRun, &kernel](const RowRun& r) { batchRun(kernel, r); });
+                  flushBatch(kernel);
+                  batched_runs = true;
+                }
+              }
+              if (!batched_runs)
+                walkWith(fixedFragment, [&fixedRun, kernel](const RowRun& r) mutable { fixedRun(kernel, r); });
             });
         } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
           walkWith([&](int32_t x, int32_t y, const int64_t* attr) { shadeFragment(x, y, attr, nullptr); });

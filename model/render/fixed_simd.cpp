@@ -1,0 +1,138 @@
+#include "render/fixed_simd.h"
+
+#include <cstdlib>
+
+#include "render/normalize.h"
+
+#if defined(__x86_64__) && defined(__GNUC__)
+#include <immintrin.h>
+#define SHD_HAVE_AVX512_KERNEL 1
+#define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd")))
+#endif
+
+namespace shd::fixed_simd {
+
+#ifdef SHD_HAVE_AVX512_KERNEL
+
+// GCC 12's AVX-512 headers pass _mm512_undefined_epi32() as the unused merge source of the
+// unmasked shift and multiply intrinsics, which -Wuninitialized reports at every use (GCC bug
+// 105593); the values are never read. Silenced for this file's kernel only.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+
+bool available() {
+  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+                          __builtin_cpu_supports("avx512cd") && std::getenv("SHD_SCALAR") == nullptr;
+  return yes;
+}
+
+namespace {
+
+// The high 64 bits of the unsigned 128-bit products a b, lane by lane, from 32 x 32 products.
+SHD_AVX512 inline __m512i mulHiU64(__m512i a, __m512i b) {
+  const __m512i low32 = _mm512_set1_epi64(0xFFFFFFFF);
+  const __m512i ah = _mm512_srli_epi64(a, 32), bh = _mm512_srli_epi64(b, 32);
+  const __m512i t = _mm512_mul_epu32(a, b);                                              // al bl
+  const __m512i u = _mm512_add_epi64(_mm512_mul_epu32(ah, b), _mm512_srli_epi64(t, 32));  // ah bl + (al bl >> 32)
+  const __m512i v = _mm512_add_epi64(_mm512_mul_epu32(a, bh), _mm512_and_si512(u, low32));  // al bh + low(u)
+  return _mm512_add_epi64(_mm512_add_epi64(_mm512_mul_epu32(ah, bh), _mm512_srli_epi64(u, 32)),
+                          _mm512_srli_epi64(v, 32));
+}
+
+// scaleCosine's fast path: (d r64 + 2^63) >> 64 for signed d and 0 <= r64 < 2^63: the signed
+// high word (the unsigned one, less r64 where d < 0) plus the carry out of the low word.
+SHD_AVX512 inline __m512i scaleCosines(__m512i d, __m512i r64) {
+  const __mmask8 neg = _mm512_cmplt_epi64_mask(d, _mm512_setzero_si512());
+  const __m512i hi_unsigned = mulHiU64(d, r64);
+  const __m512i hi = _mm512_mask_sub_epi64(hi_unsigned, neg, hi_unsigned, r64);
+  const __m512i lo = _mm512_mullo_epi64(d, r64);
+  return _mm512_add_epi64(hi, _mm512_srli_epi64(lo, 63));
+}
+
+// (x + 2^(s-1)) >> s, arithmetic: fixed_detail::roundShift.
+template <int S>
+SHD_AVX512 inline __m512i roundShift(__m512i x) {
+  return _mm512_srai_epi64(_mm512_add_epi64(x, _mm512_set1_epi64(int64_t{1} << (S - 1))), S);
+}
+
+}  // namespace
+
+SHD_AVX512 bool shadeNh8(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
+                         uint8_t rgb[3][8], int64_t (*codes)[8]) {
+  // Lanes past n compute on whatever their entries hold; they read no table (masked gathers)
+  // and their results are not stored.
+  const __mmask8 valid = static_cast<__mmask8>((1u << n) - 1);
+  const __m512i v = _mm512_loadu_si512(sq);
+  const __m512i dot_l = _mm512_loadu_si512(l), dot_h = _mm512_loadu_si512(h);
+
+  // rsqrtCore<10>: bits, shift = bits <= 62 ? (62 - bits) / 2 : -1, m, mq = m >> 30.
+  const __m512i bits = _mm512_sub_epi64(_mm512_set1_epi64(64), _mm512_lzcnt_epi64(v));
+  const __mmask8 up = _mm512_cmple_epi64_mask(bits, _mm512_set1_epi64(62));
+  const __m512i shift = _mm512_mask_blend_epi64(up, _mm512_set1_epi64(-1),
+                                                _mm512_srli_epi64(_mm512_sub_epi64(_mm512_set1_epi64(62), bits), 1));
+  // The scalar path's lanes: sqnorm 0 (bits 0) and s = 61 - shift < 35, i.e. shift > 26.
+  const __mmask8 scalar = _mm512_cmpgt_epi64_mask(shift, _mm512_set1_epi64(26)) |
+                          _mm512_cmpeq_epi64_mask(v, _mm512_setzero_si512());
+  if ((scalar & valid) != 0) return false;
+  const __m512i m = _mm512_mask_blend_epi64(up, _mm512_srli_epi64(v, 2), _mm512_sllv_epi64(v, _mm512_add_epi64(shift, shift)));
+  const __m512i mq = _mm512_srli_epi64(m, 30);  // in [2^30, 2^32)
+  // idx = ((mq - 2^30) << 10) / (3 2^30) = y / 3, y = (mq - 2^30) >> 20 < 3072: (y 43691) >> 17.
+  const __m512i y = _mm512_srli_epi64(_mm512_sub_epi64(mq, _mm512_set1_epi64(int64_t{1} << 30)), 20);
+  const __m512i idx = _mm512_srli_epi64(_mm512_mul_epu32(y, _mm512_set1_epi64(43691)), 17);
+  const __m512i r0 = _mm512_cvtepu32_epi64(_mm512_mask_i64gather_epi32(
+      _mm256_setzero_si256(), valid, idx, reinterpret_cast<const int*>(RsqrtSeed<kFixedSeedBits>::table.data()), 4));
+  // mr = (mq r0^2) >> 32 with r0^2 = a 2^32 + b: mq a + (mq b >> 32).
+  const __m512i r0sq = _mm512_mul_epu32(r0, r0);
+  const __m512i mr = _mm512_add_epi64(_mm512_mul_epu32(mq, _mm512_srli_epi64(r0sq, 32)),
+                                      _mm512_srli_epi64(_mm512_mul_epu32(mq, r0sq), 32));
+  const __m512i r = _mm512_srai_epi64(
+      _mm512_mullo_epi64(r0, _mm512_sub_epi64(_mm512_set1_epi64(int64_t{3} << 32), mr)), 17);
+  // cosineScale: s = 61 - shift, r64 = r << (64 - s) = r << (3 + shift).
+  const __m512i r64 = _mm512_sllv_epi64(r, _mm512_add_epi64(shift, _mm512_set1_epi64(3)));
+
+  const __m512i nl = scaleCosines(dot_l, r64);
+  const __mmask8 lit = _mm512_cmpgt_epi64_mask(nl, _mm512_setzero_si512());
+  const __m512i nh = scaleCosines(dot_h, r64);
+  // lobeAt: c = clamp(nh, 0, 2^32), entry c >> 16 and the step to the next with c's low 16 bits.
+  const __m512i c = _mm512_min_epi64(_mm512_max_epi64(nh, _mm512_setzero_si512()), _mm512_set1_epi64(int64_t{1} << 32));
+  const __m512i ti = _mm512_srli_epi64(c, 16);
+  const __m512i frac = _mm512_and_si512(c, _mm512_set1_epi64(0xFFFF));
+  // One 8-byte gather per lane at entry ti: t[ti] in the low half, t[ti + 1] in the high half
+  // (the table has the copy of its last entry, so ti + 1 <= 2^16 + 1 is inside it).
+  // Lanes that are unlit or below zero_below (both entries 0, so f = 0) read nothing.
+  const __mmask8 reads = valid & lit & _mm512_cmpge_epi64_mask(ti, _mm512_set1_epi64(p.zero_below));
+  const __m512i pair =
+      _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), reads, ti, reinterpret_cast<const long long*>(p.table), 4);
+  const __m512i t0 = _mm512_and_si512(pair, _mm512_set1_epi64(0xFFFFFFFF));
+  const __m512i t1 = _mm512_srli_epi64(pair, 32);
+  const __m512i f = _mm512_and_si512(  // static_cast<uint32_t>
+      _mm512_add_epi64(t0, roundShift<16>(_mm512_mullo_epi64(_mm512_sub_epi64(t1, t0), frac))),
+      _mm512_set1_epi64(0xFFFFFFFF));
+
+  for (size_t k = 0; k < 3; ++k) {
+    const __m512i diffuse = roundShift<32>(_mm512_mullo_epi64(_mm512_set1_epi64(p.diffuse[k]), nl));
+    const __m512i specular = roundShift<24>(_mm512_mullo_epi64(_mm512_set1_epi64(p.specular[k]), f));
+    // The sum of non-negative terms: unorm8FromCode's clamp at 0 never acts.
+    const __m512i code = _mm512_mask_add_epi64(_mm512_set1_epi64(p.ambient[k]), lit, _mm512_set1_epi64(p.ambient[k]),
+                                               _mm512_add_epi64(diffuse, specular));
+    const __m512i out = _mm512_srli_epi64(
+        _mm512_add_epi64(_mm512_min_epi64(code, _mm512_set1_epi64(int64_t{255} << 12)), _mm512_set1_epi64(1 << 11)), 12);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k]), _mm512_cvtepi64_epi8(out));
+    if (codes != nullptr) _mm512_storeu_si512(codes[k], code);
+  }
+  return true;
+}
+
+#pragma GCC diagnostic pop
+
+#else
+
+bool available() { return false; }
+bool shadeNh8(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, int, uint8_t[3][8], int64_t (*)[8]) {
+  return false;
+}
+
+#endif
+
+}  // namespace shd::fixed_simd
