@@ -171,10 +171,12 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     }
   std::array<int64_t, kMaxAttr> irow, icur;  // the first K are set before they are read
   std::copy(d.iref.begin(), d.iref.end(), irow.begin());
-  auto stepRow = [&](int64_t w) {  // the ROW cycle's updates: the edges, the row's attribute base
+  // The ROW cycle's updates: the edges, the row's attribute base. KC as in singleRow.
+  auto stepRow = [&](int64_t w, auto kc) {
+    constexpr int KC = decltype(kc)::value;
     for (int j = 0; j < T; ++j)
       stepEdges(d.tri[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
-    for (int a = 0; a < K; ++a) {
+    for (int a = 0; a < (KC > 0 ? KC : K); ++a) {
       const size_t ai = static_cast<size_t>(a);
       irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
     }
@@ -182,18 +184,16 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
   // successive columns, so the fragments come in x order, and lane i of the cycle at xg shows
   // the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
-  auto singleLaneRow = [&](int64_t w) {
+  auto singleLaneRow = [&](int64_t w, auto kc) {
+    constexpr int KC = decltype(kc)::value;
     const SpanLaneTri& t = d.tri[0];
     int64_t lo = 0, hi = 0;
     if (!laneRowBounds(t, w, e.data(), lo, hi)) return;
     const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
     walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
     bool ran = false;
-    if constexpr (!std::is_same_v<std::decay_t<RunSink>, NoRuns>)
-      ran = K == 4 ? runRow<4>(p, d, t, w, lo, hi, irow.data(), emit_run)
-                   : runRow<0>(p, d, t, w, lo, hi, irow.data(), emit_run);
-    if (!ran && K == 4) singleRow<4>(p, d, t, w, lo, hi, irow.data(), emit);
-    else if (!ran) singleRow<0>(p, d, t, w, lo, hi, irow.data(), emit);
+    if constexpr (!std::is_same_v<std::decay_t<RunSink>, NoRuns>) ran = runRow<KC>(p, d, t, w, lo, hi, irow.data(), emit_run);
+    if (!ran) singleRow<KC>(p, d, t, w, lo, hi, irow.data(), emit);
     walk.fragments += static_cast<uint64_t>(hi - lo + 1);
   };
   // Several lane-triangles (sierpinski): lane by lane, cycle by cycle.
@@ -240,13 +240,18 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
       }
     }
   };
-  for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {  // ROW cycles
-    ++walk.row_cycles;
-    if (T == 1) singleLaneRow(w);
-    else laneTrianglesRow(w);
-    stepRow(w);
-    if (w == d.row_last) break;
-  }
+  // The ROW cycles, with NumAttr known at compile time when it is the renderer's 4.
+  auto rows = [&](auto kc) {
+    for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
+      ++walk.row_cycles;
+      if (T == 1) singleLaneRow(w, kc);
+      else laneTrianglesRow(w);
+      stepRow(w, kc);
+      if (w == d.row_last) break;
+    }
+  };
+  if (K == 4) rows(std::integral_constant<int, 4>{});
+  else rows(std::integral_constant<int, 0>{});
   walk.cycles += walk.row_cycles + walk.span_cycles;
   return walk;
 }

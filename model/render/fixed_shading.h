@@ -217,11 +217,17 @@ class FixedPointShader {
     void start(const int64_t* n0, const int64_t* dn) {
       using fixed_detail::dot58;
       v_ = static_cast<uint64_t>(dot58(n0, sh_.v_));
-      dv_ = static_cast<uint64_t>(dot58(dn, sh_.v_));
       for (size_t i = 0; i < NL; ++i) {
         l_[i] = static_cast<uint64_t>(dot58(n0, lights_[i].l));
-        dl_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].l));
         h_[i] = static_cast<uint64_t>(dot58(n0, lights_[i].h));
+      }
+      // The steps: the same for every row of a triangle (dn is its didx, or -didx flipped).
+      if (dn[0] == dn_[0] && dn[1] == dn_[1] && dn[2] == dn_[2] && have_steps_) return;
+      dn_ = {dn[0], dn[1], dn[2]};
+      have_steps_ = true;
+      dv_ = static_cast<uint64_t>(dot58(dn, sh_.v_));
+      for (size_t i = 0; i < NL; ++i) {
+        dl_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].l));
         dh_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].h));
       }
     }
@@ -246,6 +252,8 @@ class FixedPointShader {
     const uint32_t* table_;
     uint64_t v_ = 0, dv_ = 0;
     std::array<uint64_t, NL> l_{}, dl_{}, h_{}, dh_{};
+    std::array<int64_t, 3> dn_{};  // the steps' normal increment
+    bool have_steps_ = false;
     bool simd_ = false;
     fixed_simd::NhParams simd_params_;
   };

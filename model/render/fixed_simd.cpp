@@ -1,5 +1,6 @@
 #include "render/fixed_simd.h"
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "render/normalize.h"
@@ -80,8 +81,19 @@ SHD_AVX512 bool shadeNh8(const NhParams& p, const uint64_t* sq, const uint64_t* 
   // idx = ((mq - 2^30) << 10) / (3 2^30) = y / 3, y = (mq - 2^30) >> 20 < 3072: (y 43691) >> 17.
   const __m512i y = _mm512_srli_epi64(_mm512_sub_epi64(mq, _mm512_set1_epi64(int64_t{1} << 30)), 20);
   const __m512i idx = _mm512_srli_epi64(_mm512_mul_epu32(y, _mm512_set1_epi64(43691)), 17);
-  const __m512i r0 = _mm512_cvtepu32_epi64(_mm512_mask_i64gather_epi32(
-      _mm256_setzero_si256(), valid, idx, reinterpret_cast<const int*>(RsqrtSeed<kFixedSeedBits>::table.data()), 4));
+  // The seed entries: the lanes' indexes are mostly within 16 of each other (the squared norm
+  // varies slowly between neighbouring fragments), so one 16-entry load around lane 0's and
+  // a permute; else a gather.
+  const auto& seeds = RsqrtSeed<kFixedSeedBits>::table;
+  const int64_t base = std::clamp<int64_t>(_mm_cvtsi128_si64(_mm512_castsi512_si128(idx)) - 7, 0,
+                                           static_cast<int64_t>(seeds.size()) - 16);
+  const __m512i rel = _mm512_sub_epi64(idx, _mm512_set1_epi64(base));
+  const bool window = (_mm512_cmplt_epu64_mask(rel, _mm512_set1_epi64(16)) & valid) == valid;
+  const __m512i r0 =
+      window ? _mm512_and_si512(_mm512_permutexvar_epi32(rel, _mm512_loadu_si512(seeds.data() + base)),
+                                _mm512_set1_epi64(0xFFFFFFFF))
+             : _mm512_cvtepu32_epi64(_mm512_mask_i64gather_epi32(_mm256_setzero_si256(), valid, idx,
+                                                                 reinterpret_cast<const int*>(seeds.data()), 4));
   // mr = (mq r0^2) >> 32 with r0^2 = a 2^32 + b: mq a + (mq b >> 32).
   const __m512i r0sq = _mm512_mul_epu32(r0, r0);
   const __m512i mr = _mm512_add_epi64(_mm512_mul_epu32(mq, _mm512_srli_epi64(r0sq, 32)),

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -289,7 +290,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   fb.height = H;
   // Depth last: every fragment reads it, so it is the buffer to find in the cache.
   fb.rgb.assign(static_cast<size_t>(W) * H * 3, 0);
-  fb.tri.assign(static_cast<size_t>(W) * H, -1);
+  fb.tri.resize(static_cast<size_t>(W) * H);  // all -1: every byte 0xFF (memset, where assign fills a loop)
+  std::memset(fb.tri.data(), 0xFF, fb.tri.size() * sizeof(int32_t));
   fb.depth.assign(static_cast<size_t>(W) * H, 0);
   const bool reference = opt.method == Method::Reference;
   if (reference) {
