@@ -73,6 +73,10 @@ class InlineVec {
     ::new (static_cast<void*>(a_ + n_)) T(v);
     ++n_;
   }
+  T& emplace_back() {  // a value-initialised element built in place (no temporary to copy)
+    check(n_ + 1);
+    return *::new (static_cast<void*>(a_ + n_++)) T();
+  }
   void clear() { n_ = 0; }
 
   size_t size() const { return n_; }

@@ -164,8 +164,7 @@ void buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
                   const RasterConfig& cfg) {
   const int S = cfg.subpixel_bits;
   const SpanParams& p = cfg.unit;
-  lanes.push_back(SpanLaneTri{});
-  SpanLaneTri& t = lanes.back();
+  SpanLaneTri& t = lanes.emplace_back();
   t.flip = flip;
   t.ox = static_cast<int32_t>(ox);
   t.oy = static_cast<int32_t>(oy);
@@ -316,8 +315,9 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
 
   // The attribute plane in screen pixels, referenced inside the viewport (see the error bound).
   AttributePlane& pl = res.plane;
-  const int64_t px_min = floorDiv(*std::min_element(t.X.begin(), t.X.end()), int64_t{1} << S);
-  const int64_t py_min = floorDiv(*std::min_element(t.Y.begin(), t.Y.end()), int64_t{1} << S);
+  // floor(v / 2^S) as an arithmetic shift (floor for either sign), without a division
+  const int64_t px_min = *std::min_element(t.X.begin(), t.X.end()) >> S;
+  const int64_t py_min = *std::min_element(t.Y.begin(), t.Y.end()) >> S;
   pl.xref = std::clamp<int64_t>(px_min, 0, cfg.width - 1);
   pl.yref = std::clamp<int64_t>(py_min, 0, cfg.height - 1);
   const i128 det = t.det;

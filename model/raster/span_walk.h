@@ -169,7 +169,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
       const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];
       e[static_cast<size_t>(j * 3 + s)] = {g.q, g.r};
     }
-  std::array<int64_t, kMaxAttr> irow, icur;  // the first K are set before they are read
+  std::array<int64_t, kMaxAttr> irow, icur{};  // irow's first K set here, icur's per row before they are read
   std::copy(d.iref.begin(), d.iref.end(), irow.begin());
   // The ROW cycle's updates: the edges, the row's attribute base. KC as in singleRow.
   auto stepRow = [&](int64_t w, auto kc) {

@@ -203,10 +203,20 @@ class FixedPointShader {
     bool vectorised() const { return simd_; }
     uint64_t dotL() const { return l_[0]; }
     uint64_t dotH() const { return h_[0]; }
+    uint64_t stepL() const { return dl_[0]; }  // per fragment
+    uint64_t stepH() const { return dh_[0]; }
     bool shadeLanes(const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n, uint8_t rgb[3][8],
                     int64_t (*codes)[8] = nullptr) const {
       if constexpr (kGroups) return simd_ && fixed_simd::shadeNh8(simd_params_, sq, l, h, n, rgb, codes);
       return false;
+    }
+    // shadeLanes for n <= fixed_simd::kMaxBatch fragments, 8 at a time (fixed_simd::shadeNhBatch):
+    // the groups of 8 it declines (bit g: fragments 8g..8g+7), all of them without the vector
+    // kernel.
+    uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint8_t* const rgb[3]) const {
+      if constexpr (kGroups)
+        if (simd_) return fixed_simd::shadeNhBatch(simd_params_, sq, l, h, n, rgb);
+      return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8);
     }
     FixedShade shadeDots(uint64_t sqnorm, uint64_t l, uint64_t h) {
       return sh_.shadeDots<C>(

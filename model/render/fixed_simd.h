@@ -14,6 +14,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 
 namespace shd::fixed_simd {
@@ -36,5 +37,12 @@ struct NhParams {
 // are read, and ignored). False (outputs untouched) when a lane j < n needs the scalar path.
 bool shadeNh8(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
               uint8_t rgb[3][8], int64_t (*codes)[8] = nullptr);
+
+// The same for n <= 512 lanes in groups of 8 (lanes 8g .. 8g + 7), colours to rgb[k][i]: the
+// groups it declines have bit g set in the result (their outputs untouched). The arrays hold
+// n rounded up to a multiple of 8 readable entries (rgb: writable).
+constexpr size_t kMaxBatch = 512;
+uint64_t shadeNhBatch(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                      uint8_t* const rgb[3]);
 
 }  // namespace shd::fixed_simd

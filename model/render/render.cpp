@@ -85,9 +85,11 @@ double area2(const PVertex& a, const PVertex& b, const PVertex& c) {
 // phong-fixed's fragments buffered for the shader's vector case (see render()).
 struct FixedBatch {
   static constexpr size_t kCap = 256;
+  static_assert(kCap <= fixed_simd::kMaxBatch, "one call shades a batch");
   std::array<uint64_t, kCap + 8> sq{}, l{}, h{};
   std::array<size_t, kCap> pixel{};
   std::array<int64_t, kCap> z{};
+  std::array<std::array<uint8_t, kCap + 8>, 3> rgb{};
   size_t n = 0;
 };
 
@@ -678,24 +680,22 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           int32_t* const depth = fb.depth.data();
           const auto put = write;
           uint64_t newly = 0;
-          uint8_t rgb[3][8];
-          for (size_t i = 0; i < b.n; i += 8) {
-            const int m = static_cast<int>(std::min<size_t>(8, b.n - i));
-            if (!kernel.shadeLanes(&b.sq[i], &b.l[i], &b.h[i], m, rgb))
-              for (int j = 0; j < m; ++j) {
-                const size_t f = i + static_cast<size_t>(j);
-                const std::array<uint8_t, 3> c = fixedColour(kernel.shadeDots(b.sq[f], b.l[f], b.h[f]));
-                for (size_t k = 0; k < 3; ++k) rgb[k][j] = c[k];
-              }
-            for (int j = 0; j < m; ++j) {
-              const size_t f = i + static_cast<size_t>(j), p = b.pixel[f];
-              if (b.z[f] > depth[p]) newly += put(p, b.z[f], {rgb[0][j], rgb[1][j], rgb[2][j]});
+          uint8_t* const rgb[3] = {b.rgb[0].data(), b.rgb[1].data(), b.rgb[2].data()};
+          const size_t n = b.n;  // a local: the pixels' byte stores may alias the batch
+          const uint64_t declined = kernel.shadeBatch(b.sq.data(), b.l.data(), b.h.data(), n, rgb);
+          for (size_t f = 0; f < n; ++f) {
+            if (((declined >> (f / 8)) & 1) != 0) {
+              const std::array<uint8_t, 3> c = fixedColour(kernel.shadeDots(b.sq[f], b.l[f], b.h[f]));
+              for (size_t k = 0; k < 3; ++k) rgb[k][f] = c[k];
             }
+            const size_t p = b.pixel[f];
+            if (b.z[f] > depth[p]) newly += put(p, b.z[f], {rgb[0][f], rgb[1][f], rgb[2][f]});
           }
           st.pixels_covered += newly;
           b.n = 0;
         };
-        // A run into the batch: the recurrence and the dot products stepped along it.
+        // A run into the batch: the recurrence and the dot products stepped along it (in
+        // locals: the batch's arrays would alias its count and the kernel's sums).
         auto batchRun = [&](auto& kernel, const RowRun& r) {
           FixedBatch& b = *batch;
           SquaredNormRecurrence run_sqn;
@@ -705,20 +705,30 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           size_t p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
           const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
           kernel.start(r.a0, r.da);
+          uint64_t l = kernel.dotL(), h = kernel.dotH();
+          const uint64_t dl = kernel.stepL(), dh = kernel.stepH();
+          const int64_t count = r.count;
+          size_t n = b.n;
           for (int64_t i = 0;;) {
-            if (b.n == FixedBatch::kCap) flushBatch(kernel);
-            b.sq[b.n] = sqnorm;
-            b.l[b.n] = kernel.dotL();
-            b.h[b.n] = kernel.dotH();
-            b.pixel[b.n] = p;
-            b.z[b.n] = static_cast<int64_t>(z);
-            ++b.n;
-            if (++i == r.count) break;
+            if (n == FixedBatch::kCap) {
+              b.n = n;
+              flushBatch(kernel);
+              n = 0;
+            }
+            b.sq[n] = sqnorm;
+            b.l[n] = l;
+            b.h[n] = h;
+            b.pixel[n] = p;
+            b.z[n] = static_cast<int64_t>(z);
+            ++n;
+            if (++i == count) break;
             sqnorm = run_sqn.next();
-            kernel.step();
+            l += dl;
+            h += dh;
             z += dz;
             p += step;
           }
+          b.n = n;
         };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
