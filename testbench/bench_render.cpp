@@ -2,13 +2,15 @@
 // method, with the frame buffers reused from frame to frame as a renderer does. Figures, not
 // pass/fail. The peer: idx3d III renders this sphere in about 1.3 ms (flat) and 1.8 ms (its
 // lookup-table "Phong") per frame; the targets are constant-increment Gouraud and the
-// fixed-point Phong (phong-fixed: the whole per-pixel lighting in integers) at least as fast. The RTL-in-the-loop frame time is
-// printed by `shadesim render --rtl`.
+// fixed-point Phong (phong-fixed: the whole per-pixel lighting in integers; its label says
+// whether the AVX-512 kernel ran) at least as fast. The RTL-in-the-loop frame time is printed by
+// `shadesim render --rtl`.
 //   build/testbench/bench_render [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
 #include "device/prom.h"
 #include "device/spec_params.h"
+#include "render/fixed_simd.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
@@ -35,6 +37,8 @@ void BM_Frame(benchmark::State& state, Method method, SpanMode mode, const char*
     render(scene, opt, span, spec, frame);
     benchmark::DoNotOptimize(frame.fb.rgb.data());
   }
+  // phong-fixed's kernel on this CPU: the AVX-512 one, or the scalar one (SHD_SCALAR=1 forces it).
+  if (method == Method::PhongFixed) state.SetLabel(fixed_simd::available() ? "avx512 kernel" : "scalar kernel");
   state.counters["fragments"] = static_cast<double>(frame.stats.fragments);
   state.counters["span_cycles"] = static_cast<double>(frame.stats.span_cycles);
   state.counters["frag/s"] = benchmark::Counter(static_cast<double>(frame.stats.fragments),

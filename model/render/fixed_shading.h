@@ -194,31 +194,33 @@ class FixedPointShader {
         simd_params_ = {table_, sh.table_->zero_below, ambient_, lights_[0].diffuse, lights_[0].specular};
       }
     }
-    // The vector kernel's case (fixed_simd.h): one light, a lobe of N.H.
+    // The vector kernel's case (fixed_simd.h): one light and a lobe of N.H. Its fragments are
+    // shaded away from their runs, from their squared norms and raw dot products N.L and N.H
+    // (dotL, dotH at the current fragment; stepL, stepH per fragment), kept in buffers:
+    //   shadeLanes  up to 8 of them (rgb[channel][j], and the codes if asked); false when the
+    //               vector kernel does not take them;
+    //   shadeBatch  up to fixed_simd::kMaxBatch, 8 at a time: the groups of 8 it does not take
+    //               (bit g: fragments 8g..8g+7), all of them without the vector kernel;
+    //   shadeRaw    one of them in the scalar datapath.
+    // All give what shade() gives.
     static constexpr bool kGroups = C == Cosine::NH && NL == 1;
-    // The vector case's fragments are shaded away from the run: their raw dot products
-    // (dotL, dotH at the current fragment) are kept, and shadeLanes gives the colours of up
-    // to 8 of them at once (rgb[channel][j], as shade() gives them; false where the vector
-    // kernel does not run them: then shadeDots each).
     bool vectorised() const { return simd_; }
     uint64_t dotL() const { return l_[0]; }
     uint64_t dotH() const { return h_[0]; }
-    uint64_t stepL() const { return dl_[0]; }  // per fragment
+    uint64_t stepL() const { return dl_[0]; }
     uint64_t stepH() const { return dh_[0]; }
     bool shadeLanes(const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n, uint8_t rgb[3][8],
                     int64_t (*codes)[8] = nullptr) const {
       if constexpr (kGroups) return simd_ && fixed_simd::shadeNh8(simd_params_, sq, l, h, n, rgb, codes);
       return false;
     }
-    // shadeLanes for n <= fixed_simd::kMaxBatch fragments, 8 at a time (fixed_simd::shadeNhBatch):
-    // the groups of 8 it declines (bit g: fragments 8g..8g+7), all of them without the vector
-    // kernel.
     uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint8_t* const rgb[3]) const {
       if constexpr (kGroups)
         if (simd_) return fixed_simd::shadeNhBatch(simd_params_, sq, l, h, n, rgb);
       return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8);
     }
-    FixedShade shadeDots(uint64_t sqnorm, uint64_t l, uint64_t h) {
+    FixedShade shadeRaw(uint64_t sqnorm, uint64_t l, uint64_t h) {
+      static_assert(kGroups, "one light, and no N.V (a lobe of N.H)");
       return sh_.shadeDots<C>(
           Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
           [&](size_t, PerLight&) { return static_cast<int64_t>(l); },

@@ -82,6 +82,23 @@ double area2(const PVertex& a, const PVertex& b, const PVertex& c) {
   return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
 }
 
+// A run's pixels in the framebuffer: the index and the depth code of the current one, and
+// their steps along the run.
+struct RunCursor {
+  size_t p, step;
+  uint64_t z, dz;
+  RunCursor(const RowRun& r, int width)
+      : p(static_cast<size_t>(r.y) * static_cast<size_t>(width) + static_cast<size_t>(r.x0)),
+        step(static_cast<size_t>(static_cast<ptrdiff_t>(r.dx))),  // +1 or -1 (mod 2^64)
+        z(static_cast<uint64_t>(r.a0[3])),
+        dz(static_cast<uint64_t>(r.da[3])) {}
+  int64_t depth() const { return static_cast<int64_t>(z); }
+  void next() {
+    p += step;
+    z += dz;
+  }
+};
+
 // phong-fixed's fragments buffered for the shader's vector case (see render()).
 struct FixedBatch {
   static constexpr size_t kCap = 256;
@@ -647,27 +664,22 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           const int64_t count = r.count;
           SquaredNormRecurrence run_sqn;
           uint64_t sqnorm = run_sqn.start({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
-          uint64_t z = static_cast<uint64_t>(r.a0[3]);
-          const uint64_t dz = static_cast<uint64_t>(r.da[3]);
-          size_t p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
-          const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
+          RunCursor c(r, W);
           size_t requests_answered = 0;
           uint64_t newly = 0;
           const auto put = write;
           kernel.start(r.a0, r.da);
           for (int64_t i = 0;;) {
-            __builtin_prefetch(depth + p + W);  // as colourFragment
-            const int64_t wcode = static_cast<int64_t>(z);
-            if (wcode > depth[p]) {
+            __builtin_prefetch(depth + c.p + W);  // as colourFragment
+            if (c.depth() > depth[c.p]) {
               const FixedShade fs = kernel.shade(sqnorm);
               requests_answered += fs.device_requests;
-              newly += put(p, wcode, fixedColour(fs));
+              newly += put(c.p, c.depth(), fixedColour(fs));
             }
             if (++i == count) break;
             sqnorm = run_sqn.next();
             kernel.step();
-            z += dz;
-            p += step;
+            c.next();
           }
           memo_requests += requests_answered;
           st.pixels_covered += newly;
@@ -685,7 +697,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           const uint64_t declined = kernel.shadeBatch(b.sq.data(), b.l.data(), b.h.data(), n, rgb);
           for (size_t f = 0; f < n; ++f) {
             if (((declined >> (f / 8)) & 1) != 0) {
-              const std::array<uint8_t, 3> c = fixedColour(kernel.shadeDots(b.sq[f], b.l[f], b.h[f]));
+              const std::array<uint8_t, 3> c = fixedColour(kernel.shadeRaw(b.sq[f], b.l[f], b.h[f]));
               for (size_t k = 0; k < 3; ++k) rgb[k][f] = c[k];
             }
             const size_t p = b.pixel[f];
@@ -700,10 +712,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           FixedBatch& b = *batch;
           SquaredNormRecurrence run_sqn;
           uint64_t sqnorm = run_sqn.start({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
-          uint64_t z = static_cast<uint64_t>(r.a0[3]);
-          const uint64_t dz = static_cast<uint64_t>(r.da[3]);
-          size_t p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
-          const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
+          RunCursor c(r, W);
           kernel.start(r.a0, r.da);
           uint64_t l = kernel.dotL(), h = kernel.dotH();
           const uint64_t dl = kernel.stepL(), dh = kernel.stepH();
@@ -718,15 +727,14 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             b.sq[n] = sqnorm;
             b.l[n] = l;
             b.h[n] = h;
-            b.pixel[n] = p;
-            b.z[n] = static_cast<int64_t>(z);
+            b.pixel[n] = c.p;
+            b.z[n] = c.depth();
             ++n;
             if (++i == count) break;
             sqnorm = run_sqn.next();
             l += dl;
             h += dh;
-            z += dz;
-            p += step;
+            c.next();
           }
           b.n = n;
         };
