@@ -25,6 +25,7 @@
 #include "image/image.h"
 #include "image/metrics.h"
 #include "raster/desc_stream.h"
+#include "render/fixed_simd.h"
 #include "render/render.h"
 #include "render_rtl.h"
 #include "scene/scene.h"
@@ -641,6 +642,8 @@ struct RenderCmd {
                         {"metrics", toJson(all)},
                         {"highlight_lsb_threshold", highlight_lsb},
                         {"highlight", toJson(hl)}};
+    // phong-fixed: whether the AVX-512 kernel shades its one-light N.H-lobe fragments here.
+    if (ro.method == Method::PhongFixed) j["fixed_kernel"] = fixed_simd::available() ? "avx512" : "scalar";
     if (rtl) {
       j["pixel_mismatches"] = mismatches;
       j["rtl"] = rtl_json;
