@@ -75,12 +75,13 @@ inline void laneFragment(const SpanParams& p, const SpanDesc& d, const SpanLaneT
 }
 
 // The fragments of a row of a single lane-triangle (T == 1), x = lo..hi in order: one
-// accumulator acc = I_w(x, w) stepped by didx, mapped by the lane's output map. KC: NumAttr
-// known at compile time (4, the renderer's), or 0 for p.NumAttr.
-template <int KC, class Sink>
+// accumulator acc = I_w(x, w) stepped by didx, mapped by the lane's output map. KC and AB:
+// NumAttr and AttrBits known at compile time (4 and 32, the renderer's unit), or 0 for
+// p.NumAttr and p.AttrBits.
+template <int KC, int AB, class Sink>
 inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t w, int64_t lo, int64_t hi,
                       const int64_t* irow, Sink& emit) {
-  const int K = KC > 0 ? KC : p.NumAttr, bits = p.AttrBits;
+  const int K = KC > 0 ? KC : p.NumAttr, bits = AB > 0 ? AB : p.AttrBits;
   std::array<uint64_t, kMaxAttr> acc, step, off;  // the first K are set and read
   std::array<int64_t, kMaxAttr> attr;
   for (int a = 0; a < K; ++a) {
@@ -114,10 +115,10 @@ inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri&
 // between, and fragment i shows a0 + i da with no further wrap. (Setup makes every value fit,
 // so a row that is not one run is a descriptor that setup would not make.) Pixel coordinates:
 // both ends within PixBits, so that the mask changes none.
-template <int KC, class RunSink>
+template <int KC, int AB, class RunSink>
 inline bool runRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t w, int64_t lo, int64_t hi,
                    const int64_t* irow, RunSink& emit_run) {
-  const int K = KC > 0 ? KC : p.NumAttr, bits = p.AttrBits;
+  const int K = KC > 0 ? KC : p.NumAttr, bits = AB > 0 ? AB : p.AttrBits;
   const int64_t pix_lim = int64_t{1} << p.PixBits;
   const int64_t px_lo = t.flip ? t.ox - lo : lo + t.ox, px_hi = t.flip ? t.ox - hi : hi + t.ox;
   const int64_t py = t.flip ? t.oy - w : w + t.oy;
@@ -171,29 +172,30 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     }
   std::array<int64_t, kMaxAttr> irow, icur{};  // irow's first K set here, icur's per row before they are read
   std::copy(d.iref.begin(), d.iref.end(), irow.begin());
-  // The ROW cycle's updates: the edges, the row's attribute base. KC as in singleRow.
-  auto stepRow = [&](int64_t w, auto kc) {
-    constexpr int KC = decltype(kc)::value;
+  // The ROW cycle's updates: the edges, the row's attribute base. KC and AB as in singleRow.
+  auto stepRow = [&](int64_t w, auto kc, auto ab) {
+    constexpr int KC = decltype(kc)::value, AB = decltype(ab)::value;
     for (int j = 0; j < T; ++j)
       stepEdges(d.tri[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
     for (int a = 0; a < (KC > 0 ? KC : K); ++a) {
       const size_t ai = static_cast<size_t>(a);
-      irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), p.AttrBits);
+      irow[ai] = wrapTo(u(irow[ai]) + u(d.didy[ai]), AB > 0 ? AB : p.AttrBits);
     }
   };
   // One lane-triangle (serial, evenodd, segments): the lanes of successive cycles take
   // successive columns, so the fragments come in x order, and lane i of the cycle at xg shows
   // the plane at x = xg + i (icur + i didx, all mod 2^AttrBits): one accumulator.
-  auto singleLaneRow = [&](int64_t w, auto kc) {
-    constexpr int KC = decltype(kc)::value;
+  auto singleLaneRow = [&](int64_t w, auto kc, auto ab) {
+    constexpr int KC = decltype(kc)::value, AB = decltype(ab)::value;
     const SpanLaneTri& t = d.tri[0];
     int64_t lo = 0, hi = 0;
     if (!laneRowBounds(t, w, e.data(), lo, hi)) return;
     const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
     walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
     bool ran = false;
-    if constexpr (!std::is_same_v<std::decay_t<RunSink>, NoRuns>) ran = runRow<KC>(p, d, t, w, lo, hi, irow.data(), emit_run);
-    if (!ran) singleRow<KC>(p, d, t, w, lo, hi, irow.data(), emit);
+    if constexpr (!std::is_same_v<std::decay_t<RunSink>, NoRuns>)
+      ran = runRow<KC, AB>(p, d, t, w, lo, hi, irow.data(), emit_run);
+    if (!ran) singleRow<KC, AB>(p, d, t, w, lo, hi, irow.data(), emit);
     walk.fragments += static_cast<uint64_t>(hi - lo + 1);
   };
   // Several lane-triangles (sierpinski): lane by lane, cycle by cycle.
@@ -240,18 +242,19 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
       }
     }
   };
-  // The ROW cycles, with NumAttr known at compile time when it is the renderer's 4.
-  auto rows = [&](auto kc) {
+  // The ROW cycles, with NumAttr and AttrBits known at compile time when they are the
+  // renderer's 4 and 32 (the wraps become sign extensions of the low word).
+  auto rows = [&](auto kc, auto ab) {
     for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
       ++walk.row_cycles;
-      if (T == 1) singleLaneRow(w, kc);
+      if (T == 1) singleLaneRow(w, kc, ab);
       else laneTrianglesRow(w);
-      stepRow(w, kc);
+      stepRow(w, kc, ab);
       if (w == d.row_last) break;
     }
   };
-  if (K == 4) rows(std::integral_constant<int, 4>{});
-  else rows(std::integral_constant<int, 0>{});
+  if (K == 4 && p.AttrBits == 32) rows(std::integral_constant<int, 4>{}, std::integral_constant<int, 32>{});
+  else rows(std::integral_constant<int, 0>{}, std::integral_constant<int, 0>{});
   walk.cycles += walk.row_cycles + walk.span_cycles;
   return walk;
 }
