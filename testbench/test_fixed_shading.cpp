@@ -236,7 +236,10 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
               }
               uint8_t rgb[3][8];
               int64_t codes[3][8];
-              const bool vec = kernel.shadeLanes(sq.data(), l.data(), h.data(), count, rgb, codes);
+              uint8_t* const rgb_out[3] = {rgb[0], rgb[1], rgb[2]};
+              int64_t* const codes_out[3] = {codes[0], codes[1], codes[2]};
+              const bool vec =
+                  kernel.shadeBatch(sq.data(), l.data(), h.data(), static_cast<size_t>(count), rgb_out, codes_out) == 0;
               ASSERT_EQ(vec, !small) << "n " << n << " " << toString(lobe);
               if (!vec) {
                 ++declined;

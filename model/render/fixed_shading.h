@@ -197,34 +197,25 @@ class FixedPointShader {
     // The vector kernel's case (fixed_simd.h): one light and a lobe of N.H. Its fragments are
     // shaded away from their runs, from their squared norms and raw dot products N.L and N.H
     // (dotL, dotH at the current fragment; stepL, stepH per fragment), kept in buffers:
-    //   shadeLanes  up to 8 of them (rgb[channel][j], and the codes if asked); false when the
-    //               vector kernel does not take them;
-    //   shadeBatch  up to fixed_simd::kMaxBatch, 8 at a time: the groups of 8 it does not take
-    //               (bit g: fragments 8g..8g+7), all of them without the vector kernel;
+    //   shadeBatch  up to fixed_simd::kMaxBatch of them, 8 at a time (fixed_simd::shadeNh):
+    //               the groups of 8 it does not take, all of them without the vector kernel;
     //   shadeRaw    one of them in the scalar datapath.
-    // All give what shade() gives.
+    // Both give what shade() gives.
     static constexpr bool kGroups = C == Cosine::NH && NL == 1;
     bool vectorised() const { return simd_; }
     uint64_t dotL() const { return l_[0]; }
     uint64_t dotH() const { return h_[0]; }
     uint64_t stepL() const { return dl_[0]; }
     uint64_t stepH() const { return dh_[0]; }
-    bool shadeLanes(const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n, uint8_t rgb[3][8],
-                    int64_t (*codes)[8] = nullptr) const {
-      if constexpr (kGroups) return simd_ && fixed_simd::shadeNh8(simd_params_, sq, l, h, n, rgb, codes);
-      return false;
-    }
-    uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint8_t* const rgb[3]) const {
+    uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint8_t* const rgb[3],
+                        int64_t* const codes[3] = nullptr) const {
       if constexpr (kGroups)
-        if (simd_) return fixed_simd::shadeNhBatch(simd_params_, sq, l, h, n, rgb);
-      return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8);
+        if (simd_) return fixed_simd::shadeNh(simd_params_, sq, l, h, n, rgb, codes);
+      return fixed_simd::allGroups(n);
     }
     FixedShade shadeRaw(uint64_t sqnorm, uint64_t l, uint64_t h) {
       static_assert(kGroups, "one light, and no N.V (a lobe of N.H)");
-      return sh_.shadeDots<C>(
-          Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
-          [&](size_t, PerLight&) { return static_cast<int64_t>(l); },
-          [&](size_t, const PerLight&) { return static_cast<int64_t>(h); }, nullptr);
+      return shadeAt(sqnorm, &l, &h);
     }
     void start(const int64_t* n0, const int64_t* dn) {
       using fixed_detail::dot58;
@@ -243,12 +234,7 @@ class FixedPointShader {
         dh_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].h));
       }
     }
-    FixedShade shade(uint64_t sqnorm) {
-      return sh_.shadeDots<C>(
-          Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
-          [&](size_t i, PerLight&) { return static_cast<int64_t>(l_[i]); },
-          [&](size_t i, const PerLight&) { return static_cast<int64_t>(h_[i]); }, nullptr);
-    }
+    FixedShade shade(uint64_t sqnorm) { return shadeAt(sqnorm, l_.data(), h_.data()); }
     void step() {
       v_ += dv_;
       for (size_t i = 0; i < NL; ++i) {
@@ -258,6 +244,13 @@ class FixedPointShader {
     }
 
    private:
+    // The datapath from the raw dot products of the NL lights (and the current fragment's N.V).
+    FixedShade shadeAt(uint64_t sqnorm, const uint64_t* l, const uint64_t* h) {
+      return sh_.shadeDots<C>(
+          Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
+          [&](size_t i, PerLight&) { return static_cast<int64_t>(l[i]); },
+          [&](size_t i, const PerLight&) { return static_cast<int64_t>(h[i]); }, nullptr);
+    }
     FixedPointShader& sh_;
     std::array<PerLight, NL> lights_;
     std::array<int64_t, 3> ambient_;
@@ -271,7 +264,6 @@ class FixedPointShader {
   };
 
  private:
-
   // The lighting from the integer dot products N.V (raw_nv), N.L (nl_of(i, light i), which may
   // first set a point light's directions) and N.H (nh_of(i, light i)), 58 fraction bits.
   template <Cosine C, class NL, class NH>

@@ -57,10 +57,10 @@ SHD_AVX512 inline __m512i roundShift(__m512i x) {
   return _mm512_srai_epi64(_mm512_add_epi64(x, _mm512_set1_epi64(int64_t{1} << (S - 1))), S);
 }
 
-// One group: shadeNh8 with the outputs at out[k] (8 bytes each). Inline into the batch loop,
-// where the compiler keeps the broadcast constants out of the loop.
+// One group of n <= 8 fragments at offset i of shadeNh's arrays; false when it declines them.
+// Inline into shadeNh's loop, where the compiler keeps the broadcast constants out of the loop.
 SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
-                                  uint8_t* const out_rgb[3], int64_t (*codes)[8]) {
+                                  size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
   // Lanes past n compute on whatever their entries hold; they read no table (masked gathers)
   // and their results are not stored.
   const __mmask8 valid = static_cast<__mmask8>((1u << n) - 1);
@@ -130,27 +130,20 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
                                                _mm512_add_epi64(diffuse, specular));
     const __m512i out = _mm512_srli_epi64(
         _mm512_add_epi64(_mm512_min_epi64(code, _mm512_set1_epi64(int64_t{255} << 12)), _mm512_set1_epi64(1 << 11)), 12);
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(out_rgb[k]), _mm512_cvtepi64_epi8(out));
-    if (codes != nullptr) _mm512_storeu_si512(codes[k], code);
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k] + i), _mm512_cvtepi64_epi8(out));
+    if (codes != nullptr) _mm512_storeu_si512(codes[k] + i, code);
   }
   return true;
 }
 
 }  // namespace
 
-SHD_AVX512 bool shadeNh8(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
-                         uint8_t rgb[3][8], int64_t (*codes)[8]) {
-  uint8_t* const out[3] = {rgb[0], rgb[1], rgb[2]};
-  return shadeGroup(p, sq, l, h, n, out, codes);
-}
-
-SHD_AVX512 uint64_t shadeNhBatch(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                                 uint8_t* const rgb[3]) {
+SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                            uint8_t* const rgb[3], int64_t* const codes[3]) {
   uint64_t declined = 0;
   for (size_t g = 0; g * 8 < n; ++g) {
     const size_t i = g * 8;
-    uint8_t* const out[3] = {rgb[0] + i, rgb[1] + i, rgb[2] + i};
-    if (!shadeGroup(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), out, nullptr))
+    if (!shadeGroup(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), i, rgb, codes))
       declined |= uint64_t{1} << g;
   }
   return declined;
@@ -161,11 +154,9 @@ SHD_AVX512 uint64_t shadeNhBatch(const NhParams& p, const uint64_t* sq, const ui
 #else
 
 bool available() { return false; }
-bool shadeNh8(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, int, uint8_t[3][8], int64_t (*)[8]) {
-  return false;
-}
-uint64_t shadeNhBatch(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3]) {
-  return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8);
+uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
+                 int64_t* const[3]) {
+  return allGroups(n);
 }
 
 #endif

@@ -1,4 +1,4 @@
-// phong-fixed's datapath for up to 8 fragments of a run at once, in AVX-512 (F, DQ, CD) where
+// phong-fixed's datapath for fragments 8 at a time, in AVX-512 (F, DQ, CD) where
 // the CPU has it: the same integer operations as FixedPointShader::shade() (fixed_shading.h,
 // normalize.h), lane by lane, so the same colours. It covers the common case, one directional
 // light and a lobe of N.H from a table (blinn, pow, normalized-blinn, schlick); everything
@@ -30,19 +30,17 @@ struct NhParams {
   std::array<int64_t, 3> ambient{}, diffuse{}, specular{};
 };
 
-// Lanes j < n (1..8): squared norm sq[j] (56 fraction bits) and the raw dot products N.L = l[j]
-// and N.H = h[j] (58 fraction bits, two's complement): the output colours rgb[k][j] of channel
-// k, and where codes is not null the 12-fraction-bit codes before the output rounding
-// (FixedShade::code) in codes[k][j]. The arrays hold 8 readable entries each (those past n
-// are read, and ignored). False (outputs untouched) when a lane j < n needs the scalar path.
-bool shadeNh8(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
-              uint8_t rgb[3][8], int64_t (*codes)[8] = nullptr);
-
-// The same for n <= 512 lanes in groups of 8 (lanes 8g .. 8g + 7), colours to rgb[k][i]: the
-// groups it declines have bit g set in the result (their outputs untouched). The arrays hold
-// n rounded up to a multiple of 8 readable entries (rgb: writable).
+// Fragments i < n (n <= kMaxBatch) in groups of 8 (fragments 8g .. 8g + 7): squared norm sq[i]
+// (56 fraction bits) and the raw dot products N.L = l[i] and N.H = h[i] (58 fraction bits,
+// two's complement) give the output colour rgb[k][i] of channel k and, where codes is not
+// null, the 12-fraction-bit code before the output rounding (FixedShade::code) in codes[k][i].
+// Returns the groups it declines (bit g: a fragment of group g needs the scalar path); their
+// outputs are untouched. The inputs hold n rounded up to a multiple of 8 readable entries
+// (those past n are read and ignored), the outputs as many writable ones.
 constexpr size_t kMaxBatch = 512;
-uint64_t shadeNhBatch(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                      uint8_t* const rgb[3]);
+uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                 uint8_t* const rgb[3], int64_t* const codes[3] = nullptr);
+// Every group of n fragments: what shadeNh returns when it takes none.
+inline uint64_t allGroups(size_t n) { return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8); }
 
 }  // namespace shd::fixed_simd

@@ -99,7 +99,10 @@ struct RunCursor {
   }
 };
 
-// phong-fixed's fragments buffered for the shader's vector case (see render()).
+// phong-fixed's fragments in the shader's vector case (one light, a lobe of N.H), buffered
+// from the runs of a triangle and shaded 8 at a time (FixedPointShader::RunKernel::shadeBatch):
+// the groups are independent, so the processor overlaps them, where one group per row of 5 or
+// 6 pixels would wait out its own latency. Padded by 8: a group reads and writes 8 entries.
 struct FixedBatch {
   static constexpr size_t kCap = 256;
   static_assert(kCap <= fixed_simd::kMaxBatch, "one call shades a batch");
@@ -395,10 +398,6 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     size_t dev_first, dev_count;
   };
   std::vector<Pending> pend;
-  // phong-fixed's fragments in the shader's vector case (one light, a lobe of N.H), buffered
-  // from the runs of a triangle and shaded 8 at a time (FixedPointShader::RunKernel::shadeLanes):
-  // the groups are independent, so the processor overlaps them, where one group per row of
-  // 5 or 6 pixels would wait out its own latency. Padded by 8: a group reads 8 entries.
   auto batch = std::make_unique<FixedBatch>();
   std::vector<SpecRequest> requests;
   std::vector<size_t> order;
@@ -595,28 +594,25 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         auto colourRun = [write, depth = fb.depth.data(), W, &covered = st.pixels_covered](const RowRun& r) {
           const auto put = write;
           const int64_t count = r.count;  // a local: r may alias the pixels' byte stores
-          std::array<uint64_t, 4> a, da;
+          std::array<uint64_t, 3> a, da;
           bool in_range = true;
-          for (size_t k = 0; k < 4; ++k) {
+          for (size_t k = 0; k < 3; ++k) {
             a[k] = static_cast<uint64_t>(r.a0[k]);
             da[k] = static_cast<uint64_t>(r.da[k]);
             const int64_t end = static_cast<int64_t>(a[k] + da[k] * static_cast<uint64_t>(count - 1));
-            if (k < 3) in_range = in_range && std::min(r.a0[k], end) >= 0 && std::max(r.a0[k], end) <= (255 << kColourFrac);
+            in_range = in_range && std::min(r.a0[k], end) >= 0 && std::max(r.a0[k], end) <= (255 << kColourFrac);
           }
-          const size_t p0 = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
-          const size_t step = static_cast<size_t>(static_cast<ptrdiff_t>(r.dx));  // +1 or -1 (mod 2^64)
           uint64_t newly = 0;
           auto loop = [&](auto clamp) {
             auto unorm8 = [](uint64_t c) {
               if constexpr (decltype(clamp)::value) return unorm8FromCode(static_cast<int64_t>(c), kColourFrac);
               else return static_cast<uint8_t>((c + (1u << (kColourFrac - 1))) >> kColourFrac);
             };
-            size_t p = p0;
-            for (int64_t i = 0; i < count; ++i, p += step) {
-              __builtin_prefetch(depth + p + W);  // as colourFragment
-              const int64_t z = static_cast<int64_t>(a[3]);
-              if (z > depth[p]) newly += put(p, z, {unorm8(a[0]), unorm8(a[1]), unorm8(a[2])});
-              for (size_t k = 0; k < 4; ++k) a[k] += da[k];
+            RunCursor c(r, W);
+            for (int64_t i = 0; i < count; ++i, c.next()) {
+              __builtin_prefetch(depth + c.p + W);  // as colourFragment
+              if (c.depth() > depth[c.p]) newly += put(c.p, c.depth(), {unorm8(a[0]), unorm8(a[1]), unorm8(a[2])});
+              for (size_t k = 0; k < 3; ++k) a[k] += da[k];
             }
           };
           if (in_range) loop(std::false_type{});
@@ -888,16 +884,13 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
             walkWith(fixedFragment);
           else
             fixed->withRunKernel([&](auto kernel) {
-              bool batched_runs = false;
-              if constexpr (decltype(kernel)::kGroups) {
+              if constexpr (decltype(kernel)::kGroups)
                 if (kernel.vectorised()) {
                   walkWith(fixedFragment, [&batchRun, &kernel](const RowRun& r) { batchRun(kernel, r); });
                   flushBatch(kernel);
-                  batched_runs = true;
+                  return;
                 }
-              }
-              if (!batched_runs)
-                walkWith(fixedFragment, [&fixedRun, kernel](const RowRun& r) mutable { fixedRun(kernel, r); });
+              walkWith(fixedFragment, [&fixedRun, kernel](const RowRun& r) mutable { fixedRun(kernel, r); });
             });
         } else if (!reference && walker != nullptr && m != Method::NormalBisection) {
           walkWith([&](int32_t x, int32_t y, const int64_t* attr) { shadeFragment(x, y, attr, nullptr); });
