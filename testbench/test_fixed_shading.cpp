@@ -5,11 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "approx/brdf.h"
 #include "device/prom.h"
 #include "device/spec_params.h"
+#include "render/fixed_simd.h"
+#include "render/normalize.h"
 #include "scene/scene.h"
 
 using namespace shd;
@@ -267,4 +270,90 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
   EXPECT_GT(lanes, 500000u);
   EXPECT_GT(declined, 0u);
   RecordProperty("lanes", std::to_string(lanes));
+}
+
+// fixed_simd::bufferRun against the run loop it replaces, fragment by fragment: runs of 1 to
+// 40 pixels from every start offset, over depth buffers holding codes above, below and equal
+// to the run's (and 0, not covered), with depth codes and steps that wrap mod 2^32, squared
+// norms from SquaredNormRecurrence and dot products that wrap mod 2^64, into batches filled
+// to every level (a full batch stops the run; the rest follows after the batch is emptied).
+TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
+  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR set): the scalar path runs";
+  std::mt19937_64 rng(21);
+  constexpr size_t kPixels = 64, kWidth = 16;
+  auto batch = std::make_unique<fixed_simd::Batch>();
+  uint64_t fragments = 0, passed = 0, stops = 0;
+  for (int t = 0; t < 20000; ++t) {
+    fixed_simd::Run r;
+    r.count = 1 + rng() % 40;
+    r.p = rng() % (kPixels - r.count + 1);
+    r.z = static_cast<uint32_t>(rng());
+    r.dz = t % 3 == 0 ? static_cast<uint32_t>(rng()) : static_cast<uint32_t>(static_cast<int64_t>(rng() % 2001) - 1000);
+    std::array<int64_t, 3> n0{}, dn{};
+    for (size_t k = 0; k < 3; ++k) {
+      n0[k] = static_cast<int64_t>(rng() % (uint64_t{1} << 32)) - (int64_t{1} << 31);
+      dn[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 32))) - (int64_t{1} << 20);
+    }
+    const SquaredNormRecurrence::Terms sq = SquaredNormRecurrence::terms(n0, dn);
+    r.a = sq.a;
+    r.two_b = sq.two_b;
+    r.c = sq.c;
+    r.l = rng();
+    r.dl = rng();
+    r.h = rng();
+    r.dh = rng();
+    // Depth around the run's codes: each pixel below (passes), equal or above (fails), or 0.
+    std::vector<int32_t> depth(kPixels + 2 * kWidth + 8), tri(depth.size(), -1);
+    for (size_t k = 0; k < r.count; ++k) {
+      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
+      const int pick = static_cast<int>(rng() % 4);
+      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(zk + static_cast<int32_t>(rng() % 5) - 2));
+    }
+    std::vector<int32_t> want_depth = depth, want_tri = tri;
+    // The run loop: z-test, write, and the passing fragments' inputs in order.
+    std::vector<std::array<uint64_t, 4>> want;  // sq, l, h, pixel
+    uint64_t want_fresh = 0;
+    SquaredNormRecurrence rec;
+    uint64_t f = rec.start(n0, dn);
+    for (size_t k = 0; k < r.count; ++k) {
+      if (k > 0) f = rec.next();
+      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
+      const size_t p = r.p + k;
+      if (zk <= want_depth[p]) continue;
+      want_fresh += want_depth[p] == 0 ? 1 : 0;
+      want_depth[p] = zk;
+      want_tri[p] = 7;
+      want.push_back({f, r.l + k * r.dl, r.h + k * r.dh, p});
+    }
+    // bufferRun, from a batch already filled to a random level, emptied when it stops.
+    const fixed_simd::Target target{depth.data(), tri.data(), 7, kWidth};
+    batch->n = rng() % (fixed_simd::Batch::kCap + 1);
+    if (batch->n > fixed_simd::Batch::kCap - 8 && t % 2 == 0) batch->n = fixed_simd::Batch::kCap - 8 - rng() % 16;
+    std::vector<std::array<uint64_t, 4>> got;
+    uint64_t fresh = 0;
+    for (size_t k = 0;;) {
+      const size_t n0_batch = batch->n;
+      const size_t next = fixed_simd::bufferRun(r, k, target, *batch, fresh);
+      ASSERT_GE(next, k);
+      ASSERT_LE(next, r.count);
+      ASSERT_LE(batch->n, fixed_simd::Batch::kCap);
+      for (size_t i = n0_batch; i < batch->n; ++i) got.push_back({batch->sq[i], batch->l[i], batch->h[i], batch->pixel[i]});
+      if (next == r.count) break;
+      ASSERT_GT(batch->n + 8, fixed_simd::Batch::kCap) << "stopped with room for 8";
+      ++stops;
+      batch->n = 0;
+      k = next;
+    }
+    ASSERT_EQ(depth, want_depth) << "run " << t;
+    ASSERT_EQ(tri, want_tri) << "run " << t;
+    ASSERT_EQ(fresh, want_fresh) << "run " << t;
+    ASSERT_EQ(got.size(), want.size()) << "run " << t;
+    for (size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], want[i]) << "run " << t << " fragment " << i;
+    fragments += r.count;
+    passed += want.size();
+  }
+  // Both outcomes of the z-test and of the batch's room, many times each.
+  EXPECT_GT(passed, fragments / 4);
+  EXPECT_LT(passed, fragments * 3 / 4);
+  EXPECT_GT(stops, 500u);
 }

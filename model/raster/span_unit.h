@@ -123,6 +123,9 @@ struct SpanEdge {
 };
 
 struct SpanLaneTri {
+  // User-provided, as SpanDesc's: value-initialisation (InlineVec::emplace_back()) then runs the
+  // member initialisers alone, instead of first zeroing aoff's storage.
+  SpanLaneTri() {}
   int32_t row_first = 1, row_last = 0;  // walker rows (scissored); empty if first > last
   int32_t clip_x0 = 0, clip_x1 = -1;    // walker columns whose pixels lie in the viewport
   SpanEdge edge[3];

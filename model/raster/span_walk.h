@@ -170,7 +170,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
       const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];
       e[static_cast<size_t>(j * 3 + s)] = {g.q, g.r};
     }
-  std::array<int64_t, kMaxAttr> irow, icur{};  // irow's first K set here, icur's per row before they are read
+  std::array<int64_t, kMaxAttr> irow;  // the first K set here
   std::copy(d.iref.begin(), d.iref.end(), irow.begin());
   // The ROW cycle's updates: the edges, the row's attribute base. KC and AB as in singleRow.
   auto stepRow = [&](int64_t w, auto kc, auto ab) {
@@ -216,6 +216,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     }
     if (!any) return;
     int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+    std::array<int64_t, kMaxAttr> icur{};  // the first K set here (per row: zeroing it costs more than a row of one lane-triangle)
     for (int a = 0; a < K; ++a) {
       const size_t ai = static_cast<size_t>(a);
       icur[ai] = wrapTo(u(irow[ai]) + u(d.didx[ai]) * u(xg - d.xref), p.AttrBits);

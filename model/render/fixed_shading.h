@@ -273,6 +273,13 @@ class FixedPointShader {
   FixedShade shadeAs(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam, std::vector<SpecRequest>* requests);
   template <Cosine C, class F>
   void withLightCount(F&& f);
+  // f(kernel) with a kernel built in place: passed as an lvalue, so that f taking it by
+  // reference copies none of its 300-odd bytes.
+  template <class Kernel, class F>
+  void withKernel(F& f) {
+    Kernel k(*this);
+    f(k);
+  }
   void setDirections(PerLight& pl, Vec3 l) const;
   uint32_t cookTorranceCode(int64_t nl, int64_t nv, int64_t nh, const PerLight& pl) const;
   uint64_t deviceResult(const PerLight& pl, uint32_t cos) const;  // the memo entry, evaluated on first use
@@ -364,11 +371,11 @@ template <FixedPointShader::Cosine C, class F>
 inline void FixedPointShader::withLightCount(F&& f) {
   static_assert(kMaxRunLights == 4, "one case per light count");
   switch (lights_.size()) {
-    case 0: f(RunKernel<C, 0>(*this)); break;
-    case 1: f(RunKernel<C, 1>(*this)); break;
-    case 2: f(RunKernel<C, 2>(*this)); break;
-    case 3: f(RunKernel<C, 3>(*this)); break;
-    case 4: f(RunKernel<C, 4>(*this)); break;
+    case 0: withKernel<RunKernel<C, 0>>(f); break;
+    case 1: withKernel<RunKernel<C, 1>>(f); break;
+    case 2: withKernel<RunKernel<C, 2>>(f); break;
+    case 3: withKernel<RunKernel<C, 3>>(f); break;
+    case 4: withKernel<RunKernel<C, 4>>(f); break;
     default: throw std::logic_error("FixedPointShader: a run with more lights than kMaxRunLights");
   }
 }

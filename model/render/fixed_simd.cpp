@@ -2,13 +2,14 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <stdexcept>
 
 #include "render/normalize.h"
 
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define SHD_HAVE_AVX512_KERNEL 1
-#define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd")))
+#define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd,avx512vl")))
 #endif
 
 namespace shd::fixed_simd {
@@ -24,7 +25,7 @@ namespace shd::fixed_simd {
 
 bool available() {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-                          __builtin_cpu_supports("avx512cd") && std::getenv("SHD_SCALAR") == nullptr;
+                          __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512vl") && std::getenv("SHD_SCALAR") == nullptr;
   return yes;
 }
 
@@ -59,6 +60,9 @@ SHD_AVX512 inline __m512i roundShift(__m512i x) {
 
 // One group of n <= 8 fragments at offset i of shadeNh's arrays; false when it declines them.
 // Inline into shadeNh's loop, where the compiler keeps the broadcast constants out of the loop.
+// kCodes: codes is not null (a compile-time case: the renderer's loop, without the test and
+// the code stores, runs some 20 % faster).
+template <bool kCodes>
 SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
                                   size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
   // Lanes past n compute on whatever their entries hold; they read no table (masked gathers)
@@ -131,22 +135,75 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
     const __m512i out = _mm512_srli_epi64(
         _mm512_add_epi64(_mm512_min_epi64(code, _mm512_set1_epi64(int64_t{255} << 12)), _mm512_set1_epi64(1 << 11)), 12);
     _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k] + i), _mm512_cvtepi64_epi8(out));
-    if (codes != nullptr) _mm512_storeu_si512(codes[k] + i, code);
+    if constexpr (kCodes) _mm512_storeu_si512(codes[k] + i, code);
   }
   return true;
+}
+
+template <bool kCodes>
+SHD_AVX512 uint64_t shadeGroups(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                                uint8_t* const rgb[3], int64_t* const codes[3]) {
+  uint64_t declined = 0;
+  for (size_t g = 0; g * 8 < n; ++g) {
+    const size_t i = g * 8;
+    if (!shadeGroup<kCodes>(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), i, rgb, codes))
+      declined |= uint64_t{1} << g;
+  }
+  return declined;
 }
 
 }  // namespace
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
-  uint64_t declined = 0;
-  for (size_t g = 0; g * 8 < n; ++g) {
-    const size_t i = g * 8;
-    if (!shadeGroup(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), i, rgb, codes))
-      declined |= uint64_t{1} << g;
+  return codes != nullptr ? shadeGroups<true>(p, sq, l, h, n, rgb, codes) : shadeGroups<false>(p, sq, l, h, n, rgb, nullptr);
+}
+
+SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+  const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+  const __m256i lane32 = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+  const __m512i a = _mm512_set1_epi64(static_cast<int64_t>(r.a)), two_b = _mm512_set1_epi64(static_cast<int64_t>(r.two_b));
+  const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
+  const __m512i l0 = _mm512_set1_epi64(static_cast<int64_t>(r.l)), dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl));
+  const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
+  const __m256i dz = _mm256_set1_epi32(static_cast<int32_t>(r.dz));
+  const __m256i tag = _mm256_set1_epi32(t.tag);
+  size_t n = b.n, k = first;
+  uint64_t covered = 0;
+  for (; k < r.count && n + 8 <= Batch::kCap; k += 8) {
+    const unsigned m = static_cast<unsigned>(std::min<size_t>(8, r.count - k));
+    const __mmask8 valid = static_cast<__mmask8>((1u << m) - 1);
+    // Fragments k .. k + 7: the depth codes in 32-bit lanes (mod 2^32), the rest in 64-bit.
+    // The depth and tag accesses are 8 lanes wide (32 bytes): wider ones, even with their
+    // lanes masked off, would overlap the next chunk's and stall its load behind this store.
+    const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz)),
+                                       _mm256_mullo_epi32(lane32, dz));
+    int32_t* const depth = t.depth + r.p + k;
+    // The row below, most likely this triangle's next: its depth in the cache by then.
+    __builtin_prefetch(depth + 2 * t.width);
+    __builtin_prefetch(depth + 2 * t.width + 7);
+    const __m256i old = _mm256_maskz_loadu_epi32(valid, depth);
+    const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, z, old);
+    covered += static_cast<uint64_t>(__builtin_popcount(_mm256_mask_cmpeq_epi32_mask(pass, old, _mm256_setzero_si256())));
+    _mm256_mask_storeu_epi32(depth, pass, z);
+    _mm256_mask_storeu_epi32(t.tri + r.p + k, pass, tag);
+    const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);  // below 2^32
+    const __m512i sq =
+        _mm512_add_epi64(_mm512_add_epi64(a, _mm512_mullo_epi64(kv, two_b)), _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
+    const __m512i l = _mm512_add_epi64(l0, _mm512_mullo_epi64(kv, dl));
+    const __m512i h = _mm512_add_epi64(h0, _mm512_mullo_epi64(kv, dh));
+    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.p + k)), lane32);
+    // The passing lanes, packed (the register forms of compress: the memory forms are slow on
+    // some CPUs), stored 8 entries wide.
+    _mm512_storeu_si512(b.sq.data() + n, _mm512_maskz_compress_epi64(pass, sq));
+    _mm512_storeu_si512(b.l.data() + n, _mm512_maskz_compress_epi64(pass, l));
+    _mm512_storeu_si512(b.h.data() + n, _mm512_maskz_compress_epi64(pass, h));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b.pixel.data() + n), _mm256_maskz_compress_epi32(pass, pixel));
+    n += static_cast<size_t>(__builtin_popcount(pass));
   }
-  return declined;
+  b.n = n;
+  fresh += covered;
+  return std::min(k, r.count);
 }
 
 #pragma GCC diagnostic pop
@@ -157,6 +214,9 @@ bool available() { return false; }
 uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
                  int64_t* const[3]) {
   return allGroups(n);
+}
+size_t bufferRun(const Run&, size_t, const Target&, Batch&, uint64_t&) {
+  throw std::logic_error("fixed_simd::bufferRun: built without the vector kernel");
 }
 
 #endif

@@ -43,4 +43,43 @@ uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const
 // Every group of n fragments: what shadeNh returns when it takes none.
 inline uint64_t allGroups(size_t n) { return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8); }
 
+// Fragments waiting for shadeNh: their inputs, the framebuffer pixel each colours, and the
+// colours. Padded by 8: a group reads and writes 8 entries.
+struct Batch {
+  static constexpr size_t kCap = 256;
+  static_assert(kCap <= kMaxBatch && kCap % 8 == 0, "one shadeNh call shades a batch");
+  std::array<uint64_t, kCap + 8> sq{}, l{}, h{};
+  std::array<uint32_t, kCap + 8> pixel{};
+  std::array<std::array<uint8_t, kCap + 8>, 3> rgb{};
+  size_t n = 0;
+};
+
+// A run of a row, left to right: framebuffer pixels p .. p + count - 1, fragment k with the
+// depth code z + k dz (mod 2^32), the squared norm a + k two_b + k^2 c
+// (SquaredNormRecurrence::Terms) and the raw dot products l + k dl, h + k dh (mod 2^64).
+struct Run {
+  size_t p = 0, count = 0;
+  uint32_t z = 0, dz = 0;
+  uint64_t a = 0, two_b = 0, c = 0;
+  uint64_t l = 0, dl = 0, h = 0, dh = 0;
+};
+
+// The depth and triangle buffers the run's fragments are tested against and written to. The
+// depth codes are compared as int32_t: right when every code of the run fits int32_t (the
+// span unit's AttrBits <= 32), as the caller checks.
+struct Target {
+  int32_t* depth = nullptr;
+  int32_t* tri = nullptr;
+  int32_t tag = 0;
+  size_t width = 0;  // pixels per row: the row below a run is prefetched
+};
+
+// Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
+// the z-test (the fragment's code above the buffer's), and where it passes the code and the
+// tag written to the buffers and the fragment appended to b. Adds to fresh the passing pixels
+// whose depth was 0 (not covered before). Returns the first fragment it did not take (r.count
+// when it took all); the caller shades the batch and calls again for the rest. With the
+// vector kernel only (available()).
+size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
+
 }  // namespace shd::fixed_simd

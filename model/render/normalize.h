@@ -23,7 +23,11 @@ namespace shd {
 // following pixel's F_i (two additions).
 class SquaredNormRecurrence {
  public:
-  uint64_t start(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn) {
+  // The closed form's terms, mod 2^64: F_i = a + i two_b + i^2 c.
+  struct Terms {
+    uint64_t a, two_b, c;
+  };
+  static Terms terms(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn) {
     uint64_t A = 0, B = 0, C = 0;
     for (size_t k = 0; k < 3; ++k) {
       const uint64_t a = static_cast<uint64_t>(n0[k]), d = static_cast<uint64_t>(dn[k]);
@@ -31,10 +35,14 @@ class SquaredNormRecurrence {
       B += a * d;
       C += d * d;
     }
-    F_ = A;
-    two_b_ = 2 * B;
-    two_c_ = 2 * C;
-    ci_ = C;  // C_1 = C
+    return {A, 2 * B, C};
+  }
+  uint64_t start(const std::array<int64_t, 3>& n0, const std::array<int64_t, 3>& dn) {
+    const Terms t = terms(n0, dn);
+    F_ = t.a;
+    two_b_ = t.two_b;
+    two_c_ = 2 * t.c;
+    ci_ = t.c;  // C_1 = C
     return F_;
   }
   uint64_t next() {

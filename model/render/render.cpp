@@ -99,20 +99,6 @@ struct RunCursor {
   }
 };
 
-// phong-fixed's fragments in the shader's vector case (one light, a lobe of N.H), buffered
-// from the runs of a triangle and shaded 8 at a time (FixedPointShader::RunKernel::shadeBatch):
-// the groups are independent, so the processor overlaps them, where one group per row of 5 or
-// 6 pixels would wait out its own latency. Padded by 8: a group reads and writes 8 entries.
-struct FixedBatch {
-  static constexpr size_t kCap = 256;
-  static_assert(kCap <= fixed_simd::kMaxBatch, "one call shades a batch");
-  std::array<uint64_t, kCap + 8> sq{}, l{}, h{};
-  std::array<size_t, kCap> pixel{};
-  std::array<int64_t, kCap> z{};
-  std::array<std::array<uint8_t, kCap + 8>, 3> rgb{};
-  size_t n = 0;
-};
-
 // A screen triangle to draw: its vertices (in the object's vertex array, the clipped polygon
 // or a split) and the method that draws it.
 struct Part {
@@ -398,7 +384,11 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     size_t dev_first, dev_count;
   };
   std::vector<Pending> pend;
-  auto batch = std::make_unique<FixedBatch>();
+  // phong-fixed's fragments in the shader's vector case (one light, a lobe of N.H), z-tested
+  // and buffered from the runs of a triangle and shaded 8 at a time (fixed_simd.h): the groups
+  // are independent, so the processor overlaps them, where one group per row of 5 or 6 pixels
+  // would wait out its own latency.
+  auto batch = std::make_unique<fixed_simd::Batch>();
   std::vector<SpecRequest> requests;
   std::vector<size_t> order;
   std::vector<Vec3> bisected;
@@ -680,59 +670,54 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           memo_requests += requests_answered;
           st.pixels_covered += newly;
         };
-        // The batch: shaded 8 at a time, then written where the z-test passes (the datapath is a
-        // pure function; no two fragments of a triangle share a pixel, so the order of the
-        // writes within it does not matter).
+        // The batch: shaded 8 at a time, the colours written (bufferRun has z-tested its
+        // fragments and written their depth; the datapath is a pure function, and no two
+        // fragments of a triangle share a pixel, so the order of the writes does not matter).
         auto flushBatch = [&](auto& kernel) {
-          FixedBatch& b = *batch;
-          int32_t* const depth = fb.depth.data();
-          const auto put = write;
-          uint64_t newly = 0;
+          fixed_simd::Batch& b = *batch;
           uint8_t* const rgb[3] = {b.rgb[0].data(), b.rgb[1].data(), b.rgb[2].data()};
           const size_t n = b.n;  // a local: the pixels' byte stores may alias the batch
           const uint64_t declined = kernel.shadeBatch(b.sq.data(), b.l.data(), b.h.data(), n, rgb);
-          for (size_t f = 0; f < n; ++f) {
-            if (((declined >> (f / 8)) & 1) != 0) {
+          for (uint64_t g = declined; g != 0; g &= g - 1)
+            for (size_t f = 8 * static_cast<size_t>(__builtin_ctzll(g)), e = std::min(f + 8, n); f < e; ++f) {
               const std::array<uint8_t, 3> c = fixedColour(kernel.shadeRaw(b.sq[f], b.l[f], b.h[f]));
               for (size_t k = 0; k < 3; ++k) rgb[k][f] = c[k];
             }
+          uint8_t* const out = fb.rgb.data();
+          for (size_t f = 0; f < n; ++f) {
             const size_t p = b.pixel[f];
-            if (b.z[f] > depth[p]) newly += put(p, b.z[f], {rgb[0][f], rgb[1][f], rgb[2][f]});
+            for (size_t k = 0; k < 3; ++k) out[p * 3 + k] = rgb[k][f];
           }
-          st.pixels_covered += newly;
           b.n = 0;
         };
-        // A run into the batch: the recurrence and the dot products stepped along it (in
-        // locals: the batch's arrays would alias its count and the kernel's sums).
+        // A run into the batch: z-tested, its depth codes written, its passing fragments'
+        // squared norms and dot products buffered (fixed_simd::bufferRun). Depth codes that may
+        // not fit int32_t (AttrBits above 32) and right-to-left runs take fixedRun.
+        const SpanParams* walker = span.walker();
+        const bool depth_fits = walker != nullptr && walker->AttrBits <= 32;
+        const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tag), static_cast<size_t>(W)};
         auto batchRun = [&](auto& kernel, const RowRun& r) {
-          FixedBatch& b = *batch;
-          SquaredNormRecurrence run_sqn;
-          uint64_t sqnorm = run_sqn.start({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
-          RunCursor c(r, W);
-          kernel.start(r.a0, r.da);
-          uint64_t l = kernel.dotL(), h = kernel.dotH();
-          const uint64_t dl = kernel.stepL(), dh = kernel.stepH();
-          const int64_t count = r.count;
-          size_t n = b.n;
-          for (int64_t i = 0;;) {
-            if (n == FixedBatch::kCap) {
-              b.n = n;
-              flushBatch(kernel);
-              n = 0;
-            }
-            b.sq[n] = sqnorm;
-            b.l[n] = l;
-            b.h[n] = h;
-            b.pixel[n] = c.p;
-            b.z[n] = c.depth();
-            ++n;
-            if (++i == count) break;
-            sqnorm = run_sqn.next();
-            l += dl;
-            h += dh;
-            c.next();
+          if (!depth_fits || r.dx != 1) {
+            fixedRun(kernel, r);
+            return;
           }
-          b.n = n;
+          kernel.start(r.a0, r.da);
+          const auto sq = SquaredNormRecurrence::terms({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
+          fixed_simd::Run run;
+          run.p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
+          run.count = static_cast<size_t>(r.count);
+          run.z = static_cast<uint32_t>(r.a0[3]);
+          run.dz = static_cast<uint32_t>(r.da[3]);
+          run.a = sq.a;
+          run.two_b = sq.two_b;
+          run.c = sq.c;
+          run.l = kernel.dotL();
+          run.dl = kernel.stepL();
+          run.h = kernel.dotH();
+          run.dh = kernel.stepH();
+          uint64_t newly = 0;
+          for (size_t k = 0; (k = fixed_simd::bufferRun(run, k, target, *batch, newly)) < run.count;) flushBatch(kernel);
+          st.pixels_covered += newly;
         };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
         std::array<std::array<double, 3>, 3> mid_colour{};
@@ -870,7 +855,6 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // The fragments: shaded as the model's walk produces them, or collected first (the
         // reference walks the same pixel set by direct edge evaluation; the RTL's stream;
         // normal-bisection needs whole rows).
-        const SpanParams* walker = span.walker();
         auto walkWith = [&](auto&& sink, auto&&... runs) {
           const SpanWalk wk = walkSpanUnit(*walker, *s.desc, sink, runs...);
           st.span_cycles += wk.cycles;
@@ -883,8 +867,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           if (batched || !fixed->takesRuns())
             walkWith(fixedFragment);
           else
-            fixed->withRunKernel([&](auto kernel) {
-              if constexpr (decltype(kernel)::kGroups)
+            fixed->withRunKernel([&](auto& kernel) {
+              if constexpr (std::decay_t<decltype(kernel)>::kGroups)
                 if (kernel.vectorised()) {
                   walkWith(fixedFragment, [&batchRun, &kernel](const RowRun& r) { batchRun(kernel, r); });
                   flushBatch(kernel);
