@@ -357,3 +357,73 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   EXPECT_LT(passed, fragments * 3 / 4);
   EXPECT_GT(stops, 500u);
 }
+
+// fixed_simd::colourRun against the flat/Gouraud run loop, pixel by pixel: runs of 1 to 40
+// pixels from every start offset, over depth buffers holding codes above, below and equal to
+// the run's (and 0), with colour codes below 0, within [0, 255 2^frac] and above (the clamp),
+// for fraction bits 1 to 23. The pixels that fail the z-test keep their depth, tag and colour.
+TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
+  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR set): the scalar path runs";
+  std::mt19937_64 rng(22);
+  constexpr size_t kPixels = 64, kWidth = 16;
+  uint64_t fragments = 0, passed = 0, clamped = 0;
+  for (int t = 0; t < 20000; ++t) {
+    fixed_simd::ColourRun r;
+    r.count = 1 + rng() % 40;
+    r.p = rng() % (kPixels - r.count + 1);
+    r.z = static_cast<uint32_t>(rng());
+    r.dz = t % 3 == 0 ? static_cast<uint32_t>(rng()) : static_cast<uint32_t>(static_cast<int64_t>(rng() % 2001) - 1000);
+    r.frac = std::array<int, 5>{1, 5, 12, 12, 23}[rng() % 5];
+    const int64_t top = int64_t{255} << r.frac;
+    std::array<int64_t, 3> step{};
+    for (size_t ch = 0; ch < 3; ++ch) {
+      // Start and end around [0, top]: the codes are affine along the run, as the span unit's.
+      const int64_t lo = -top / 4 - 2, span = top + top / 2 + 4;
+      // (and within int32_t, as the span unit's codes are).
+      auto pick = [&] {
+        return std::clamp<int64_t>(lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(span)), INT32_MIN, INT32_MAX);
+      };
+      const int64_t c0 = pick(), c1 = pick();
+      // The step mod 2^32, as the span unit's (exact where the codes are: they fit int32_t).
+      step[ch] = r.count > 1 ? (c1 - c0) / static_cast<int64_t>(r.count - 1) : 0;
+      r.c[ch] = static_cast<int32_t>(c0);
+      r.dc[ch] = static_cast<int32_t>(static_cast<uint32_t>(step[ch]));
+    }
+    std::vector<int32_t> depth(kPixels + 2 * kWidth + 8), tri(depth.size(), -1);
+    std::vector<uint8_t> rgb(3 * depth.size());
+    for (uint8_t& b : rgb) b = static_cast<uint8_t>(rng());
+    for (size_t k = 0; k < r.count; ++k) {
+      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
+      const int pick = static_cast<int>(rng() % 4);
+      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(zk + static_cast<int32_t>(rng() % 5) - 2));
+    }
+    std::vector<int32_t> want_depth = depth, want_tri = tri;
+    std::vector<uint8_t> want_rgb = rgb;
+    uint64_t want_fresh = 0;
+    for (size_t k = 0; k < r.count; ++k) {
+      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
+      const size_t p = r.p + k;
+      if (zk <= want_depth[p]) continue;
+      want_fresh += want_depth[p] == 0 ? 1 : 0;
+      want_depth[p] = zk;
+      want_tri[p] = 9;
+      for (size_t ch = 0; ch < 3; ++ch) {
+        const int64_t code = int64_t{r.c[ch]} + static_cast<int64_t>(k) * step[ch];
+        clamped += code < 0 || code > top ? 1 : 0;
+        want_rgb[3 * p + ch] = unorm8FromCode(code, r.frac);
+      }
+      ++passed;
+    }
+    const fixed_simd::Target target{depth.data(), tri.data(), 9, kWidth};
+    const uint64_t fresh = fixed_simd::colourRun(r, target, rgb.data());
+    ASSERT_EQ(depth, want_depth) << "run " << t;
+    ASSERT_EQ(tri, want_tri) << "run " << t;
+    for (size_t i = 0; i < rgb.size(); ++i)
+      ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << "run " << t << " frac " << r.frac << " byte " << i;
+    ASSERT_EQ(fresh, want_fresh) << "run " << t;
+    fragments += r.count;
+  }
+  EXPECT_GT(passed, fragments / 4);
+  EXPECT_LT(passed, fragments * 3 / 4);
+  EXPECT_GT(clamped, passed / 10);
+}

@@ -9,7 +9,7 @@
 #if defined(__x86_64__) && defined(__GNUC__)
 #include <immintrin.h>
 #define SHD_HAVE_AVX512_KERNEL 1
-#define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd,avx512vl")))
+#define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd,avx512vl,avx512bw")))
 #endif
 
 namespace shd::fixed_simd {
@@ -25,7 +25,8 @@ namespace shd::fixed_simd {
 
 bool available() {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
-                          __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512vl") && std::getenv("SHD_SCALAR") == nullptr;
+                          __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512vl") &&
+                          __builtin_cpu_supports("avx512bw") && std::getenv("SHD_SCALAR") == nullptr;
   return yes;
 }
 
@@ -57,6 +58,15 @@ template <int S>
 SHD_AVX512 inline __m512i roundShift(__m512i x) {
   return _mm512_srai_epi64(_mm512_add_epi64(x, _mm512_set1_epi64(int64_t{1} << (S - 1))), S);
 }
+
+// Bit i of a 4-bit mask spread to bits 3i .. 3i + 2: the byte mask of 4 packed RGB pixels.
+constexpr std::array<uint16_t, 16> kSpread3 = [] {
+  std::array<uint16_t, 16> t{};
+  for (unsigned m = 0; m < 16; ++m)
+    for (unsigned i = 0; i < 4; ++i)
+      if ((m >> i) & 1) t[m] = static_cast<uint16_t>(t[m] | (7u << (3 * i)));
+  return t;
+}();
 
 // One group of n <= 8 fragments at offset i of shadeNh's arrays; false when it declines them.
 // Inline into shadeNh's loop, where the compiler keeps the broadcast constants out of the loop.
@@ -140,6 +150,29 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
   return true;
 }
 
+// The z-test of pixels p + k .. p + k + 7 of a run (the first m of them exist): the depth codes
+// z + (k + i) dz (mod 2^32) against the buffer's, and where they pass the codes and the tag
+// written. Returns the passing lanes; adds to fresh those whose depth was 0. The accesses are
+// 8 lanes wide (32 bytes): wider ones, even with their lanes masked off, would overlap the next
+// step's and stall its load behind this store.
+SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t k, unsigned m, uint32_t z, uint32_t dz,
+                                  uint64_t& fresh) {
+  const __mmask8 valid = static_cast<__mmask8>((1u << m) - 1);
+  const __m256i zk = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(z + static_cast<uint32_t>(k) * dz)),
+                                      _mm256_mullo_epi32(_mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0),
+                                                         _mm256_set1_epi32(static_cast<int32_t>(dz))));
+  int32_t* const depth = t.depth + p + k;
+  // The row after next, most likely this triangle's: its depth in the cache by then.
+  __builtin_prefetch(depth + 2 * t.width);
+  __builtin_prefetch(depth + 2 * t.width + 7);
+  const __m256i old = _mm256_maskz_loadu_epi32(valid, depth);
+  const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, zk, old);
+  fresh += static_cast<uint64_t>(__builtin_popcount(_mm256_mask_cmpeq_epi32_mask(pass, old, _mm256_setzero_si256())));
+  _mm256_mask_storeu_epi32(depth, pass, zk);
+  _mm256_mask_storeu_epi32(t.tri + p + k, pass, _mm256_set1_epi32(t.tag));
+  return pass;
+}
+
 template <bool kCodes>
 SHD_AVX512 uint64_t shadeGroups(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                                 uint8_t* const rgb[3], int64_t* const codes[3]) {
@@ -161,38 +194,22 @@ SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_
 
 SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
-  const __m256i lane32 = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512i a = _mm512_set1_epi64(static_cast<int64_t>(r.a)), two_b = _mm512_set1_epi64(static_cast<int64_t>(r.two_b));
   const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
   const __m512i l0 = _mm512_set1_epi64(static_cast<int64_t>(r.l)), dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl));
   const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
-  const __m256i dz = _mm256_set1_epi32(static_cast<int32_t>(r.dz));
-  const __m256i tag = _mm256_set1_epi32(t.tag);
   size_t n = b.n, k = first;
   uint64_t covered = 0;
   for (; k < r.count && n + 8 <= Batch::kCap; k += 8) {
-    const unsigned m = static_cast<unsigned>(std::min<size_t>(8, r.count - k));
-    const __mmask8 valid = static_cast<__mmask8>((1u << m) - 1);
-    // Fragments k .. k + 7: the depth codes in 32-bit lanes (mod 2^32), the rest in 64-bit.
-    // The depth and tag accesses are 8 lanes wide (32 bytes): wider ones, even with their
-    // lanes masked off, would overlap the next chunk's and stall its load behind this store.
-    const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz)),
-                                       _mm256_mullo_epi32(lane32, dz));
-    int32_t* const depth = t.depth + r.p + k;
-    // The row below, most likely this triangle's next: its depth in the cache by then.
-    __builtin_prefetch(depth + 2 * t.width);
-    __builtin_prefetch(depth + 2 * t.width + 7);
-    const __m256i old = _mm256_maskz_loadu_epi32(valid, depth);
-    const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, z, old);
-    covered += static_cast<uint64_t>(__builtin_popcount(_mm256_mask_cmpeq_epi32_mask(pass, old, _mm256_setzero_si256())));
-    _mm256_mask_storeu_epi32(depth, pass, z);
-    _mm256_mask_storeu_epi32(t.tri + r.p + k, pass, tag);
-    const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);  // below 2^32
+    const __mmask8 pass = zTest8(t, r.p, k, static_cast<unsigned>(std::min<size_t>(8, r.count - k)), r.z, r.dz, covered);
+    // Fragments k .. k + 7 in 64-bit lanes (k < 2^32).
+    const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
     const __m512i sq =
         _mm512_add_epi64(_mm512_add_epi64(a, _mm512_mullo_epi64(kv, two_b)), _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
     const __m512i l = _mm512_add_epi64(l0, _mm512_mullo_epi64(kv, dl));
     const __m512i h = _mm512_add_epi64(h0, _mm512_mullo_epi64(kv, dh));
-    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.p + k)), lane32);
+    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.p + k)),
+                                           _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0));
     // The passing lanes, packed (the register forms of compress: the memory forms are slow on
     // some CPUs), stored 8 entries wide.
     _mm512_storeu_si512(b.sq.data() + n, _mm512_maskz_compress_epi64(pass, sq));
@@ -206,6 +223,38 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   return std::min(k, r.count);
 }
 
+SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb) {
+  const __m256i lane = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+  const __m128i frac = _mm_cvtsi32_si128(r.frac);
+  const __m256i top = _mm256_set1_epi32(255 << r.frac), half = _mm256_set1_epi32(1 << (r.frac - 1));
+  // Within each 128-bit half: pixels' bytes r g b (of 32-bit lanes r | g << 8 | b << 16) packed
+  // into the first 12 bytes.
+  const __m256i pack = _mm256_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1,  //
+                                        0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1);
+  uint64_t covered = 0;
+  for (size_t k = 0; k < r.count; k += 8) {
+    const __mmask8 pass = zTest8(t, r.p, k, static_cast<unsigned>(std::min<size_t>(8, r.count - k)), r.z, r.dz, covered);
+    if (pass == 0) continue;
+    __m256i px = _mm256_setzero_si256();
+    for (int ch = 0; ch < 3; ++ch) {
+      // unorm8FromCode: the code clamped to [0, 255 2^frac], rounded half up to an integer.
+      const __m256i code = _mm256_add_epi32(
+          _mm256_set1_epi32(static_cast<int32_t>(static_cast<uint32_t>(r.c[ch]) + static_cast<uint32_t>(k) * static_cast<uint32_t>(r.dc[ch]))),
+          _mm256_mullo_epi32(lane, _mm256_set1_epi32(r.dc[ch])));
+      const __m256i u8 = _mm256_srl_epi32(
+          _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), top), half), frac);
+      px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * ch));
+    }
+    const __m256i bytes = _mm256_shuffle_epi8(px, pack);
+    // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
+    const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
+    uint8_t* const out = rgb + 3 * (r.p + k);
+    _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
+    _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
+  }
+  return covered;
+}
+
 #pragma GCC diagnostic pop
 
 #else
@@ -217,6 +266,9 @@ uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64
 }
 size_t bufferRun(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRun: built without the vector kernel");
+}
+uint64_t colourRun(const ColourRun&, const Target&, uint8_t*) {
+  throw std::logic_error("fixed_simd::colourRun: built without the vector kernel");
 }
 
 #endif

@@ -1,8 +1,10 @@
-// phong-fixed's datapath for fragments 8 at a time, in AVX-512 (F, DQ, CD) where
-// the CPU has it: the same integer operations as FixedPointShader::shade() (fixed_shading.h,
-// normalize.h), lane by lane, so the same colours. It covers the common case, one directional
-// light and a lobe of N.H from a table (blinn, pow, normalized-blinn, schlick); everything
-// else, and lanes it cannot take (a squared norm below 2^8, see CosineScale), stays scalar.
+// Fixed-point fragment work 8 fragments at a time, in AVX-512 (F, DQ, CD, VL, BW) where the
+// CPU has it: the z-test and writes of the runs of a row (flat and Gouraud colours; phong-fixed's
+// inputs into a batch), and phong-fixed's datapath, the same integer operations as
+// FixedPointShader::shade() (fixed_shading.h, normalize.h), lane by lane, so the same colours.
+// The datapath covers the common case, one directional light and a lobe of N.H from a table
+// (blinn, pow, normalized-blinn, schlick); everything else, and lanes it cannot take (a squared
+// norm below 2^8, see CosineScale), stays scalar.
 //
 // The 128-bit products of the scalar path become 64-bit lane operations:
 //   m r0^2 >> 32   r0^2 < 2^34 split at 2^32: mq a + (mq b >> 32), each product below 2^64;
@@ -19,7 +21,7 @@
 
 namespace shd::fixed_simd {
 
-// The CPU runs the vector kernel (AVX-512 F, DQ and CD), and SHD_SCALAR is not set in the
+// The CPU runs the vector kernel (AVX-512 F, DQ, CD, VL and BW), and SHD_SCALAR is not set in the
 // environment (which forces the scalar path, for comparisons).
 bool available();
 
@@ -73,6 +75,21 @@ struct Target {
   int32_t tag = 0;
   size_t width = 0;  // pixels per row: the row below a run is prefetched
 };
+
+// A run of flat or Gouraud fragments, left to right: pixels p .. p + count - 1, fragment k with
+// the depth code z + k dz (mod 2^32) and colour codes c[ch] + k dc[ch] (frac fraction bits,
+// 1 <= frac <= 23; the run's codes fit int32_t, as the span unit's do for AttrBits <= 32).
+struct ColourRun {
+  size_t p = 0, count = 0;
+  uint32_t z = 0, dz = 0;
+  std::array<int32_t, 3> c{}, dc{};
+  int frac = 12;
+};
+
+// The run's z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
+// and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch]. Returns the
+// passing pixels whose depth was 0 (not covered before). With the vector kernel only.
+uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb);
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
 // the z-test (the fragment's code above the buffer's), and where it passes the code and the

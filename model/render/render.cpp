@@ -567,6 +567,11 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           tri_of[p] = tag;
           return fresh;
         };
+        // The runs of a row in the vector kernel (fixed_simd.h): left to right, with depth codes
+        // that fit int32_t (AttrBits <= 32).
+        const SpanParams* walker = span.walker();
+        const bool vector_runs = fixed_simd::available() && walker != nullptr && walker->AttrBits <= 32;
+        const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tag), static_cast<size_t>(W)};
         // Flat and Gouraud: z-test, then the interpolated colour codes straight to unorm8 (what
         // combine() gives them).
         auto colourFragment = [write, depth = fb.depth.data(), W, &covered = st.pixels_covered](int32_t x, int32_t y,
@@ -581,7 +586,22 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // registers, the newly covered pixels counted once per run. When the colour codes at
         // both ends of the run lie in [0, 255 2^12] so do all between (they are affine), and
         // unorm8FromCode is the rounding shift alone.
-        auto colourRun = [write, depth = fb.depth.data(), W, &covered = st.pixels_covered](const RowRun& r) {
+        auto colourRun = [write, depth = fb.depth.data(), W, &covered = st.pixels_covered, vector_runs, &target,
+                          rgb = fb.rgb.data()](const RowRun& r) {
+          if (vector_runs && r.dx == 1) {
+            fixed_simd::ColourRun run;
+            run.p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
+            run.count = static_cast<size_t>(r.count);
+            run.z = static_cast<uint32_t>(r.a0[3]);
+            run.dz = static_cast<uint32_t>(r.da[3]);
+            for (size_t k = 0; k < 3; ++k) {
+              run.c[k] = static_cast<int32_t>(r.a0[k]);
+              run.dc[k] = static_cast<int32_t>(r.da[k]);
+            }
+            run.frac = kColourFrac;
+            covered += fixed_simd::colourRun(run, target, rgb);
+            return;
+          }
           const auto put = write;
           const int64_t count = r.count;  // a local: r may alias the pixels' byte stores
           std::array<uint64_t, 3> a, da;
@@ -691,13 +711,10 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           b.n = 0;
         };
         // A run into the batch: z-tested, its depth codes written, its passing fragments'
-        // squared norms and dot products buffered (fixed_simd::bufferRun). Depth codes that may
-        // not fit int32_t (AttrBits above 32) and right-to-left runs take fixedRun.
-        const SpanParams* walker = span.walker();
-        const bool depth_fits = walker != nullptr && walker->AttrBits <= 32;
-        const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tag), static_cast<size_t>(W)};
+        // squared norms and dot products buffered (fixed_simd::bufferRun). Other runs (see
+        // vector_runs) take fixedRun.
         auto batchRun = [&](auto& kernel, const RowRun& r) {
-          if (!depth_fits || r.dx != 1) {
+          if (!vector_runs || r.dx != 1) {
             fixedRun(kernel, r);
             return;
           }
