@@ -108,11 +108,11 @@ inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri&
   else row(std::false_type{});
 }
 
-// singleRow's fragments as one RowRun when they form one: the values singleRow emits at the
-// row's ends, x = lo and x = hi, differ by exactly (hi - lo) times the step. The emitted value
-// is the plane (affine in x) mod 2^AttrBits, so that holds exactly when both ends lie in the
-// same window of 2^AttrBits values; then, the plane being monotonic, so does every value in
-// between, and fragment i shows a0 + i da with no further wrap. (Setup makes every value fit,
+// singleRow's fragments as one RowRun when they form one: the value singleRow emits at x = lo
+// plus (hi - lo) times the step, in exact integers, fits AttrBits. The emitted value is the
+// plane (affine in x) mod 2^AttrBits, so that end is then the value emitted at x = hi, and both
+// ends lie in the same window of 2^AttrBits values; the plane being monotonic, so does every
+// value in between, and fragment i shows a0 + i da with no further wrap. (Setup makes every value fit,
 // so a row that is not one run is a descriptor that setup would not make.) Pixel coordinates:
 // both ends within PixBits, so that the mask changes none.
 template <int KC, int AB, class RunSink>
@@ -130,9 +130,11 @@ inline bool runRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t,
     const uint64_t acc = u(irow[ai]) + u(d.didx[ai]) * u(lo - d.xref);
     const uint64_t step = t.flip ? 0 - u(d.didx[ai]) : u(d.didx[ai]);  // in emission order
     const int64_t v_lo = wrapTo(t.flip ? u(t.aoff[ai]) - acc : acc + u(t.aoff[ai]), bits);
-    const int64_t v_hi = wrapTo(u(v_lo) + step * u(n1), bits);
-    int64_t span = 0;
-    if (__builtin_mul_overflow(static_cast<int64_t>(step), n1, &span) || v_hi - v_lo != span) return false;
+    // The progression's end v_lo + step n1, exactly, lies in the AttrBits range.
+    int64_t span = 0, end = 0;
+    if (__builtin_mul_overflow(static_cast<int64_t>(step), n1, &span) || __builtin_add_overflow(v_lo, span, &end) ||
+        end != wrapTo(u(end), bits))
+      return false;
     a0[ai] = v_lo;
     da[ai] = n1 > 0 ? static_cast<int64_t>(step) : 0;
   }
@@ -164,7 +166,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   const int L = p.LanesPerTri, T = p.NumTri, K = p.NumAttr;
   SpanWalk walk;
   walk.cycles = 1;  // IDLE, accepting the descriptor
-  std::array<SpanDdaState, kMaxLaneTri * 3> e{};
+  std::array<SpanDdaState, kMaxLaneTri * 3> e;  // the first 3 T set here (zeroing all costs more than a row)
   for (int j = 0; j < T; ++j)
     for (int s = 0; s < 3; ++s) {
       const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];
