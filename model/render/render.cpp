@@ -389,6 +389,28 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   // are independent, so the processor overlaps them, where one group per row of 5 or 6 pixels
   // would wait out its own latency.
   auto batch = std::make_unique<fixed_simd::Batch>();
+  // The batch: shaded 8 at a time, the colours written (bufferRun has z-tested its fragments
+  // and written their depth and tag). It collects the runs of several triangles of an object
+  // (the same shader constants), in the order they were z-tested: where two of them cover a
+  // pixel, the second passed the test against the first's depth and its colour is written
+  // last. Everything else that writes a colour at once flushes it first.
+  auto flushBatch = [&](auto& kernel) {
+    fixed_simd::Batch& b = *batch;
+    uint8_t* const rgb[3] = {b.rgb[0].data(), b.rgb[1].data(), b.rgb[2].data()};
+    const size_t n = b.n;  // a local: the pixels' byte stores may alias the batch
+    const uint64_t declined = kernel.shadeBatch(b.sq.data(), b.l.data(), b.h.data(), n, rgb);
+    for (uint64_t g = declined; g != 0; g &= g - 1)
+      for (size_t f = 8 * static_cast<size_t>(__builtin_ctzll(g)), e = std::min(f + 8, n); f < e; ++f) {
+        const std::array<uint8_t, 3> c = fixedColour(kernel.shadeRaw(b.sq[f], b.l[f], b.h[f]));
+        for (size_t k = 0; k < 3; ++k) rgb[k][f] = c[k];
+      }
+    uint8_t* const out = fb.rgb.data();
+    for (size_t f = 0; f < n; ++f) {
+      const size_t p = b.pixel[f];
+      for (size_t k = 0; k < 3; ++k) out[p * 3 + k] = rgb[k][f];
+    }
+    b.n = 0;
+  };
   std::vector<SpecRequest> requests;
   std::vector<size_t> order;
   std::vector<Vec3> bisected;
@@ -570,7 +592,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
         // The runs of a row in the vector kernel (fixed_simd.h): left to right, with depth codes
         // that fit int32_t (AttrBits <= 32).
         const SpanParams* walker = span.walker();
-        const bool vector_runs = fixed_simd::available() && walker != nullptr && walker->AttrBits <= 32;
+        const bool vector_runs = opt.vector_kernel && fixed_simd::available() && walker != nullptr && walker->AttrBits <= 32;
         const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tag), static_cast<size_t>(W)};
         // Flat and Gouraud: z-test, then the interpolated colour codes straight to unorm8 (what
         // combine() gives them).
@@ -690,31 +712,12 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           memo_requests += requests_answered;
           st.pixels_covered += newly;
         };
-        // The batch: shaded 8 at a time, the colours written (bufferRun has z-tested its
-        // fragments and written their depth; the datapath is a pure function, and no two
-        // fragments of a triangle share a pixel, so the order of the writes does not matter).
-        auto flushBatch = [&](auto& kernel) {
-          fixed_simd::Batch& b = *batch;
-          uint8_t* const rgb[3] = {b.rgb[0].data(), b.rgb[1].data(), b.rgb[2].data()};
-          const size_t n = b.n;  // a local: the pixels' byte stores may alias the batch
-          const uint64_t declined = kernel.shadeBatch(b.sq.data(), b.l.data(), b.h.data(), n, rgb);
-          for (uint64_t g = declined; g != 0; g &= g - 1)
-            for (size_t f = 8 * static_cast<size_t>(__builtin_ctzll(g)), e = std::min(f + 8, n); f < e; ++f) {
-              const std::array<uint8_t, 3> c = fixedColour(kernel.shadeRaw(b.sq[f], b.l[f], b.h[f]));
-              for (size_t k = 0; k < 3; ++k) rgb[k][f] = c[k];
-            }
-          uint8_t* const out = fb.rgb.data();
-          for (size_t f = 0; f < n; ++f) {
-            const size_t p = b.pixel[f];
-            for (size_t k = 0; k < 3; ++k) out[p * 3 + k] = rgb[k][f];
-          }
-          b.n = 0;
-        };
         // A run into the batch: z-tested, its depth codes written, its passing fragments'
         // squared norms and dot products buffered (fixed_simd::bufferRun). Other runs (see
         // vector_runs) take fixedRun.
         auto batchRun = [&](auto& kernel, const RowRun& r) {
           if (!vector_runs || r.dx != 1) {
+            if (batch->n > 0) flushBatch(kernel);
             fixedRun(kernel, r);
             return;
           }
@@ -886,9 +889,13 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           else
             fixed->withRunKernel([&](auto& kernel) {
               if constexpr (std::decay_t<decltype(kernel)>::kGroups)
-                if (kernel.vectorised()) {
-                  walkWith(fixedFragment, [&batchRun, &kernel](const RowRun& r) { batchRun(kernel, r); });
-                  flushBatch(kernel);
+                if (opt.vector_kernel && kernel.vectorised()) {
+                  walkWith(
+                      [&](int32_t x, int32_t y, const int64_t* attr) {
+                        if (batch->n > 0) flushBatch(kernel);
+                        fixedFragment(x, y, attr);
+                      },
+                      [&batchRun, &kernel](const RowRun& r) { batchRun(kernel, r); });
                   return;
                 }
               walkWith(fixedFragment, [&fixedRun, kernel](const RowRun& r) mutable { fixedRun(kernel, r); });
@@ -919,6 +926,12 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
               write(pd.pixel, pd.w, combine(pd.lsb, pd.dev_count ? &device_out[pd.dev_first] : nullptr, pd.dev_count));
       }
     }
+    // The object's fragments still in the batch (phong-fixed's vector case: its kernel).
+    if (batch->n > 0)
+      fixed->withRunKernel([&](auto& kernel) {
+        if constexpr (std::decay_t<decltype(kernel)>::kGroups) flushBatch(kernel);
+      });
+    if (batch->n > 0) throw std::logic_error("render: fragments left in the batch of another shader");
   }
   st.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
