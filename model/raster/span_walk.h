@@ -112,9 +112,9 @@ inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri&
 // plus (hi - lo) times the step, in exact integers, fits AttrBits. The emitted value is the
 // plane (affine in x) mod 2^AttrBits, so that end is then the value emitted at x = hi, and both
 // ends lie in the same window of 2^AttrBits values; the plane being monotonic, so does every
-// value in between, and fragment i shows a0 + i da with no further wrap. (Setup makes every value fit,
-// so a row that is not one run is a descriptor that setup would not make.) Pixel coordinates:
-// both ends within PixBits, so that the mask changes none.
+// value in between, and fragment i shows a0 + i da with no further wrap. (Setup makes every
+// value fit, so a row that is not one run is a descriptor that setup would not make.) Pixel
+// coordinates: both ends within PixBits, so that the mask changes none.
 template <int KC, int AB, class RunSink>
 inline bool runRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t w, int64_t lo, int64_t hi,
                    const int64_t* irow, RunSink& emit_run) {
@@ -218,7 +218,9 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     }
     if (!any) return;
     int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
-    std::array<int64_t, kMaxAttr> icur{};  // the first K set here (per row: zeroing it costs more than a row of one lane-triangle)
+    // The first K set here (zeroed per row here, not per descriptor: that costs more than a
+    // row of one lane-triangle).
+    std::array<int64_t, kMaxAttr> icur{};
     for (int a = 0; a < K; ++a) {
       const size_t ai = static_cast<size_t>(a);
       icur[ai] = wrapTo(u(irow[ai]) + u(d.didx[ai]) * u(xg - d.xref), p.AttrBits);

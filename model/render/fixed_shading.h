@@ -159,6 +159,8 @@ class FixedPointShader {
 
  private:
   enum class Cosine { NH, RV, CookTorrance, Device };
+  // The lobe reads N.V (phong's R.V, cook-torrance).
+  static constexpr bool needsNv(Cosine c) { return c == Cosine::RV || c == Cosine::CookTorrance; }
   struct PerLight {
     const CameraLight* light = nullptr;
     std::array<int32_t, 3> l{}, h{};  // Q1.30 (point lights: this pixel's)
@@ -202,6 +204,7 @@ class FixedPointShader {
     //   shadeRaw    one of them in the scalar datapath.
     // Both give what shade() gives.
     static constexpr bool kGroups = C == Cosine::NH && NL == 1;
+    static constexpr bool kNeedsNv = needsNv(C);
     bool vectorised() const { return simd_; }
     uint64_t dotL() const { return l_[0]; }
     uint64_t dotH() const { return h_[0]; }
@@ -219,7 +222,7 @@ class FixedPointShader {
     }
     void start(const int64_t* n0, const int64_t* dn) {
       using fixed_detail::dot58;
-      v_ = static_cast<uint64_t>(dot58(n0, sh_.v_));
+      if constexpr (kNeedsNv) v_ = static_cast<uint64_t>(dot58(n0, sh_.v_));
       for (size_t i = 0; i < NL; ++i) {
         l_[i] = static_cast<uint64_t>(dot58(n0, lights_[i].l));
         h_[i] = static_cast<uint64_t>(dot58(n0, lights_[i].h));
@@ -228,7 +231,7 @@ class FixedPointShader {
       if (dn[0] == dn_[0] && dn[1] == dn_[1] && dn[2] == dn_[2] && have_steps_) return;
       dn_ = {dn[0], dn[1], dn[2]};
       have_steps_ = true;
-      dv_ = static_cast<uint64_t>(dot58(dn, sh_.v_));
+      if constexpr (kNeedsNv) dv_ = static_cast<uint64_t>(dot58(dn, sh_.v_));
       for (size_t i = 0; i < NL; ++i) {
         dl_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].l));
         dh_[i] = static_cast<uint64_t>(dot58(dn, lights_[i].h));
@@ -236,7 +239,7 @@ class FixedPointShader {
     }
     FixedShade shade(uint64_t sqnorm) { return shadeAt(sqnorm, l_.data(), h_.data()); }
     void step() {
-      v_ += dv_;
+      if constexpr (kNeedsNv) v_ += dv_;
       for (size_t i = 0; i < NL; ++i) {
         l_[i] += dl_[i];
         h_[i] += dh_[i];
@@ -313,7 +316,7 @@ template <FixedPointShader::Cosine C>
 inline FixedShade FixedPointShader::shadeAs(const int64_t* n28, uint64_t sqnorm, Vec3 p_cam,
                                             std::vector<SpecRequest>* requests) {
   using fixed_detail::dot58;
-  constexpr bool needs_nv = C == Cosine::RV || C == Cosine::CookTorrance;
+  constexpr bool needs_nv = needsNv(C);
   return shadeDots<C>(
       Consts{ambient_, table_ ? table_->code.data() : nullptr, lights_.data(), lights_.size()}, sqnorm,
       needs_nv ? dot58(n28, v_) : 0,
@@ -331,7 +334,7 @@ inline FixedShade FixedPointShader::shadeDots(const Consts& k, uint64_t sqnorm, 
   FixedShade s;
   s.code = k.ambient;
   const CosineScale sc = cosineScale(sqnorm);
-  constexpr bool needs_nv = C == Cosine::RV || C == Cosine::CookTorrance;
+  constexpr bool needs_nv = needsNv(C);
   const int64_t nv = needs_nv ? scaleCosine(raw_nv, sc) : 0;
   for (size_t li = 0; li < k.count; ++li) {
     PerLight& pl = k.lights[li];

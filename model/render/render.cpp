@@ -385,9 +385,9 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   };
   std::vector<Pending> pend;
   // phong-fixed's fragments in the shader's vector case (one light, a lobe of N.H), z-tested
-  // and buffered from the runs of a triangle and shaded 8 at a time (fixed_simd.h): the groups
-  // are independent, so the processor overlaps them, where one group per row of 5 or 6 pixels
-  // would wait out its own latency.
+  // and buffered from the runs of an object's triangles and shaded 8 at a time (fixed_simd.h):
+  // the groups are independent, so the processor overlaps them, where one group per row of 5
+  // or 6 pixels would wait out its own latency.
   auto batch = std::make_unique<fixed_simd::Batch>();
   // The batch: shaded 8 at a time, the colours written (bufferRun has z-tested its fragments
   // and written their depth and tag). It collects the runs of several triangles of an object
