@@ -73,7 +73,7 @@ struct Target {
   int32_t* depth = nullptr;
   int32_t* tri = nullptr;
   int32_t tag = 0;
-  size_t width = 0;  // pixels per row: the row below a run is prefetched
+  size_t width = 0;  // pixels per row: the row after next is prefetched
 };
 
 // A run of flat or Gouraud fragments, left to right: pixels p .. p + count - 1, fragment k with
