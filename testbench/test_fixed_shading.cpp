@@ -307,7 +307,7 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
     for (size_t k = 0; k < r.count; ++k) {
       const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
       const int pick = static_cast<int>(rng() % 4);
-      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(zk + static_cast<int32_t>(rng() % 5) - 2));
+      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(static_cast<uint32_t>(zk) + static_cast<uint32_t>(rng() % 5) - 2u));
     }
     std::vector<int32_t> want_depth = depth, want_tri = tri;
     // The run loop: z-test, write, and the passing fragments' inputs in order.
@@ -395,7 +395,7 @@ TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
     for (size_t k = 0; k < r.count; ++k) {
       const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
       const int pick = static_cast<int>(rng() % 4);
-      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(zk + static_cast<int32_t>(rng() % 5) - 2));
+      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(static_cast<uint32_t>(zk) + static_cast<uint32_t>(rng() % 5) - 2u));
     }
     std::vector<int32_t> want_depth = depth, want_tri = tri;
     std::vector<uint8_t> want_rgb = rgb;
