@@ -195,7 +195,7 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
 // up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must make it
 // decline the group. Skipped, and said so, on a CPU without AVX-512.
 TEST(FixedSimd, LanesEqualTheScalarDatapath) {
-  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 F/DQ/CD here (or SHD_SCALAR set): the scalar path runs";
+  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 F/DQ/CD/VL/BW here (or SHD_SCALAR set): the scalar path runs";
   std::mt19937_64 rng(12);
   std::normal_distribution<double> g;
   std::uniform_real_distribution<double> u01;
