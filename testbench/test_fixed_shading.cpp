@@ -272,6 +272,55 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
   RecordProperty("lanes", std::to_string(lanes));
 }
 
+namespace {
+
+// The run tests' framebuffer: a run lies within the first kRunPixels pixels; rows of
+// kRunWidth, and room for the prefetches of the row after next.
+constexpr size_t kRunPixels = 64, kRunWidth = 16, kRunBuffer = kRunPixels + 2 * kRunWidth + 8;
+
+// A random run of 1 to 40 pixels from any start offset, its depth codes wrapping mod 2^32
+// (every third run with any step).
+fixed_simd::RunPixels randomRunPixels(std::mt19937_64& rng, int t) {
+  fixed_simd::RunPixels px;
+  px.count = 1 + rng() % 40;
+  px.p = rng() % (kRunPixels - px.count + 1);
+  px.z = static_cast<uint32_t>(rng());
+  px.dz = t % 3 == 0 ? static_cast<uint32_t>(rng()) : static_cast<uint32_t>(static_cast<int64_t>(rng() % 2001) - 1000);
+  return px;
+}
+
+// Fragment k's depth code, as the kernel compares it.
+int32_t depthCode(const fixed_simd::RunPixels& px, size_t k) {
+  return static_cast<int32_t>(px.z + static_cast<uint32_t>(k) * px.dz);
+}
+
+// A depth buffer around the run's codes: each pixel below (passes), equal or above (fails), or
+// 0 (not covered).
+std::vector<int32_t> depthAround(std::mt19937_64& rng, const fixed_simd::RunPixels& px) {
+  std::vector<int32_t> depth(kRunBuffer);
+  for (size_t k = 0; k < px.count; ++k) {
+    const int32_t zk = depthCode(px, k);
+    const int pick = static_cast<int>(rng() % 4);
+    depth[px.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(static_cast<uint32_t>(zk) + static_cast<uint32_t>(rng() % 5) - 2u));
+  }
+  return depth;
+}
+
+// The run loop's z-test of fragment k, with its writes of depth and tag where it passes (and
+// the count of pixels it covers first): true where it passes.
+bool zTestWrite(const fixed_simd::RunPixels& px, size_t k, int32_t tag, std::vector<int32_t>& depth,
+                std::vector<int32_t>& tri, uint64_t& fresh) {
+  const int32_t zk = depthCode(px, k);
+  const size_t p = px.p + k;
+  if (zk <= depth[p]) return false;
+  fresh += depth[p] == 0 ? 1 : 0;
+  depth[p] = zk;
+  tri[p] = tag;
+  return true;
+}
+
+}  // namespace
+
 // fixed_simd::bufferRun against the run loop it replaces, fragment by fragment: runs of 1 to
 // 40 pixels from every start offset, over depth buffers holding codes above, below and equal
 // to the run's (and 0, not covered), with depth codes and steps that wrap mod 2^32, squared
@@ -280,15 +329,11 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
 TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR set): the scalar path runs";
   std::mt19937_64 rng(21);
-  constexpr size_t kPixels = 64, kWidth = 16;
   auto batch = std::make_unique<fixed_simd::Batch>();
   uint64_t fragments = 0, passed = 0, stops = 0;
   for (int t = 0; t < 20000; ++t) {
     fixed_simd::Run r;
-    r.count = 1 + rng() % 40;
-    r.p = rng() % (kPixels - r.count + 1);
-    r.z = static_cast<uint32_t>(rng());
-    r.dz = t % 3 == 0 ? static_cast<uint32_t>(rng()) : static_cast<uint32_t>(static_cast<int64_t>(rng() % 2001) - 1000);
+    r.px = randomRunPixels(rng, t);
     std::array<int64_t, 3> n0{}, dn{};
     for (size_t k = 0; k < 3; ++k) {
       n0[k] = static_cast<int64_t>(rng() % (uint64_t{1} << 32)) - (int64_t{1} << 31);
@@ -302,31 +347,20 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
     r.dl = rng();
     r.h = rng();
     r.dh = rng();
-    // Depth around the run's codes: each pixel below (passes), equal or above (fails), or 0.
-    std::vector<int32_t> depth(kPixels + 2 * kWidth + 8), tri(depth.size(), -1);
-    for (size_t k = 0; k < r.count; ++k) {
-      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
-      const int pick = static_cast<int>(rng() % 4);
-      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(static_cast<uint32_t>(zk) + static_cast<uint32_t>(rng() % 5) - 2u));
-    }
+    std::vector<int32_t> depth = depthAround(rng, r.px), tri(depth.size(), -1);
     std::vector<int32_t> want_depth = depth, want_tri = tri;
     // The run loop: z-test, write, and the passing fragments' inputs in order.
     std::vector<std::array<uint64_t, 4>> want;  // sq, l, h, pixel
     uint64_t want_fresh = 0;
     SquaredNormRecurrence rec;
     uint64_t f = rec.start(n0, dn);
-    for (size_t k = 0; k < r.count; ++k) {
+    for (size_t k = 0; k < r.px.count; ++k) {
       if (k > 0) f = rec.next();
-      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
-      const size_t p = r.p + k;
-      if (zk <= want_depth[p]) continue;
-      want_fresh += want_depth[p] == 0 ? 1 : 0;
-      want_depth[p] = zk;
-      want_tri[p] = 7;
-      want.push_back({f, r.l + k * r.dl, r.h + k * r.dh, p});
+      if (zTestWrite(r.px, k, 7, want_depth, want_tri, want_fresh))
+        want.push_back({f, r.l + k * r.dl, r.h + k * r.dh, r.px.p + k});
     }
     // bufferRun, from a batch already filled to a random level, emptied when it stops.
-    const fixed_simd::Target target{depth.data(), tri.data(), 7, kWidth};
+    const fixed_simd::Target target{depth.data(), tri.data(), 7, kRunWidth};
     batch->n = rng() % (fixed_simd::Batch::kCap + 1);
     if (batch->n > fixed_simd::Batch::kCap - 8 && t % 2 == 0) batch->n = fixed_simd::Batch::kCap - 8 - rng() % 16;
     std::vector<std::array<uint64_t, 4>> got;
@@ -335,10 +369,10 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
       const size_t n0_batch = batch->n;
       const size_t next = fixed_simd::bufferRun(r, k, target, *batch, fresh);
       ASSERT_GE(next, k);
-      ASSERT_LE(next, r.count);
+      ASSERT_LE(next, r.px.count);
       ASSERT_LE(batch->n, fixed_simd::Batch::kCap);
       for (size_t i = n0_batch; i < batch->n; ++i) got.push_back({batch->sq[i], batch->l[i], batch->h[i], batch->pixel[i]});
-      if (next == r.count) break;
+      if (next == r.px.count) break;
       ASSERT_GT(batch->n + 8, fixed_simd::Batch::kCap) << "stopped with room for 8";
       ++stops;
       batch->n = 0;
@@ -349,7 +383,7 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
     ASSERT_EQ(fresh, want_fresh) << "run " << t;
     ASSERT_EQ(got.size(), want.size()) << "run " << t;
     for (size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], want[i]) << "run " << t << " fragment " << i;
-    fragments += r.count;
+    fragments += r.px.count;
     passed += want.size();
   }
   // Both outcomes of the z-test and of the batch's room, many times each.
@@ -365,14 +399,10 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
 TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
   if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR set): the scalar path runs";
   std::mt19937_64 rng(22);
-  constexpr size_t kPixels = 64, kWidth = 16;
   uint64_t fragments = 0, passed = 0, clamped = 0;
   for (int t = 0; t < 20000; ++t) {
     fixed_simd::ColourRun r;
-    r.count = 1 + rng() % 40;
-    r.p = rng() % (kPixels - r.count + 1);
-    r.z = static_cast<uint32_t>(rng());
-    r.dz = t % 3 == 0 ? static_cast<uint32_t>(rng()) : static_cast<uint32_t>(static_cast<int64_t>(rng() % 2001) - 1000);
+    r.px = randomRunPixels(rng, t);
     r.frac = std::array<int, 5>{1, 5, 12, 12, 23}[rng() % 5];
     const int64_t top = int64_t{255} << r.frac;
     std::array<int64_t, 3> step{};
@@ -385,28 +415,19 @@ TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
       };
       const int64_t c0 = pick(), c1 = pick();
       // The step mod 2^32, as the span unit's (exact where the codes are: they fit int32_t).
-      step[ch] = r.count > 1 ? (c1 - c0) / static_cast<int64_t>(r.count - 1) : 0;
+      step[ch] = r.px.count > 1 ? (c1 - c0) / static_cast<int64_t>(r.px.count - 1) : 0;
       r.c[ch] = static_cast<int32_t>(c0);
       r.dc[ch] = static_cast<int32_t>(static_cast<uint32_t>(step[ch]));
     }
-    std::vector<int32_t> depth(kPixels + 2 * kWidth + 8), tri(depth.size(), -1);
-    std::vector<uint8_t> rgb(3 * depth.size());
+    std::vector<uint8_t> rgb(3 * kRunBuffer);
     for (uint8_t& b : rgb) b = static_cast<uint8_t>(rng());
-    for (size_t k = 0; k < r.count; ++k) {
-      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
-      const int pick = static_cast<int>(rng() % 4);
-      depth[r.p + k] = pick == 0 ? 0 : (pick == 1 ? zk : static_cast<int32_t>(static_cast<uint32_t>(zk) + static_cast<uint32_t>(rng() % 5) - 2u));
-    }
+    std::vector<int32_t> depth = depthAround(rng, r.px), tri(depth.size(), -1);
     std::vector<int32_t> want_depth = depth, want_tri = tri;
     std::vector<uint8_t> want_rgb = rgb;
     uint64_t want_fresh = 0;
-    for (size_t k = 0; k < r.count; ++k) {
-      const auto zk = static_cast<int32_t>(r.z + static_cast<uint32_t>(k) * r.dz);
-      const size_t p = r.p + k;
-      if (zk <= want_depth[p]) continue;
-      want_fresh += want_depth[p] == 0 ? 1 : 0;
-      want_depth[p] = zk;
-      want_tri[p] = 9;
+    for (size_t k = 0; k < r.px.count; ++k) {
+      if (!zTestWrite(r.px, k, 9, want_depth, want_tri, want_fresh)) continue;
+      const size_t p = r.px.p + k;
       for (size_t ch = 0; ch < 3; ++ch) {
         const int64_t code = int64_t{r.c[ch]} + static_cast<int64_t>(k) * step[ch];
         clamped += code < 0 || code > top ? 1 : 0;
@@ -414,14 +435,14 @@ TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
       }
       ++passed;
     }
-    const fixed_simd::Target target{depth.data(), tri.data(), 9, kWidth};
+    const fixed_simd::Target target{depth.data(), tri.data(), 9, kRunWidth};
     const uint64_t fresh = fixed_simd::colourRun(r, target, rgb.data());
     ASSERT_EQ(depth, want_depth) << "run " << t;
     ASSERT_EQ(tri, want_tri) << "run " << t;
     for (size_t i = 0; i < rgb.size(); ++i)
       ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << "run " << t << " frac " << r.frac << " byte " << i;
     ASSERT_EQ(fresh, want_fresh) << "run " << t;
-    fragments += r.count;
+    fragments += r.px.count;
   }
   EXPECT_GT(passed, fragments / 4);
   EXPECT_LT(passed, fragments * 3 / 4);

@@ -150,18 +150,19 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
   return true;
 }
 
-// The z-test of pixels p + k .. p + k + 7 of a run (the first m of them exist): the depth codes
-// z + (k + i) dz (mod 2^32) against the buffer's, and where they pass the codes and the tag
-// written. Returns the passing lanes; adds to fresh those whose depth was 0. The accesses are
-// 8 lanes wide (32 bytes): wider ones, even with their lanes masked off, would overlap the next
-// step's and stall its load behind this store.
-SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t k, unsigned m, uint32_t z, uint32_t dz,
-                                  uint64_t& fresh) {
-  const __mmask8 valid = static_cast<__mmask8>((1u << m) - 1);
-  const __m256i zk = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(z + static_cast<uint32_t>(k) * dz)),
-                                      _mm256_mullo_epi32(_mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0),
-                                                         _mm256_set1_epi32(static_cast<int32_t>(dz))));
-  int32_t* const depth = t.depth + p + k;
+// Lanes 0 .. 7 as 32-bit values.
+SHD_AVX512 inline __m256i lanes8() { return _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0); }
+
+// The z-test of fragments k .. k + 7 of a run (those below px.count): their depth codes
+// against the buffer's, and where they pass the codes and the tag written. Returns the passing
+// lanes; adds to fresh those whose depth was 0. The accesses are 8 lanes wide (32 bytes): wider
+// ones, even with their lanes masked off, would overlap the next step's and stall its load
+// behind this store.
+SHD_AVX512 inline __mmask8 zTest8(const Target& t, const RunPixels& px, size_t k, uint64_t& fresh) {
+  const __mmask8 valid = static_cast<__mmask8>((1u << std::min<size_t>(8, px.count - k)) - 1);
+  const __m256i zk = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(px.z + static_cast<uint32_t>(k) * px.dz)),
+                                      _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(px.dz))));
+  int32_t* const depth = t.depth + px.p + k;
   // The row after next, most likely this triangle's: its depth in the cache by then.
   __builtin_prefetch(depth + 2 * t.width);
   __builtin_prefetch(depth + 2 * t.width + 7);
@@ -169,7 +170,7 @@ SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t k, unsigned 
   const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, zk, old);
   fresh += static_cast<uint64_t>(__builtin_popcount(_mm256_mask_cmpeq_epi32_mask(pass, old, _mm256_setzero_si256())));
   _mm256_mask_storeu_epi32(depth, pass, zk);
-  _mm256_mask_storeu_epi32(t.tri + p + k, pass, _mm256_set1_epi32(t.tag));
+  _mm256_mask_storeu_epi32(t.tri + px.p + k, pass, _mm256_set1_epi32(t.tag));
   return pass;
 }
 
@@ -200,16 +201,15 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
   size_t n = b.n, k = first;
   uint64_t covered = 0;
-  for (; k < r.count && n + 8 <= Batch::kCap; k += 8) {
-    const __mmask8 pass = zTest8(t, r.p, k, static_cast<unsigned>(std::min<size_t>(8, r.count - k)), r.z, r.dz, covered);
+  for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
+    const __mmask8 pass = zTest8(t, r.px, k, covered);
     // Fragments k .. k + 7 in 64-bit lanes (k < 2^32).
     const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
     const __m512i sq =
         _mm512_add_epi64(_mm512_add_epi64(a, _mm512_mullo_epi64(kv, two_b)), _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
     const __m512i l = _mm512_add_epi64(l0, _mm512_mullo_epi64(kv, dl));
     const __m512i h = _mm512_add_epi64(h0, _mm512_mullo_epi64(kv, dh));
-    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.p + k)),
-                                           _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0));
+    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.p + k)), lanes8());
     // The passing lanes, packed (the register forms of compress: the memory forms are slow on
     // some CPUs), stored 8 entries wide.
     _mm512_storeu_si512(b.sq.data() + n, _mm512_maskz_compress_epi64(pass, sq));
@@ -220,11 +220,10 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   }
   b.n = n;
   fresh += covered;
-  return std::min(k, r.count);
+  return std::min(k, r.px.count);
 }
 
 SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb) {
-  const __m256i lane = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
   const __m128i frac = _mm_cvtsi32_si128(r.frac);
   const __m256i top = _mm256_set1_epi32(255 << r.frac), half = _mm256_set1_epi32(1 << (r.frac - 1));
   // Within each 128-bit half: pixels' bytes r g b (of 32-bit lanes r | g << 8 | b << 16) packed
@@ -232,15 +231,15 @@ SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb)
   const __m256i pack = _mm256_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1,  //
                                         0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1);
   uint64_t covered = 0;
-  for (size_t k = 0; k < r.count; k += 8) {
-    const __mmask8 pass = zTest8(t, r.p, k, static_cast<unsigned>(std::min<size_t>(8, r.count - k)), r.z, r.dz, covered);
+  for (size_t k = 0; k < r.px.count; k += 8) {
+    const __mmask8 pass = zTest8(t, r.px, k, covered);
     if (pass == 0) continue;
     __m256i px = _mm256_setzero_si256();
     for (int ch = 0; ch < 3; ++ch) {
       // unorm8FromCode: the code clamped to [0, 255 2^frac], rounded half up to an integer.
       const __m256i code = _mm256_add_epi32(
           _mm256_set1_epi32(static_cast<int32_t>(static_cast<uint32_t>(r.c[ch]) + static_cast<uint32_t>(k) * static_cast<uint32_t>(r.dc[ch]))),
-          _mm256_mullo_epi32(lane, _mm256_set1_epi32(r.dc[ch])));
+          _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(r.dc[ch])));
       const __m256i u8 = _mm256_srl_epi32(
           _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), top), half), frac);
       px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * ch));
@@ -248,7 +247,7 @@ SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb)
     const __m256i bytes = _mm256_shuffle_epi8(px, pack);
     // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
     const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
-    uint8_t* const out = rgb + 3 * (r.p + k);
+    uint8_t* const out = rgb + 3 * (r.px.p + k);
     _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
     _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
   }

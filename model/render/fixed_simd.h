@@ -56,12 +56,17 @@ struct Batch {
   size_t n = 0;
 };
 
-// A run of a row, left to right: framebuffer pixels p .. p + count - 1, fragment k with the
-// depth code z + k dz (mod 2^32), the squared norm a + k two_b + k^2 c
-// (SquaredNormRecurrence::Terms) and the raw dot products l + k dl, h + k dh (mod 2^64).
-struct Run {
+// The pixels of a run of a row, left to right: framebuffer pixels p .. p + count - 1, fragment
+// k with the depth code z + k dz (mod 2^32).
+struct RunPixels {
   size_t p = 0, count = 0;
   uint32_t z = 0, dz = 0;
+};
+
+// A phong-fixed run: fragment k of px with the squared norm a + k two_b + k^2 c
+// (SquaredNormRecurrence::Terms) and the raw dot products l + k dl, h + k dh (mod 2^64).
+struct Run {
+  RunPixels px;
   uint64_t a = 0, two_b = 0, c = 0;
   uint64_t l = 0, dl = 0, h = 0, dh = 0;
 };
@@ -76,12 +81,11 @@ struct Target {
   size_t width = 0;  // pixels per row: the row after next is prefetched
 };
 
-// A run of flat or Gouraud fragments, left to right: pixels p .. p + count - 1, fragment k with
-// the depth code z + k dz (mod 2^32) and colour codes c[ch] + k dc[ch] (frac fraction bits,
-// 1 <= frac <= 23; the run's codes fit int32_t, as the span unit's do for AttrBits <= 32).
+// A run of flat or Gouraud fragments: fragment k of px with the colour codes c[ch] + k dc[ch]
+// (frac fraction bits, 1 <= frac <= 23; the run's codes fit int32_t, as the span unit's do for
+// AttrBits <= 32).
 struct ColourRun {
-  size_t p = 0, count = 0;
-  uint32_t z = 0, dz = 0;
+  RunPixels px;
   std::array<int32_t, 3> c{}, dc{};
   int frac = 12;
 };

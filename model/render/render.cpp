@@ -612,10 +612,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                           rgb = fb.rgb.data()](const RowRun& r) {
           if (vector_runs && r.dx == 1) {
             fixed_simd::ColourRun run;
-            run.p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
-            run.count = static_cast<size_t>(r.count);
-            run.z = static_cast<uint32_t>(r.a0[3]);
-            run.dz = static_cast<uint32_t>(r.da[3]);
+            run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0),
+                      static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])};
             for (size_t k = 0; k < 3; ++k) {
               run.c[k] = static_cast<int32_t>(r.a0[k]);
               run.dc[k] = static_cast<int32_t>(r.da[k]);
@@ -724,10 +722,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           kernel.start(r.a0, r.da);
           const auto sq = SquaredNormRecurrence::terms({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
           fixed_simd::Run run;
-          run.p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
-          run.count = static_cast<size_t>(r.count);
-          run.z = static_cast<uint32_t>(r.a0[3]);
-          run.dz = static_cast<uint32_t>(r.da[3]);
+          run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0),
+                    static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])};
           run.a = sq.a;
           run.two_b = sq.two_b;
           run.c = sq.c;
@@ -736,7 +732,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
           run.h = kernel.dotH();
           run.dh = kernel.stepH();
           uint64_t newly = 0;
-          for (size_t k = 0; (k = fixed_simd::bufferRun(run, k, target, *batch, newly)) < run.count;) flushBatch(kernel);
+          for (size_t k = 0; (k = fixed_simd::bufferRun(run, k, target, *batch, newly)) < run.px.count;) flushBatch(kernel);
           st.pixels_covered += newly;
         };
         // biquadratic: the exactly shaded colours at the edge midpoints (screen space).
