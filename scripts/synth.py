@@ -1,0 +1,522 @@
+#!/usr/bin/env python3
+"""synth.py: synthesise one specular-unit or span-unit configuration with yosys for iCE40 and/or
+Xilinx 7-series and report its area.
+
+Usage: scripts/synth.py CONFIG [--unit spec|span] [--prom FILE] [--out DIR]
+                        [--target ice40|xc7|both] [--check]
+
+CONFIG is a configuration file (<unit>_<name>.json; --unit names the unit of a file named
+otherwise) or "<unit>:<name>" of the registry vectors/config/ (scripts/shd_config.py reads it:
+`shd_config.py list` prints the registry). The unit decides the top module and the RTL files:
+spec is shd_spec_unit (rtl/shd_spec_unit.v, shd_coef_rom.v, shd_pipe_reg.v), span is
+shd_span_unit (rtl/shd_span_unit.v). Everything below is about the spec unit except where "A span
+configuration" says otherwise.
+  --prom    the PROM ($readmemh hex file). Default: the repository's vectors/prom/spec_<name>.hex
+            when it exists and CONFIG is the registry's configuration of that name (the same JSON);
+            otherwise make one with `shadesim prom --config CONFIG --format hex -o FILE` and pass
+            --prom FILE.
+  --out     the output directory, default out/synth/<unit>_<name> of the repository (in an
+            installation that is under <prefix>/share/shadesim: pass --out there).
+  --target  ice40, xc7 or both (the default).
+The rtl/, vectors/ and scripts/ directories are found relative to this script (the source tree,
+or an installation's <prefix>/share/shadesim with the same layout), never via the current
+directory.
+
+The "rtl" object of the configuration becomes one `chparam -set Name Value ... shd_spec_unit`
+(one command: separate chparams elaborate the module once per parameter, with old and new values
+mixed, and yosys warns about out-of-range selects in those intermediate modules); the PROM
+becomes RomFile, an absolute path (yosys reads it at elaboration: `initial $readmemh` under
+SYNTHESIS). The PROM must hold exactly 2^ShinBits words of the configuration's word width.
+Paths travel inside yosys commands (RomFile as a Verilog string), so the PROM, the output
+directory and the RTL directory must not contain whitespace, quotes, backslashes or ';'.
+Flows:
+  ice40  synth_ice40 -dsp                                  (flattens by default)
+  xc7    synth_xilinx -family xc7 -flatten -noiopad -noclkbuf
+         -flatten so both targets are counted the same way; -noiopad -noclkbuf because the unit
+         is a block inside a design, not a chip top (IBUF/OBUF/BUFG would be ~100 cells of noise).
+
+Output (in --out; every file is written under a temporary name and renamed):
+  <target>_stat.json  yosys `stat -json` of the synthesised netlist
+  <target>.log        the full yosys log
+  summary.json        {"config", "config_file", "prom_file", "yosys", "rtl": {...}, "prom": {...},
+                       "targets": {"<target>": {luts, ffs, carries, dsps, brams, bram_kbits,
+                       cells_total, wall_s, cells_by_type, expected, checks}}}
+    luts        iCE40 SB_LUT4; xc7 LUT1..LUT6 plus INV (yosys's name for an inverting LUT1)
+    ffs         every flip-flop primitive (SB_DFF*, FD*)
+    carries     iCE40 SB_CARRY (one per bit); xc7 CARRY4 (one per 4 bits): not comparable
+    dsps        SB_MAC16 / DSP48E1
+    brams       block-RAM primitives (SB_RAM40_4K*, RAMB18E1, RAMB36E1); bram_kbits their capacity
+    cells_total every cell of the netlist
+    wall_s      wall time of the yosys run
+
+--check makes the run fail (exit 1) unless the netlist is what the RTL is meant to become:
+  rom_bram  The PROM is entirely in block RAM, and in the least block RAM its contents need.
+            yosys drops PROM bit columns that are constant over all 2^ShinBits words, so the
+            geometry is depth 2^ShinBits x (columns that vary in the hex file). iCE40: the
+            SB_RAM40_4K count equals min over its read modes 256x16, 512x8, 1024x4, 2048x2 of
+            ceil(depth/d)*ceil(width/w). xc7: the capacity in kbit equals the least one over the
+            RAMB18E1 (16384x1 .. 512x36) and RAMB36E1 (32768x1 .. 512x72) aspect ratios (yosys
+            may pick either primitive when they tie, so kbit is compared, not the count). Also:
+            no $mem cell and no distributed-RAM/ROM primitive is left. Fails when the ROM falls
+            into LUTs (rom_style = "logic", an asynchronous read) or is duplicated.
+  dsps      The DSP count equals what the multipliers need. Operand widths come from the RTL
+            header's derivation (uQ1.Wc: CW = Wc+1; KW = Ci+Cf; DTW = Df-1; GTW = Ci+1+Hf;
+            FW = Wf+1; L = LightBits):
+              MUL1     c*c           CW x CW unsigned
+              MUL2     deg 2: a*dt   (KW+1) x DTW signed (a is unsigned: one zero sign bit)
+                       deg 3: gt*dt  GTW x DTW signed
+              Horner   deg 3: u*c    KW x (CW+1) signed
+              MUL3..5  f*L           FW x L unsigned (three of them)
+            and each is tiled the way yosys's share/mul2dsp.v does it (iCE40: 16x16 tiles;
+            pieces narrower than 2 bits or with a product under 11 bits go to LUTs. xc7:
+            signed-only 25x18 tiles, 17-bit A slices, products under 9 bits to LUTs). Fails
+            when a multiplier stays in LUTs or is wider than the derivation (e.g. a manual sign
+            extension that wreduce cannot remove costs whole extra DSP tiles).
+  warnings  yosys printed no warning except the known harmless ones in KNOWN_WARNINGS below
+            (multiple drivers, a memory turned into registers, a bad $readmemh are caught).
+
+A span configuration (vectors/config/span_<mode>.json): the span unit shd_span_unit with the
+configuration's "rtl" object; no PROM (--prom is an error), summary.json has "top" and no
+"prom_file"/"prom". Its --check has these checks instead of rom_bram:
+  dsps      The only multiplier is the row start icur = irow + didx*(xg - xref), one per
+            attribute: AttrBits x (CoordBits+1) signed, of which the low AttrBits are used
+            (the plane wraps at AttrBits). The DSP count equals NumAttr times its mul2dsp.v
+            tiling as above. Fails when the lanes' i*didx (constant multiples, built from
+            shifts and adds) or the LanesPerTri*didx step turn into multipliers, or the row
+            multiply stays in LUTs.
+  latches   proc_dlatch inferred no latch (the comb blocks assign every output on every path).
+  no_mem    no $mem cell, block RAM or distributed RAM: the unit is registers and logic only.
+  warnings  as above.
+
+Exit status: 0 success, 1 a failed check, 2 a usage or input error, 3 yosys failed.
+"""
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+HERE = os.path.dirname(os.path.realpath(__file__))
+sys.dont_write_bytecode = True  # no __pycache__ in scripts/ (a source tree or an installation)
+sys.path.insert(0, HERE)
+import shd_config  # noqa: E402  (found next to this script)
+
+ROOT = os.path.dirname(HERE)  # the source tree, or <prefix>/share/shadesim
+PROG = "synth.py"
+
+# The parameters the checks below use; the configuration must define them.
+REQUIRED = {
+    "spec": ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
+             "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"],
+    "span": ["NumTri", "LanesPerTri", "AlignLanes", "NumAttr", "AttrBits",
+             "CoordBits", "RemBits", "PixBits", "TagBits"],
+}
+
+FLOWS = {
+    "ice40": "synth_ice40 -dsp",
+    "xc7": "synth_xilinx -family xc7 -flatten -noiopad -noclkbuf",
+}
+
+# Warnings seen in clean runs and known to be harmless.
+KNOWN_WARNINGS = [
+    # abc on a module or cone with no latches.
+    r"ABC: Warning: The network is combinational",
+    # xc7 block-RAM mapping: yosys declares the RAMB18E1/RAMB36E1 data and address ports at
+    # their widest (TDP data, cascade address) and trims them to the mode it used; nothing is lost.
+    r"Warning: Resizing cell port .*\.(DOADO|DOBDO|DOPADOP|DOPBDOP|DIADI|DIBDI|DIPADIP|DIPBDIP"
+    r"|ADDRARDADDR|ADDRBWRADDR) from \d+ bits to \d+ bits\.",
+]
+
+# mul2dsp.v parameters as synth_ice40 -dsp and synth_xilinx -family xc7 pass them (yosys 0.23).
+TECH = {
+    "ice40": dict(amax=16, bmax=16, apart=16, bpart=16, amin=2, bmin=2, ymin=11, signed_only=False),
+    "xc7": dict(amax=25, bmax=18, apart=18, bpart=18, amin=2, bmin=2, ymin=9, signed_only=True),
+}
+
+
+class InputError(Exception):
+    """A usage or input error: exit status 2."""
+
+
+class YosysError(Exception):
+    """yosys failed: exit status 3."""
+
+
+def plain_path(what, path):
+    """Paths travel inside yosys commands (RomFile as a Verilog string): keep them plain."""
+    if not re.fullmatch(r"[^\s\"\\;]+", path):
+        raise InputError(f"{what} path '{path}' must not contain whitespace, quotes, "
+                         f"backslashes or ';'")
+
+
+# ---------------------------------------------------------------- configuration and PROM
+
+def load_config(ref, unit):
+    """The configuration CONFIG names (a file or <unit>:<name>), with the parameters checked."""
+    try:
+        c = shd_config.resolve(ref, [shd_config.DEFAULT_DIR], unit)
+    except shd_config.ConfigError as e:
+        raise InputError(str(e))
+    if c.unit is None:
+        raise InputError(f"{ref}: name the unit (--unit spec|span)")
+    if unit is not None and c.unit != unit:
+        raise InputError(f"{ref} is a {c.unit} configuration, not {unit} (--unit {unit})")
+    for name in REQUIRED[c.unit]:
+        if name not in c.rtl:
+            raise InputError(f"{c.path}: rtl.{name} is missing")
+    return c
+
+
+def default_prom(c, ref):
+    """The repository's PROM of a registry spec configuration, or an InputError."""
+    path = os.path.join(ROOT, "vectors", "prom", f"spec_{c.name}.hex")
+    how = (f"make one with 'shadesim prom --config {ref} --format hex -o <file>' "
+           f"and pass --prom <file>")
+    if not os.path.isfile(path):
+        raise InputError(f"no PROM for spec:{c.name} ({path} does not exist): {how}")
+    registry_file = os.path.join(shd_config.DEFAULT_DIR, f"spec_{c.name}.json")
+    try:
+        with open(registry_file, encoding="utf-8") as f:
+            same = json.loads(f.read()) == json.loads(c.text)
+    except (OSError, ValueError):
+        same = False
+    if not same:
+        raise InputError(f"{c.path} is not the registry's configuration spec:{c.name}, so "
+                         f"{path} may not be its PROM: {how}")
+    return path
+
+
+def prom_geometry(path, p):
+    """(depth, word bits, bit columns that vary) of a $readmemh file; fails on a malformed one."""
+    depth = 1 << p["ShinBits"]
+    kw = p["CoefIntBits"] + p["CoefFracBits"]
+    word_bits = kw if p["Degree"] == 2 else 2 * kw + p["CosFracBits"] + 1
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(f"{path}: cannot read the PROM: {getattr(e, 'strerror', None) or e}")
+    text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
+    text = re.sub(r"//[^\n]*", " ", text)
+    words, addr = {}, 0
+    for tok in text.split():
+        if tok.startswith("@"):
+            if re.fullmatch(r"@[0-9a-fA-F_]+", tok) is None:
+                raise InputError(f"{path}: '{tok}' is not a hex address")
+            addr = int(tok[1:].replace("_", ""), 16)
+            continue
+        if addr >= depth:
+            raise InputError(f"{path}: more than {depth} words (2^ShinBits)")
+        if re.fullmatch(r"[0-9a-fA-F_]+", tok) is None:
+            raise InputError(f"{path}: '{tok}' is not a hex word")
+        v = int(tok.replace("_", ""), 16)
+        if v >> word_bits:
+            raise InputError(f"{path}: word {tok} at address {addr} exceeds {word_bits} bits")
+        words[addr] = v
+        addr += 1
+    if len(words) != depth:
+        raise InputError(f"{path}: {len(words)} words, the unit needs {depth} (2^ShinBits)")
+    vals = list(words.values())
+    varying = sum(1 for b in range(word_bits) if len({(v >> b) & 1 for v in vals}) > 1)
+    return depth, word_bits, varying
+
+
+# ---------------------------------------------------------------- yosys
+
+def run_yosys(c, tgt, rtl_files, chparams, prom, out):
+    """Synthesises for one target; writes <tgt>.log and <tgt>_stat.json; returns the wall time."""
+    top = c.top
+    log = os.path.join(out, f"{tgt}.log")
+    stat = os.path.join(out, f"{tgt}_stat.json")
+    rom = f' -set RomFile "{prom}"' if c.unit == "spec" else ""
+    script = "\n".join([
+        f"read_verilog -defer {' '.join(rtl_files)}",
+        f"chparam {chparams}{rom} {top}",
+        f"hierarchy -check -top {top}",
+        f"{FLOWS[tgt]} -top {top}",
+        f"tee -q -o {stat}.tmp stat -json",
+    ])
+    for f in (stat + ".tmp", log + ".tmp"):
+        if os.path.exists(f):
+            os.remove(f)
+    t0 = time.monotonic()
+    r = subprocess.run(["yosys", "-q", "-l", log + ".tmp", "-p", script],
+                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    wall = time.monotonic() - t0
+    if os.path.exists(log + ".tmp"):
+        os.replace(log + ".tmp", log)
+    if r.returncode != 0:
+        if os.path.exists(stat + ".tmp"):
+            os.remove(stat + ".tmp")
+        lines = []
+        if os.path.exists(log):
+            with open(log, errors="replace") as f:
+                lines = [l.rstrip("\n") for l in f if "ERROR" in l][:5]
+        if not lines:
+            lines = r.stderr.decode(errors="replace").splitlines()[-20:]
+        raise YosysError("\n".join([f"yosys failed for {c.name} / {tgt} (full log: {log}):"]
+                                   + lines))
+    os.replace(stat + ".tmp", stat)
+    return float(f"{wall:.2f}")
+
+
+# ---------------------------------------------------------------- the checks
+
+def tiles(t, aw, bw, asg, bsg, yw, cell="$mul"):
+    """DSP primitives mul2dsp.v makes of one $mul/$__mul cell (it recurses on its own pieces)."""
+    if aw < t["amin"] or bw < t["bmin"] or yw < t["ymin"]:
+        return 0                                   # _TECHMAP_FAIL_: left to LUTs
+    if t["signed_only"] and cell == "$mul" and not asg and not bsg:
+        return tiles(t, aw + 1, bw + 1, True, True, yw, "$mul")
+    if cell == "$mul" and aw < bw:
+        return tiles(t, bw, aw, bsg, asg, yw, "$mul")
+    h = 1 if t["signed_only"] else 0               # sign_headroom
+    if aw > t["amax"]:
+        step = t["apart"] - h
+        n = (aw - t["amax"] + step - 1) // step
+        last = aw - n * step
+        return (n * tiles(t, t["apart"], bw, bool(h), bsg, min(yw, bw + t["apart"]), "$__mul")
+                + tiles(t, last, bw, asg, bsg, bw + last, "$__mul"))
+    if bw > t["bmax"]:
+        step = t["bpart"] - h
+        n = (bw - t["bmax"] + step - 1) // step
+        last = bw - n * step
+        return (n * tiles(t, aw, t["bpart"], asg, bool(h), min(yw, aw + t["bpart"]), "$__mul")
+                + tiles(t, aw, last, asg, bsg, aw + last, "$__mul"))
+    return 1
+
+
+def multipliers(unit, p):
+    """(name, a bits, b bits, a signed, b signed, product bits used) per multiplier."""
+    if unit == "span":
+        # icur = irow + didx*(xg - xref): AttrBits x (CoordBits+1) signed, low AttrBits used.
+        return [(f"row start didx{a}*(xg-xref)", p["AttrBits"], p["CoordBits"] + 1, True, True,
+                 p["AttrBits"]) for a in range(p["NumAttr"])]
+    wc = p["CosFracBits"]
+    cw = wc + 1
+    kw = p["CoefIntBits"] + p["CoefFracBits"]
+    dtw = p["DiffFracBits"] - 1
+    gtw = p["CoefIntBits"] + 1 + p["HornerFracBits"]
+    fw = p["SpecFracBits"] + 1
+    lb = p["LightBits"]
+    m = [("MUL1 c*c", cw, cw, False, False, 2 * wc - 1)]      # only c^2 - c's bits are used
+    if p["Degree"] == 2:
+        m.append(("MUL2 a*dt", kw + 1, dtw, True, True, kw + dtw))
+    else:
+        m.append(("Horner u*c", kw, cw + 1, True, True, kw + wc))
+        m.append(("MUL2 gt*dt", gtw, dtw, True, True, gtw + dtw))
+    for k, ch in enumerate("RGB"):
+        m.append((f"MUL{3 + k} f*L{ch}", fw, lb, False, False, fw - 1 + lb))
+    return m
+
+
+def ice40_brams(d_need, w_need):
+    if w_need == 0:
+        return 0
+    return min(math.ceil(d_need / d) * math.ceil(w_need / w)
+               for d, w in [(256, 16), (512, 8), (1024, 4), (2048, 2)])
+
+
+def xc7_bram_kbits(d_need, w_need):
+    if w_need == 0:
+        return 0
+    prims = [(18, [(16384, 1), (8192, 2), (4096, 4), (2048, 9), (1024, 18), (512, 36)]),
+             (36, [(32768, 1), (16384, 2), (8192, 4), (4096, 9), (2048, 18), (1024, 36), (512, 72)])]
+    return min(math.ceil(d_need / d) * math.ceil(w_need / w) * kbit
+               for kbit, modes in prims for d, w in modes)
+
+
+def count(cells, pattern):
+    return sum(n for t, n in cells.items() if re.fullmatch(pattern, t))
+
+
+def classify(tgt, cells):
+    if tgt == "ice40":
+        r = dict(luts=count(cells, r"SB_LUT4"), ffs=count(cells, r"SB_DFF\w*"),
+                 carries=count(cells, r"SB_CARRY"), dsps=count(cells, r"SB_MAC16"),
+                 brams=count(cells, r"SB_RAM40_4K\w*"))
+        r["bram_kbits"] = 4 * r["brams"]
+        r["distributed_ram"] = 0
+    else:
+        r = dict(luts=count(cells, r"LUT[1-6]|INV"), ffs=count(cells, r"FD[CPRS]E(_1)?|LD[CP]E?"),
+                 carries=count(cells, r"CARRY4"), dsps=count(cells, r"DSP48E1"),
+                 brams=count(cells, r"RAMB(18|36)E1"))
+        r["bram_kbits"] = 18 * count(cells, r"RAMB18E1") + 36 * count(cells, r"RAMB36E1")
+        r["distributed_ram"] = count(cells, r"RAM\d+X\d+\w*|RAM\d+M\w*|ROM\d+X1")
+    r["cells_total"] = sum(cells.values())
+    return r
+
+
+def evaluate(c, tgt, wall, out, geometry, failed):
+    """The target's summary entry; prints its line and appends failed checks to `failed`."""
+    name, p, span = c.name, c.rtl, c.unit == "span"
+    with open(os.path.join(out, f"{tgt}_stat.json")) as f:
+        cells = json.load(f)["design"]["num_cells_by_type"]
+    r = classify(tgt, cells)
+    r["wall_s"] = wall
+    r["cells_by_type"] = cells
+
+    per_mul = {f"{m[0]} {m[1]}x{m[2]} {'signed' if m[3] else 'unsigned'}": tiles(TECH[tgt], *m[1:])
+               for m in multipliers(c.unit, p)}
+    exp = dict(dsps=sum(per_mul.values()), dsps_per_multiplier=per_mul)
+    leftover_mem = count(cells, r"\$mem\w*")
+    with open(os.path.join(out, f"{tgt}.log"), errors="replace") as f:
+        log = f.read().splitlines()
+    warns = [l for l in log if re.search(r"warning", l, re.I) and not l.startswith("Warnings:")
+             and not any(re.search(k, l) for k in KNOWN_WARNINGS)]
+
+    if span:
+        latches = [l for l in log if l.startswith("Latch inferred for signal")]
+        mem_ok = leftover_mem == 0 and r["brams"] == 0 and r["distributed_ram"] == 0
+        checks = dict(dsps=r["dsps"] == exp["dsps"], latches=not latches, no_mem=mem_ok,
+                      warnings=not warns)
+        r.update(expected=exp, checks=checks, unexpected_warnings=warns[:20])
+        print(f"  {name:10s} {tgt:5s} {r['wall_s']:5.1f} s  LUT {r['luts']:5d}  FF {r['ffs']:5d}  "
+              f"carry {r['carries']:4d}  DSP {r['dsps']:2d}  cells {r['cells_total']:5d}  "
+              f"latches {len(latches)}")
+        if not checks["latches"]:
+            failed.append(f"{name}/{tgt} latches: " + "; ".join(latches[:5]))
+        if not checks["no_mem"]:
+            failed.append(f"{name}/{tgt} no_mem: {leftover_mem} $mem, {r['brams']} block RAM, "
+                          f"{r['distributed_ram']} distributed RAM/ROM cells (expected none)")
+    else:
+        depth, word_bits, varying = geometry
+        if tgt == "ice40":
+            exp["brams"] = ice40_brams(depth, varying)
+            rom_ok = r["brams"] == exp["brams"]
+        else:
+            exp["bram_kbits"] = xc7_bram_kbits(depth, varying)
+            rom_ok = r["bram_kbits"] == exp["bram_kbits"]
+        rom_ok = rom_ok and leftover_mem == 0 and r["distributed_ram"] == 0
+        checks = dict(rom_bram=rom_ok, dsps=r["dsps"] == exp["dsps"], warnings=not warns)
+        r.update(expected=exp, checks=checks, unexpected_warnings=warns[:20])
+
+        bram = f"{r['brams']} ({r['bram_kbits']} kbit)"
+        print(f"  {name:8s} {tgt:5s} {r['wall_s']:5.1f} s  LUT {r['luts']:5d}  FF {r['ffs']:5d}  "
+              f"carry {r['carries']:4d}  DSP {r['dsps']:2d}  BRAM {bram:13s} "
+              f"cells {r['cells_total']:5d}  ROM in BRAM: {'yes' if rom_ok else 'NO'}")
+        if not checks["rom_bram"]:
+            want = f"{exp['brams']} SB_RAM40_4K" if tgt == "ice40" else f"{exp['bram_kbits']} kbit"
+            failed.append(f"{name}/{tgt} rom_bram: PROM {depth}x{varying} (of {word_bits} bits; "
+                          f"constant columns dropped) should take {want}; got {bram}, "
+                          f"{leftover_mem} $mem, {r['distributed_ram']} distributed RAM/ROM cells")
+    if not checks["dsps"]:
+        failed.append(f"{name}/{tgt} dsps: {r['dsps']} DSPs, expected {exp['dsps']} = {per_mul}")
+    if not checks["warnings"]:
+        failed.append(f"{name}/{tgt} warnings: unexpected yosys warnings:\n      "
+                      + "\n      ".join(warns[:10]))
+    return r
+
+
+def write_json(path, obj):
+    tmp = os.path.join(os.path.dirname(path), "." + os.path.basename(path) + ".tmp")
+    with open(tmp, "w") as f:
+        json.dump(obj, f, indent=2)
+        f.write("\n")
+    os.replace(tmp, path)
+
+
+# ---------------------------------------------------------------- main
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(prog=PROG, description=__doc__,
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("config", metavar="CONFIG",
+                   help="a configuration file, or <unit>:<name> of the registry")
+    p.add_argument("--unit", choices=sorted(shd_config.UNITS),
+                   help="the unit of a configuration file not named <unit>_<name>.json")
+    p.add_argument("--prom", metavar="FILE", help="spec: the PROM hex file")
+    p.add_argument("--out", metavar="DIR", help="output directory")
+    p.add_argument("--target", choices=["ice40", "xc7", "both"], default="both")
+    p.add_argument("--check", action="store_true", help="fail (exit 1) unless the checks pass")
+    return p.parse_args(argv)
+
+
+def main(argv):
+    a = parse_args(argv)
+    targets = ["ice40", "xc7"] if a.target == "both" else [a.target]
+    c = load_config(a.config, a.unit)
+    config_file = os.path.realpath(c.path) if os.path.isfile(c.path) else c.path
+
+    prom = None
+    geometry = None
+    if c.unit == "span":
+        if a.prom is not None:
+            raise InputError(f"--prom: {c.unit}:{c.name} is a span configuration, which has no "
+                             f"PROM (--prom applies to spec configurations only)")
+    else:
+        prom = a.prom if a.prom is not None else default_prom(c, a.config)
+        if not os.path.isfile(prom):
+            raise InputError(f"PROM file '{prom}' not found (make it with 'shadesim prom "
+                             f"--config {a.config} --format hex -o {prom}')")
+        prom = os.path.realpath(prom)
+        plain_path("PROM", prom)
+        geometry = prom_geometry(prom, c.rtl)
+
+    if shutil.which("yosys") is None:
+        raise InputError("yosys not found (apt-get install yosys)")
+    out = a.out if a.out is not None else os.path.join(ROOT, "out", "synth", f"{c.unit}_{c.name}")
+    out = os.path.realpath(out)
+    plain_path("output", out)
+    plain_path("RTL", ROOT)
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"cannot create the output directory '{out}': {e.strerror}"
+                         + ("" if a.out else " (pass --out DIR)"))
+
+    rtl_files = [os.path.join(ROOT, "rtl", f) for f in shd_config.UNITS[c.unit]["rtl"]]
+    for f in rtl_files:
+        if not os.path.isfile(f):
+            raise InputError(f"RTL file '{f}' not found")
+    chparams = shd_config.tool_args(c, "yosys")[0]
+    yosys_version = subprocess.run(["yosys", "-V"], stdout=subprocess.PIPE,
+                                   text=True).stdout.strip()
+
+    walls = {}
+    for tgt in targets:
+        print(f"{PROG}: {c.name} / {tgt} ...", flush=True)
+        walls[tgt] = run_yosys(c, tgt, rtl_files, chparams, prom, out)
+
+    if c.unit == "span":
+        summary = dict(config=c.name, config_file=config_file, top=c.top, yosys=yosys_version,
+                       rtl=c.rtl, targets={})
+    else:
+        depth, word_bits, varying = geometry
+        summary = dict(config=c.name, config_file=config_file, prom_file=prom,
+                       yosys=yosys_version, rtl=c.rtl,
+                       prom=dict(depth=depth, word_bits=word_bits, varying_bits=varying),
+                       targets={})
+    failed = []
+    for tgt, wall in walls.items():
+        summary["targets"][tgt] = evaluate(c, tgt, wall, out, geometry, failed)
+
+    write_json(os.path.join(out, "summary.json"), summary)
+    print(f"  summary: {os.path.join(out, 'summary.json')}", flush=True)
+    for msg in failed:
+        print(("CHECK FAILED: " if a.check else "note: ") + msg, file=sys.stderr)
+    if a.check:
+        if failed:
+            return 1
+        if c.unit == "span":
+            print("  checks passed: DSPs = row-start multiplier tiling, no latches, no memories, "
+                  "no unexpected warnings")
+        else:
+            print("  checks passed: ROM in least block RAM, DSPs = multiplier tiling, "
+                  "no unexpected warnings")
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main(sys.argv[1:]))
+    except InputError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        sys.exit(2)
+    except YosysError as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr)
+        sys.exit(3)
