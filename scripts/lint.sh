@@ -1,14 +1,19 @@
 #!/usr/bin/env bash
-# lint.sh: the RTL portability gate (DESIGN.md: rtl/ must pass `verilator --lint-only -Wall` and
-# compile under Icarus `iverilog -g2012`). Checks, one output line each:
+# lint.sh: the RTL portability gate: the RTL must pass `verilator --lint-only -Wall` and compile
+# under Icarus `iverilog -g2012`, on its own and with the parameters of every configuration of the
+# registry (vectors/config/, read through scripts/shd_config.py). Checks, one output line each:
 #   verilator  <file>    every rtl/*.v on its own, top = the file's name, default parameters
 #                        (submodules are found with -y rtl)
 #   verilator  <top> [<config>]
-#                        the unit with the "rtl" parameters of a configuration (-G<Name>=<value>):
-#                        shd_spec_unit for every vectors/config/spec_<config>.json,
-#                        shd_span_unit for every vectors/config/span_<config>.json
+#                        the unit with the "rtl" parameters of a configuration (-G<Name>=<value>
+#                        from `shd_config.py args --tool verilator`): shd_spec_unit for every
+#                        spec configuration, shd_span_unit for every span configuration
+#                        (`shd_config.py list`: vectors/config/<unit>_<config>.json)
 #   iverilog   <top> [<config>]
-#                        iverilog -g2012 -Wall compile of the same (-P<top>.<Name>=<value>)
+#                        iverilog -g2012 -Wall compile of the same (-P<top>.<Name>=<value> from
+#                        `shd_config.py args --tool icarus`)
+#   config     registry  shown only when `shd_config.py list` rejects a configuration file
+#                        (a FAIL: the configuration checks are skipped)
 # Any warning or error fails the check: Icarus exits 0 on warnings (an unknown -P parameter, an
 # out-of-range part select), so any output at all counts as a failure. Lint waivers, if the
 # project adds them, are Verilator configuration files rtl/*.vlt and are passed to every
@@ -34,21 +39,33 @@ done
 shopt -s nullglob
 rtl_files=("$RTL"/*.v)
 waivers=("$RTL"/*.vlt)
-spec_configs=("$ROOT"/vectors/config/spec_*.json)
-span_configs=("$ROOT"/vectors/config/span_*.json)
 shopt -u nullglob
 ((${#rtl_files[@]} > 0)) || { echo "lint.sh: error: no rtl/*.v" >&2; exit 2; }
-((${#spec_configs[@]} > 0)) || { echo "lint.sh: error: no vectors/config/spec_*.json" >&2; exit 2; }
-((${#span_configs[@]} > 0)) || { echo "lint.sh: error: no vectors/config/span_*.json" >&2; exit 2; }
-# "<top> <config file>" per configuration: the file name's prefix names the unit.
-configs=()
-for cfg in "${spec_configs[@]}"; do configs+=("shd_spec_unit $cfg"); done
-for cfg in "${span_configs[@]}"; do configs+=("shd_span_unit $cfg"); done
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
 failures=0
+shd_config() { python3 "$ROOT/scripts/shd_config.py" "$@"; }
+# "<top> <name> <file>" per configuration of the registry, the spec unit first.
+configs=()
+if ! listing=$(shd_config list 2>"$tmp/out"); then
+  printf 'FAIL  config     registry\n'
+  sed 's/^/      /' "$tmp/out"
+  failures=$((failures + 1))
+else
+  for unit in spec span; do
+    top=$(shd_config unit "$unit" | sed -n 1p)
+    n=0
+    while read -r u name file; do
+      [[ $u == "$unit" ]] || continue
+      configs+=("$top $name $file")
+      n=$((n + 1))
+    done <<<"$listing"
+    ((n > 0)) || { echo "lint.sh: error: no $unit configuration in vectors/config" >&2; exit 2; }
+  done
+fi
+
 # run_check <label> <command...>: passes when the command exits 0 and prints nothing.
 run_check() {
   local label=$1 rc=0
@@ -74,36 +91,17 @@ for f in "${rtl_files[@]}"; do
 done
 
 for entry in "${configs[@]}"; do
-  top=${entry%% *}
-  cfg=${entry#* }
-  name=$(basename "$cfg" .json)
-  name=${name#*_}
-  # One "Name=Value" per line from the configuration's "rtl" object, integers only.
-  if ! params=$(python3 - "$cfg" 2>"$tmp/out" <<'EOF'
-import json, re, sys
-path = sys.argv[1]
-try:
-    rtl = json.load(open(path))["rtl"]
-    assert isinstance(rtl, dict), "'rtl' is not an object"
-except (OSError, ValueError, KeyError, AssertionError) as e:
-    sys.exit(f"lint.sh: error: {path}: {e!r}")
-for k, v in rtl.items():
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", k) or type(v) is not int:
-        sys.exit(f"lint.sh: error: {path}: rtl.{k} = {v!r} is not an integer parameter")
-    print(f"{k}={v}")
-EOF
-  ); then
+  read -r top name cfg <<<"$entry"
+  # The parameter options of each tool, one per line (shd_config.py validates the file).
+  if ! gparams=$(shd_config args --tool verilator "$cfg" 2>"$tmp/out") ||
+     ! pparams=$(shd_config args --tool icarus --top "$top" "$cfg" 2>"$tmp/out"); then
     printf 'FAIL  config     %s\n' "$top [$name]"
     sed 's/^/      /' "$tmp/out"
     failures=$((failures + 1))
     continue
   fi
-  gargs=()
-  pargs=()
-  while IFS= read -r kv; do
-    gargs+=("-G$kv")
-    pargs+=("-P$top.$kv")
-  done <<<"$params"
+  mapfile -t gargs <<<"$gparams"
+  mapfile -t pargs <<<"$pparams"
   run_check "verilator  $top [$name]" verilator_lint --top-module "$top" "${gargs[@]}" "$RTL/$top.v"
   run_check "iverilog   $top [$name]" \
     iverilog -g2012 -Wall -s "$top" "${pargs[@]}" -o "$tmp/$top.$name.vvp" "${rtl_files[@]}"
