@@ -1,8 +1,13 @@
 #!/usr/bin/env bash
 # run_icarus.sh: replays a shadesim vector file (sim/vector_file.h) under Icarus Verilog.
-# The file's header names the unit and the configuration; the testbench is compiled with that
-# configuration's parameters (vectors/config/<unit>_<config>.json, the same source CMake
-# verilates from) and the specular unit loads the PROM the header names (relative to the file).
+# The file's header names the unit and the configuration ("# config <name> <json>"); the testbench
+# is compiled with that configuration's parameters and the specular unit loads the PROM the header
+# names (relative to the file). The parameters come from scripts/shd_config.py: when <name> is a
+# configuration of the registry (`shd_config.py list`: vectors/config/<unit>_<name>.json, the same
+# source CMake verilates from), from the registry file, so a stale vector file fails the
+# testbench's comparison with its "# params" line; otherwise (a user's own configuration) from the
+# JSON of the "# config" line itself. The script prints which source it used. The RTL files of the
+# unit come from `shd_config.py unit`.
 #
 #   testbench/icarus/run_icarus.sh [--fst WAVE.fst] [--prom PROM.hex] [--work DIR] FILE.vec
 #
@@ -40,34 +45,40 @@ vec=$(cd "$(dirname "$vec")" && pwd)/$(basename "$vec")
 # "# unit <u>" and "# config <name> <json>" from the header (before the first record).
 header() { awk -v key="$1" '/^[^#]/ { exit } $1 == "#" && $2 == key { sub(/^# [^ ]+ /, ""); print; exit }' "$vec"; }
 unit=$(header unit)
-config=$(header config | cut -d' ' -f1)
+config_line=$(header config)
+config=${config_line%% *}
 [ "$unit" = spec ] || [ "$unit" = span ] || die "$vec: no '# unit spec|span' header line: not a shadesim vector file"
 [ -n "$config" ] || die "$vec: no '# config' header line"
 case "$config" in */*|.*) die "$vec: configuration name '$config'" ;; esac
-cfg_json=$root/vectors/config/${unit}_${config}.json
-[ -f "$cfg_json" ] || die "$vec: configuration '$config' has no $cfg_json"
 
+shd_config() { python3 "$root/scripts/shd_config.py" "$@"; }
 top=tb_${unit}_unit
+# The registry's file of this configuration, if there is one.
+registry=$(shd_config list --unit "$unit" 2>&1) || die "the configuration registry: $registry"
+cfg_json=$(awk -v name="$config" '$2 == name { sub(/^[^ ]+ [^ ]+ /, ""); print; exit }' <<<"$registry")
 # -P<top>.<Name>=<value> for every member of the configuration's "rtl" object (integers only).
+if [ -n "$cfg_json" ]; then
+  source_text="the registry's $unit:$config ($cfg_json)"
+  params=$(shd_config args --tool icarus --top "$top" "$cfg_json" 2>&1) || die "$params"
+else
+  case "$config_line" in *" "*) cfg_rtl=${config_line#* } ;; *) cfg_rtl="" ;; esac
+  [ -n "$cfg_rtl" ] || die "$vec: '$config' is not a $unit configuration of the registry, and its '# config' line has no parameters"
+  source_text="the '# config $config' line of $(basename "$vec") ($unit:$config is not in the registry)"
+  params=$(printf '{"name": "%s", "rtl": %s}\n' "$config" "$cfg_rtl" |
+           shd_config args --tool icarus --top "$top" --unit "$unit" - 2>&1) ||
+    die "$vec: the parameters of its '# config' line: $params"
+fi
 pargs=()
-while IFS= read -r kv; do pargs+=("-P$top.$kv"); done < <(python3 - "$cfg_json" <<'EOF'
-import json, re, sys
-path = sys.argv[1]
-try:
-    rtl = json.load(open(path))["rtl"]
-    assert isinstance(rtl, dict), "'rtl' is not an object"
-except (OSError, ValueError, KeyError, AssertionError) as e:
-    sys.exit(f"run_icarus.sh: error: {path}: {e!r}")
-for k, v in rtl.items():
-    if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", k) or type(v) is not int:
-        sys.exit(f"run_icarus.sh: error: {path}: rtl.{k} = {v!r} is not an integer parameter")
-    print(f"{k}={v}")
-EOF
-)
-[ ${#pargs[@]} -gt 0 ] || die "$cfg_json: no parameters"
+while IFS= read -r p; do [ -z "$p" ] || pargs+=("$p"); done <<<"$params"
+[ ${#pargs[@]} -gt 0 ] || die "$source_text: no parameters"
+
+# The unit's RTL files: `shd_config.py unit` prints its top module, then the files.
+unit_info=$(shd_config unit "$unit") || die "shd_config.py unit $unit failed"
+read -ra sources <<<"$(sed -n 2p <<<"$unit_info")"
+[ ${#sources[@]} -gt 0 ] || die "no RTL files for the $unit unit"
+for f in "${sources[@]}"; do [ -f "$f" ] || die "RTL file $f not found"; done
 
 if [ "$unit" = spec ]; then
-  sources=("$root/rtl/shd_spec_unit.v" "$root/rtl/shd_coef_rom.v" "$root/rtl/shd_pipe_reg.v")
   if [ -z "$prom" ]; then
     prom=$(header prom)
     [ -n "$prom" ] || die "$vec: no '# prom' header line"
@@ -76,7 +87,6 @@ if [ "$unit" = spec ]; then
   [ -f "$prom" ] || die "PROM file $prom does not exist"
   prom=$(cd "$(dirname "$prom")" && pwd)/$(basename "$prom")
 else
-  sources=("$root/rtl/shd_span_unit.v")
   [ -z "$prom" ] || die "--prom: the span unit has no PROM"
 fi
 
@@ -100,6 +110,7 @@ if [ -n "$fst" ]; then
   plusargs+=("+dump=$fst")
   extended+=(-fst)
 fi
+echo "run_icarus.sh: parameters from $source_text"
 echo "run_icarus.sh: $unit/$config, $(basename "$vec") under $(iverilog -V 2>&1 | head -1 | cut -d' ' -f1-4)"
 # vvp prints "VCD info: ..." when dumping; $fatal gives exit status 1.
 vvp -n "$work/$top.vvp" "${plusargs[@]}" "${extended[@]}"

@@ -6,8 +6,11 @@
 //             iverilog -g2012 -Wall -I testbench/icarus -s tb_spec_unit -Ptb_spec_unit.<Name>=<value>... -o tb.vvp \
 //               testbench/icarus/tb_spec_unit.v rtl/shd_spec_unit.v rtl/shd_coef_rom.v rtl/shd_pipe_reg.v
 //             vvp -n tb.vvp +vec=/abs/file.vec +prom=/abs/prom.hex [+dump=/abs/wave.fst -fst]
-//           Paths must be absolute (TOOLCHAIN pitfall 6). Parameters: those of the configuration,
-//           which the file's "# params" line must repeat (a file for another configuration fails).
+//           Paths must be absolute: $readmemh (and $fopen) resolve a relative path against the
+//           simulator's current directory, not the vector file's, and a PROM file $readmemh cannot
+//           find is only a warning.
+//           Parameters: those of the configuration, which the file's "# params" line must repeat
+//           (a file for another configuration fails).
 // Checks:   every PROM word loaded (no X: $readmemh only warns on a missing or short file);
 //           per cycle valid_o, spec_o, spec_r_o, spec_g_o, spec_b_o with !== (an X is a
 //           mismatch). Prints the first 10 mismatches (cycle, signal, both values), ends with
