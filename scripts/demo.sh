@@ -33,8 +33,7 @@ mv "$out/spec_error_default.txt.tmp" "$out/spec_error_default.txt"
 cat "$out/spec_error_default.txt"
 
 echo "== 4. synthesis with yosys (out/synth/default/)"
-"$root/scripts/synth.sh" --config "$root/vectors/config/spec_default.json" \
-  --prom "$out/prom/spec_default.hex" --out "$out/synth/default" --target both --check
+"$root/scripts/synth.py" spec:default --prom "$out/prom/spec_default.hex" --out "$out/synth/default" --target both --check
 
 echo "== 5. span unit: cycles per mode on the size classes and the idx3d sphere, checked against the RTL"
 "$S" span-cycles --triangles 20000 --rtl --json-out "$out/span_cycles.json" > "$out/span_cycles.txt.tmp"

@@ -24,8 +24,13 @@ else
 fi
 mkdir -p "$dest/prom"
 
+# The configurations of the registry (scripts/shd_config.py: "<unit> <name> <file>" per line).
+configs=$(python3 "$root/scripts/shd_config.py" list)
+spec_configs=$(awk '$1 == "spec" { print $2 }' <<<"$configs")
+span_configs=$(awk '$1 == "span" { print $2 }' <<<"$configs")
+
 # The PROM of every unit configuration, as the simulators load it.
-for cfg in default narrow wide cubic; do
+for cfg in $spec_configs; do
   "$shadesim" prom --config "$root/vectors/config/spec_$cfg.json" --format hex -o "$dest/prom/spec_$cfg.hex" 2>/dev/null
 done
 # The default PROM in every FPGA vendor's format.
@@ -39,11 +44,11 @@ done
 # phases (every size class x shape, the wide viewport) to finish in every mode; each file's
 # "# coverage" lines say by which cycle (test_vectors checks it).
 mkdir -p "$dest/cycles"
-for cfg in default narrow wide cubic; do
+for cfg in $spec_configs; do
   "$shadesim" vectors --unit spec --config "$cfg" --cycles 3000 --seed 1 --prom "$dest/prom/spec_$cfg.hex" \
     -o "$dest/cycles/spec_$cfg.vec" 2>/dev/null
 done
-for mode in serial evenodd seg2 seg4 seg8 sierpinski; do
+for mode in $span_configs; do
   "$shadesim" vectors --unit span --config "$mode" --cycles 4000 --seed 1 -o "$dest/cycles/span_$mode.vec" 2>/dev/null
 done
 

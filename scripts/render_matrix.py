@@ -18,8 +18,10 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TEAPOTS = "/usr/share/assimp/models/Collada/teapots.DAE"  # Debian assimp-testmodels
-SCENES = ["builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials",
-          os.path.join(ROOT, "vectors/scenes/still_life.json"), TEAPOTS]
+# Relative to the repository (the renders run there), so that the statistics' scene names of two
+# checkouts are equal.
+SCENES = ["builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials", "vectors/scenes/still_life.json",
+          TEAPOTS]
 METHODS = ["flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "phong-fixed",
            "normal-bisection", "biquadratic", "modified-gouraud", "adaptive", "reference"]
 MODES = ["serial", "evenodd", "seg4", "sierpinski"]
@@ -45,13 +47,15 @@ def jobs():
 def render_one(shadesim, outdir, name, args):
     png = os.path.join(outdir, name + ".png")
     cmd = [shadesim, "render", *args, "--quiet", "-o", png, "--json", os.path.join(outdir, name + ".json")]
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     return name, r.returncode, r.stderr.strip()
 
 
 def render(a):
     if not os.path.exists(TEAPOTS):
         sys.exit(f"render_matrix: {TEAPOTS} missing (Debian package assimp-testmodels)")
+    a.out = os.path.abspath(a.out)
+    a.shadesim = os.path.abspath(a.shadesim)
     os.makedirs(a.out, exist_ok=True)
     todo = jobs()
     failed = 0

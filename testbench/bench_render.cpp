@@ -9,7 +9,7 @@
 #include <benchmark/benchmark.h>
 
 #include "device/prom.h"
-#include "device/spec_params.h"
+#include "config/registry.h"
 #include "render/fixed_simd.h"
 #include "render/render.h"
 #include "scene/scene.h"
@@ -20,14 +20,13 @@ namespace {
 
 // brdf "": the sphere's own material (Blinn, exact pow per pixel); "quadratic": the specular
 // unit's polynomial from its PROM (the paper's device: no pow), evaluated by its model.
-void BM_Frame(benchmark::State& state, Method method, SpanMode mode, const char* brdf) {
+void BM_Frame(benchmark::State& state, Method method, const char* mode, const char* brdf) {
   const Scene scene = loadScene("builtin:sphere");
   RenderOptions opt;
   opt.method = method;
-  opt.span_mode = mode;
   opt.brdf = brdf;
-  ModelSpanEngine span(SpanParams::forMode(mode));
-  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath("default"));
+  ModelSpanEngine span(spanConfig(mode).rtl);
+  const SpecUnitConfig cfg = specConfig("default");
   ModelSpecEngine quadratic(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl));
   SpecEngines spec;
   spec.quadratic = &quadratic;
@@ -47,20 +46,20 @@ void BM_Frame(benchmark::State& state, Method method, SpanMode mode, const char*
 
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_Frame, flat, Method::Flat, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, gouraud, Method::Gouraud, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, gouraud_classical, Method::GouraudClassical, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, phong, Method::Phong, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, phong_incremental, Method::PhongIncremental, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, phong_fixed, Method::PhongFixed, SpanMode::Serial, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, gouraud_sierpinski, Method::Gouraud, SpanMode::Sierpinski, "")->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, phong_incremental_sierpinski, Method::PhongIncremental, SpanMode::Sierpinski, "")
+BENCHMARK_CAPTURE(BM_Frame, flat, Method::Flat, "serial", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud, Method::Gouraud, "serial", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud_classical, Method::GouraudClassical, "serial", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong, Method::Phong, "serial", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong_incremental, Method::PhongIncremental, "serial", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong_fixed, Method::PhongFixed, "serial", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud_sierpinski, Method::Gouraud, "sierpinski", "")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, phong_incremental_sierpinski, Method::PhongIncremental, "sierpinski", "")
     ->Unit(benchmark::kMillisecond);
 
-BENCHMARK_CAPTURE(BM_Frame, phong_incremental_device, Method::PhongIncremental, SpanMode::Serial, "quadratic")
+BENCHMARK_CAPTURE(BM_Frame, phong_incremental_device, Method::PhongIncremental, "serial", "quadratic")
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, phong_fixed_device, Method::PhongFixed, SpanMode::Serial, "quadratic")
+BENCHMARK_CAPTURE(BM_Frame, phong_fixed_device, Method::PhongFixed, "serial", "quadratic")
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_Frame, gouraud_device, Method::Gouraud, SpanMode::Serial, "quadratic")->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_Frame, gouraud_device, Method::Gouraud, "serial", "quadratic")->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

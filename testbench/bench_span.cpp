@@ -6,8 +6,9 @@
 
 #include <filesystem>
 
+#include "config/registry.h"
 #include "raster/desc_stream.h"
-#include "span_cosim.h"
+#include "cosim/span_cosim.h"
 
 using namespace shd;
 
@@ -15,9 +16,9 @@ namespace {
 
 constexpr uint64_t kTriangles = 20000;  // the mixed generator stream, about 57 pixels each
 
-std::vector<SpanDesc> descriptors(SpanMode m) {
+std::vector<SpanDesc> descriptors(const std::string& m) {
   RasterConfig c;
-  c.unit = SpanParams::forMode(m);
+  c.unit = spanConfig(m).rtl;
   DescriptorStream s(7, kTriangles, c);
   std::vector<SpanDesc> out;
   SpanDesc d;
@@ -25,12 +26,14 @@ std::vector<SpanDesc> descriptors(SpanMode m) {
   return out;
 }
 
-SpanMode modeOf(const benchmark::State& st) { return allSpanModes()[static_cast<size_t>(st.range(0))]; }
+// The span configurations (lane modes) of the registry, by benchmark argument.
+std::string modeOf(const benchmark::State& st) { return builtinConfigNames("span")[static_cast<size_t>(st.range(0))]; }
+const int kLastMode = static_cast<int>(builtinConfigNames("span").size()) - 1;
 
 void BM_SpanModel(benchmark::State& state) {
-  const SpanMode m = modeOf(state);
+  const std::string m = modeOf(state);
   const auto descs = descriptors(m);
-  SpanUnitModel unit(SpanParams::forMode(m));
+  SpanUnitModel unit(spanConfig(m).rtl);
   uint64_t frags = 0, tris = 0;
   for (auto _ : state)
     for (const SpanDesc& d : descs) {
@@ -39,13 +42,13 @@ void BM_SpanModel(benchmark::State& state) {
     }
   state.counters["fragments/s"] = benchmark::Counter(static_cast<double>(frags), benchmark::Counter::kIsRate);
   state.counters["triangles/s"] = benchmark::Counter(static_cast<double>(tris), benchmark::Counter::kIsRate);
-  state.SetLabel(toString(m));
+  state.SetLabel(m);
 }
 
 void BM_SpanRtl(benchmark::State& state) {
-  const SpanMode m = modeOf(state);
+  const std::string m = modeOf(state);
   const auto descs = descriptors(m);
-  auto dut = makeSpanDut(toString(m), "");
+  auto dut = makeSpanDut(m, "");
   dut->reset();
   uint64_t frags = 0, tris = 0;
   SpanOut o;
@@ -68,11 +71,11 @@ void BM_SpanRtl(benchmark::State& state) {
     }
   state.counters["fragments/s"] = benchmark::Counter(static_cast<double>(frags), benchmark::Counter::kIsRate);
   state.counters["triangles/s"] = benchmark::Counter(static_cast<double>(tris), benchmark::Counter::kIsRate);
-  state.SetLabel(toString(m));
+  state.SetLabel(m);
 }
 
 void BM_SpanCosim(benchmark::State& state) {
-  const SpanMode m = modeOf(state);
+  const std::string m = modeOf(state);
   const auto descs = descriptors(m);
   uint64_t frags = 0, tris = 0, mism = 0;
   for (auto _ : state) {
@@ -81,7 +84,7 @@ void BM_SpanCosim(benchmark::State& state) {
     o.ready_prob = 1.0;
     o.desc_gap_prob = 0.0;
     o.fail_dir = std::filesystem::temp_directory_path().string();
-    const SpanCosimResult r = runSpanCosim(toString(m), [&](SpanDesc& d) {
+    const SpanCosimResult r = runSpanCosim(m, [&](SpanDesc& d) {
       if (i == descs.size()) return false;
       d = descs[i++];
       return true;
@@ -93,13 +96,13 @@ void BM_SpanCosim(benchmark::State& state) {
   state.counters["fragments/s"] = benchmark::Counter(static_cast<double>(frags), benchmark::Counter::kIsRate);
   state.counters["triangles/s"] = benchmark::Counter(static_cast<double>(tris), benchmark::Counter::kIsRate);
   state.counters["mismatches"] = static_cast<double>(mism);
-  state.SetLabel(toString(m));
+  state.SetLabel(m);
 }
 
 }  // namespace
 
-BENCHMARK(BM_SpanModel)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SpanRtl)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_SpanCosim)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SpanModel)->DenseRange(0, kLastMode)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SpanRtl)->DenseRange(0, kLastMode)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SpanCosim)->DenseRange(0, kLastMode)->Unit(benchmark::kMillisecond);
 
 BENCHMARK_MAIN();

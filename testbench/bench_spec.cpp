@@ -10,9 +10,10 @@
 
 #include <fmt/format.h>
 
+#include "config/registry.h"
 #include "device/prom.h"
 #include "device/prom_io.h"
-#include "spec_cosim.h"
+#include "cosim/spec_cosim.h"
 
 using namespace shd;
 
@@ -22,7 +23,7 @@ struct Fixture {
   PromTable table;
   std::string prom_path;
   explicit Fixture(const std::string& name) {
-    const SpecUnitConfig c = SpecUnitConfig::load(configPath(name));
+    const SpecUnitConfig c = specConfig(name);
     table = buildPromTable(PromRequest::fromContent(c.prom), c.rtl);
     prom_path = (std::filesystem::temp_directory_path() / fmt::format("bench_spec_{}.hex", name)).string();
     writeFileAtomic(prom_path, renderProm(table, PromFormat::Hex));

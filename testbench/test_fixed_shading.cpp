@@ -1,5 +1,6 @@
 // phong-fixed's datapath (render/fixed_shading.h): against the double-precision shader it
 // replaces, its lobe tables against the lobes, and the specular unit's memo against the unit.
+#include "config/registry.h"
 #include "render/fixed_shading.h"
 
 #include <gtest/gtest.h>
@@ -115,7 +116,7 @@ TEST(FixedShading, LobeTablesHoldTheLobeAtEveryCode) {
 // The memo gives the unit's model's result for every cos code of a row, and rows of other
 // requests leave it in place.
 TEST(FixedShading, SpecResultMemoEqualsTheUnitsModel) {
-  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath("default"));
+  const SpecUnitConfig cfg = specConfig("default");
   const PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
   const SpecUnitModel unit(t.unit, t.words);
   SpecResultMemo memo(unit);

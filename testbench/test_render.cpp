@@ -9,11 +9,14 @@
 
 #include "render/fixed_simd.h"
 #include "render/render.h"
-#include "render_rtl.h"
-#include "replay.h"
+#include "cosim/render_rtl.h"
+#include "cosim/replay.h"
 #include "scene/scene.h"
+#include "test_util.h"
 
 using namespace shd;
+using shd::testutil::spanModes;
+using shd::testutil::spanParams;
 namespace fs = std::filesystem;
 
 namespace {
@@ -22,19 +25,18 @@ struct ModelEngines {
   ModelSpanEngine span;
   std::unique_ptr<ModelSpecEngine> quad;
   SpecEngines view;
-  explicit ModelEngines(SpanMode m) : span(SpanParams::forMode(m)) {
-    const SpecUnitConfig c = SpecUnitConfig::load(configPath("default"));
+  explicit ModelEngines(const std::string& m) : span(spanParams(m)) {
+    const SpecUnitConfig c = specConfig("default");
     quad = std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(c.prom), c.rtl));
     view.quadratic = quad.get();
   }
 };
 
-RenderResult renderModel(const Scene& s, Method m, const std::string& brdf, SpanMode mode) {
+RenderResult renderModel(const Scene& s, Method m, const std::string& brdf, const std::string& mode) {
   ModelEngines e(mode);
   RenderOptions o;
   o.method = m;
   o.brdf = brdf;
-  o.span_mode = mode;
   return render(s, o, e.span, e.view);
 }
 
@@ -50,13 +52,13 @@ double maxError(const Framebuffer& a, const Framebuffer& ref) {
 TEST(Render, ImageDoesNotDependOnTheLaneMode) {
   const Scene s = loadScene("builtin:sphere");
   for (Method m : {Method::Gouraud, Method::Phong, Method::PhongFixed}) {
-    const RenderResult serial = renderModel(s, m, "quadratic", SpanMode::Serial);
-    for (SpanMode mode : allSpanModes()) {
+    const RenderResult serial = renderModel(s, m, "quadratic", "serial");
+    for (const std::string& mode : spanModes()) {
       const RenderResult r = renderModel(s, m, "quadratic", mode);
-      EXPECT_EQ(r.fb.rgb, serial.fb.rgb) << toString(m) << " " << toString(mode);
+      EXPECT_EQ(r.fb.rgb, serial.fb.rgb) << toString(m) << " " << mode;
       EXPECT_EQ(r.stats.fragments, serial.stats.fragments);
-      if (mode != SpanMode::Serial) {
-        EXPECT_LT(r.stats.span_cycles, serial.stats.span_cycles) << toString(mode);
+      if (mode != "serial") {
+        EXPECT_LT(r.stats.span_cycles, serial.stats.span_cycles) << mode;
       }
     }
   }
@@ -66,20 +68,19 @@ TEST(Render, RtlInTheLoopEqualsTheModelPixelForPixel) {
   const Scene s = loadScene("builtin:sphere");
   const fs::path tmp = fs::path(testing::TempDir()) / "render_rtl";
   fs::create_directories(tmp);
-  for (SpanMode mode : {SpanMode::Serial, SpanMode::Sierpinski}) {
+  for (const char* mode : {"serial", "sierpinski"}) {
     for (Method m : {Method::Gouraud, Method::Phong, Method::PhongFixed}) {
       const RenderResult model = renderModel(s, m, "quadratic", mode);
-      RtlSpanEngine span(mode);
-      const SpecUnitConfig c = SpecUnitConfig::load(configPath("default"));
-      RtlSpecEngine spec("default", buildPromTable(PromRequest::fromContent(c.prom), c.rtl), (tmp / "spec.hex").string());
+      RtlSpanEngine span(spanConfig(mode));
+      const SpecUnitConfig c = specConfig("default");
+      RtlSpecEngine spec(specConfig("default"), buildPromTable(PromRequest::fromContent(c.prom), c.rtl), (tmp / "spec.hex").string());
       SpecEngines view;
       view.quadratic = &spec;
       RenderOptions o;
       o.method = m;
       o.brdf = "quadratic";
-      o.span_mode = mode;
       const RenderResult hw = render(s, o, span, view);
-      EXPECT_EQ(hw.fb.rgb, model.fb.rgb) << toString(m) << " " << toString(mode);
+      EXPECT_EQ(hw.fb.rgb, model.fb.rgb) << toString(m) << " " << mode;
       EXPECT_EQ(hw.fb.depth, model.fb.depth);
       EXPECT_EQ(hw.stats.span_cycles, model.stats.span_cycles);
       EXPECT_EQ(hw.stats.spec_cycles, model.stats.spec_cycles);
@@ -98,7 +99,7 @@ TEST(Render, RtlDisagreementSavesTheCaseAlone) {
   const fs::path dir = fs::path(testing::TempDir()) / "render_rtl_fault";
   fs::remove_all(dir);
   fs::create_directories(dir);
-  const SpecUnitConfig c = SpecUnitConfig::load(configPath("default"));
+  const SpecUnitConfig c = specConfig("default");
   const PromTable table = buildPromTable(PromRequest::fromContent(c.prom), c.rtl);
   RenderOptions o;
   o.method = Method::Phong;
@@ -114,9 +115,8 @@ TEST(Render, RtlDisagreementSavesTheCaseAlone) {
     return std::string();
   };
   {  // span: the seg2 RTL against a model with the even/odd lane layout
-    o.span_mode = SpanMode::Seg2;
-    RtlSpanEngine span(SpanMode::Seg2, dir.string(), SpanParams::forMode(SpanMode::EvenOdd));
-    RtlSpecEngine spec("default", table, (dir / "spec.hex").string(), dir.string());
+    RtlSpanEngine span(spanConfig("seg2"), dir.string(), spanParams("evenodd"));
+    RtlSpecEngine spec(specConfig("default"), table, (dir / "spec.hex").string(), dir.string());
     const std::string msg = messageOf(span, spec);
     std::printf("%s\n", msg.c_str());
     EXPECT_NE(msg.find("span unit (seg2): the RTL differs from the model on triangle"), std::string::npos) << msg;
@@ -129,13 +129,12 @@ TEST(Render, RtlDisagreementSavesTheCaseAlone) {
     EXPECT_EQ(r.first->cycle, r.cycles) << "the failing cycle is the file's last";
   }
   {  // spec: one PROM word differs in the model only (the word of the sphere's shininess)
-    o.span_mode = SpanMode::Serial;
     std::vector<PromWord> words = table.words;
     const int addr = table.addressOf(std::round(s.materials.at(0).shininess));
     ASSERT_GE(addr, 0);
     words[static_cast<size_t>(addr)] ^= PromWord{1} << 3;
-    RtlSpanEngine span(SpanMode::Serial, dir.string());
-    RtlSpecEngine spec("default", table, (dir / "spec.hex").string(), dir.string(), words);
+    RtlSpanEngine span(spanConfig("serial"), dir.string());
+    RtlSpecEngine spec(specConfig("default"), table, (dir / "spec.hex").string(), dir.string(), words);
     const std::string msg = messageOf(span, spec);
     std::printf("%s\n", msg.c_str());
     EXPECT_NE(msg.find("specular unit (default): the RTL differs from the model for shininess code"), std::string::npos)
@@ -150,9 +149,8 @@ TEST(Render, RtlDisagreementSavesTheCaseAlone) {
   {  // and agreeing units save nothing
     const fs::path clean = dir / "clean";
     fs::create_directories(clean);
-    o.span_mode = SpanMode::Serial;
-    RtlSpanEngine span(SpanMode::Serial, clean.string());
-    RtlSpecEngine spec("default", table, (clean / "spec.hex").string(), clean.string());
+    RtlSpanEngine span(spanConfig("serial"), clean.string());
+    RtlSpecEngine spec(specConfig("default"), table, (clean / "spec.hex").string(), clean.string());
     EXPECT_EQ(messageOf(span, spec), "");
     size_t files = 0;
     for (const auto& e : fs::directory_iterator(clean)) files += e.path().extension() == ".vec" ? 1 : 0;
@@ -164,14 +162,14 @@ TEST(Render, MethodsAgainstTheReference) {
   const Scene s = loadScene("builtin:sphere");
   RenderOptions ro;
   ro.method = Method::Reference;
-  ModelEngines e(SpanMode::Serial);
+  ModelEngines e("serial");
   const RenderResult ref = render(s, ro, e.span, e.view);
-  const double flat = maxError(renderModel(s, Method::Flat, "", SpanMode::Serial).fb, ref.fb);
-  const double gouraud = maxError(renderModel(s, Method::Gouraud, "", SpanMode::Serial).fb, ref.fb);
-  const double phong = maxError(renderModel(s, Method::Phong, "", SpanMode::Serial).fb, ref.fb);
-  const double phong_inc = maxError(renderModel(s, Method::PhongIncremental, "", SpanMode::Serial).fb, ref.fb);
-  const double phong_fixed = maxError(renderModel(s, Method::PhongFixed, "", SpanMode::Serial).fb, ref.fb);
-  const double biquad = maxError(renderModel(s, Method::Biquadratic, "", SpanMode::Serial).fb, ref.fb);
+  const double flat = maxError(renderModel(s, Method::Flat, "", "serial").fb, ref.fb);
+  const double gouraud = maxError(renderModel(s, Method::Gouraud, "", "serial").fb, ref.fb);
+  const double phong = maxError(renderModel(s, Method::Phong, "", "serial").fb, ref.fb);
+  const double phong_inc = maxError(renderModel(s, Method::PhongIncremental, "", "serial").fb, ref.fb);
+  const double phong_fixed = maxError(renderModel(s, Method::PhongFixed, "", "serial").fb, ref.fb);
+  const double biquad = maxError(renderModel(s, Method::Biquadratic, "", "serial").fb, ref.fb);
   std::printf(
       "max error vs reference (LSB): flat %.2f gouraud %.2f biquadratic %.2f phong %.2f phong-incremental %.2f "
       "phong-fixed %.2f\n",
@@ -204,8 +202,8 @@ TEST(Render, PhongFixedMemoEqualsTheBatchedRequests) {
   };
   for (const char* scene : {"builtin:sphere", "builtin:plane"}) {
     const Scene s = loadScene(scene);
-    const RenderResult memo = renderModel(s, Method::PhongFixed, "quadratic", SpanMode::Serial);
-    ModelEngines e(SpanMode::Serial);
+    const RenderResult memo = renderModel(s, Method::PhongFixed, "quadratic", "serial");
+    ModelEngines e("serial");
     BatchOnly batch(*e.quad);
     SpecEngines view;
     view.quadratic = &batch;
@@ -222,7 +220,7 @@ TEST(Render, PhongFixedMemoEqualsTheBatchedRequests) {
 
 TEST(Render, BadOptionsAreNamed) {
   const Scene s = loadScene("builtin:sphere");
-  ModelSpanEngine span(SpanParams::forMode(SpanMode::Serial));
+  ModelSpanEngine span(spanParams("serial"));
   RenderOptions o;
   o.brdf = "glossy";
   EXPECT_THROW(render(s, o, span, SpecEngines{}), std::invalid_argument);
@@ -273,7 +271,7 @@ TEST(Render, ModifiedGouraudSplitsWhereAHighlightCrossesAnEdge) {
   // A coarse sphere (8 segments): highlights fall inside large triangles and across edges.
   Scene s = loadScene("builtin:sphere");
   s.objects[0].mesh = idx3dSphere(1, 8);
-  ModelEngines e(SpanMode::Serial);
+  ModelEngines e("serial");
   RenderOptions o;
   o.method = Method::ModifiedGouraud;
   const RenderResult mod = render(s, o, e.span, e.view);
@@ -299,7 +297,7 @@ TEST(Render, ModifiedGouraudSplitsWhereAHighlightCrossesAnEdge) {
 
 TEST(Render, AdaptiveFollowsItsThresholds) {
   const Scene s = loadScene("builtin:sphere");
-  ModelEngines e(SpanMode::Serial);
+  ModelEngines e("serial");
   RenderOptions o;
   o.method = Method::Adaptive;
   const RenderResult strict = render(s, o, e.span, e.view);  // the listing's thresholds
@@ -318,7 +316,7 @@ TEST(Render, AdaptiveFollowsItsThresholds) {
 
 TEST(Render, NormalBisectionBetweenPhongAndLinearNormals) {
   const Scene s = loadScene("builtin:sphere");
-  ModelEngines e(SpanMode::Serial);
+  ModelEngines e("serial");
   RenderOptions o;
   o.method = Method::Phong;
   const RenderResult phong = render(s, o, e.span, e.view);
@@ -354,7 +352,7 @@ TEST(Render, VectorPathsEqualTheScalarPaths) {
   uint64_t pixels = 0;
   for (const std::string scene : {"builtin:sphere", "builtin:torus", "builtin:materials", "builtin:plane", teapots.c_str()}) {
     const Scene s = loadScene(scene);
-    for (const SpanMode mode : {SpanMode::Serial, SpanMode::EvenOdd, SpanMode::Sierpinski})
+    for (const char* mode : {"serial", "evenodd", "sierpinski"})
       for (const Case& c : cases) {
         ModelEngines e(mode);
         RenderOptions o;
@@ -362,11 +360,10 @@ TEST(Render, VectorPathsEqualTheScalarPaths) {
         // (materials: a lobe of N.H for its cubic object too, which needs the cubic unit; its
         // objects still change the shader's constants from one to the next)
         o.brdf = std::string(c.brdf).empty() && scene == "builtin:materials" ? "blinn" : c.brdf;
-        o.span_mode = mode;
         const RenderResult vec = render(s, o, e.span, e.view);
         o.vector_kernel = false;
         const RenderResult scalar = render(s, o, e.span, e.view);
-        const std::string what = scene + " " + toString(c.m) + " " + c.brdf + " " + toString(mode);
+        const std::string what = scene + " " + toString(c.m) + " " + c.brdf + " " + mode;
         // The first differing entry (-1: none).
         auto firstDiff = [](const auto& x, const auto& y) {
           if (x.size() != y.size()) return ptrdiff_t{0};

@@ -10,24 +10,26 @@
 #include <random>
 
 #include "raster/desc_stream.h"
-#include "replay.h"
-#include "span_cosim.h"
-#include "vector_gen.h"
+#include "cosim/replay.h"
+#include "cosim/span_cosim.h"
+#include "vectors/vector_gen.h"
 // Verilator's own headers are not -Wextra clean (verilated_types.h:1127, an unused parameter).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wunused-parameter"
-#include "verilated_ports.h"
+#include "harness/verilated_ports.h"
 #pragma GCC diagnostic pop
 
 using namespace shd;
+using shd::testutil::spanModes;
+using shd::testutil::spanParams;
 namespace fs = std::filesystem;
 
 namespace {
 
 // Generator triangles through setup for `mode`; triangles setup drops are skipped.
-std::function<bool(SpanDesc&)> stream(SpanMode mode, uint64_t seed, long count) {
+std::function<bool(SpanDesc&)> stream(const std::string& mode, uint64_t seed, long count) {
   RasterConfig cfg;
-  cfg.unit = SpanParams::forMode(mode);
+  cfg.unit = spanParams(mode);
   auto s = std::make_shared<DescriptorStream>(seed, static_cast<uint64_t>(count), cfg);
   return [s](SpanDesc& d) { return s->next(d); };
 }
@@ -35,7 +37,7 @@ std::function<bool(SpanDesc&)> stream(SpanMode mode, uint64_t seed, long count) 
 // That stream offered to a unit cycle by cycle: the descriptor on offer, if any, and the next
 // one once the unit has accepted it.
 struct Offer {
-  Offer(SpanMode mode, uint64_t seed, long count) : next(stream(mode, seed, count)) { have = next(pending); }
+  Offer(const std::string& mode, uint64_t seed, long count) : next(stream(mode, seed, count)) { have = next(pending); }
   void accepted() { have = next(pending); }
   std::function<bool(SpanDesc&)> next;
   SpanDesc pending;
@@ -47,7 +49,7 @@ struct Offer {
 class SpanCosimModes : public testing::TestWithParam<std::string> {};
 
 TEST_P(SpanCosimModes, RandomTrianglesWithBackPressure) {
-  const SpanMode mode = parseSpanMode(GetParam());
+  const std::string mode = GetParam();
   SpanCosimOptions o;
   o.seed = 31;
   o.fail_dir = shd::testutil::freshTestDir("span_cosim").string();
@@ -61,15 +63,15 @@ TEST_P(SpanCosimModes, RandomTrianglesWithBackPressure) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Modes, SpanCosimModes,
-                         testing::Values("serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"));
+                         testing::ValuesIn(shd::testutil::spanModes()));
 
 TEST(SpanCosim, DetectsAModelOfAnotherLaneLayout) {
   // The checker must be able to fail: seg2 and evenodd draw the same pixels with the same
   // values but put them in different lanes and cycles.
   SpanCosimOptions o;
   o.fail_dir = shd::testutil::freshTestDir("span_cosim").string();
-  o.model_params = SpanParams::forMode(SpanMode::EvenOdd);
-  const SpanCosimResult r = runSpanCosim("seg2", stream(SpanMode::Seg2, 5, 200), o);
+  o.model_params = spanParams("evenodd");
+  const SpanCosimResult r = runSpanCosim("seg2", stream("seg2", 5, 200), o);
   ASSERT_GT(r.mismatches, 0u);
   ASSERT_TRUE(r.first.has_value());
   std::printf("as expected: cycle %llu triangle %u: %s\n", static_cast<unsigned long long>(r.first->cycle),
@@ -95,7 +97,7 @@ TEST(SpanCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
   // The counterpart of the saved failing case: the correct model's expectations pass.
   const fs::path dir = shd::testutil::freshTestDir("span_cosim");
   const std::string vec = (dir / "seg2.vec").string();
-  writeSpanVectors(vec, generateSpanVectors("seg2", 2000, 5));
+  writeSpanVectors(vec, generateSpanVectors(spanConfig("seg2"), 2000, 5));
   const ReplayResult rr = replayVectorFile(vec);
   EXPECT_EQ(rr.cycles, 2000u);
   EXPECT_GT(rr.results, 1000u);
@@ -117,7 +119,7 @@ TEST(SpanCosim, TickCheckFindsEveryDifferenceTheComparisonFinds) {
     SpanUnitModel model(p);
     dut->reset();
     model.reset();
-    Offer offer(parseSpanMode(mode), 9, 400);
+    Offer offer(mode, 9, 400);
     std::mt19937_64 rng(4);
     std::array<int, kKinds> changed{};
     SpanOut exp, bad, got;
@@ -175,7 +177,7 @@ TEST(SpanCosim, OneEvalCyclesEqualTwoEvalCycles) {
     fast->reset();
     traced->reset();
     model.reset();
-    Offer offer(parseSpanMode(mode), 13, 150);
+    Offer offer(mode, 13, 150);
     std::mt19937_64 rng(8);
     SpanOut exp, a, b;
     uint64_t cycles = 0;

@@ -2,6 +2,7 @@
 // every lane mode against the serial mode, the fill rule on shared edges, the plane's error
 // bound, the cycle formula, and stalls.
 #include "fixed/fixed.h"
+#include "test_util.h"
 #include "raster/setup.h"
 #include "raster/span_unit.h"
 #include "raster/span_walk.h"
@@ -17,14 +18,16 @@
 #include <fmt/format.h>
 
 using namespace shd;
+using shd::testutil::spanModes;
+using shd::testutil::spanParams;
 
 namespace {
 
-RasterConfig configFor(SpanMode m, int w = 64, int h = 48) {
+RasterConfig configFor(const std::string& m, int w = 64, int h = 48) {
   RasterConfig c;
   c.width = w;
   c.height = h;
-  c.unit = SpanParams::forMode(m);
+  c.unit = spanParams(m);
   return c;
 }
 
@@ -80,10 +83,10 @@ RunWalk walkWithRuns(const SpanParams& p, const SpanDesc& d, std::vector<SpanFra
   return rw;
 }
 
-std::vector<SpanFragment> runMode(SpanMode m, const std::array<SetupVertex, 3>& v, const RasterConfig& base,
+std::vector<SpanFragment> runMode(const std::string& m, const std::array<SetupVertex, 3>& v, const RasterConfig& base,
                                   SpanRun* run_out = nullptr) {
   RasterConfig c = base;
-  c.unit = SpanParams::forMode(m);
+  c.unit = spanParams(m);
   const SetupResult s = setupTriangle(v, 7, c);
   if (!s.desc) return {};
   SpanUnitModel unit(c.unit);
@@ -127,13 +130,14 @@ std::string describe(const GenTriangle& t) {
 // cycle-by-cycle model: the same fragments in the same order, the same cycles.
 void checkModesAgainstSerial(uint64_t seed, long count) {
   RasterConfig c;  // 512 x 512
-  c.unit = SpanParams::forMode(SpanMode::Serial);
+  c.unit = spanParams("serial");
   TriangleGenerator gen(seed);
   std::vector<SpanUnitModel> units;
   std::vector<RasterConfig> cfgs;
-  for (SpanMode m : allSpanModes()) {
+  const std::vector<std::string> modes = spanModes();
+  for (const std::string& m : modes) {
     cfgs.push_back(c);
-    cfgs.back().unit = SpanParams::forMode(m);
+    cfgs.back().unit = spanParams(m);
     units.emplace_back(cfgs.back().unit);
   }
   long frags = 0;
@@ -143,7 +147,7 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
     const auto v = toSetupVertices(t, c.unit.NumAttr);
     std::vector<SpanFragment> serial;
     for (size_t mi = 0; mi < units.size(); ++mi) {
-      const char* mode = toString(allSpanModes()[mi]);
+      const char* mode = modes[mi].c_str();
       const SetupResult s = setupTriangle(v, t.id, cfgs[mi]);
       std::vector<SpanFragment> got;
       if (s.desc) {
@@ -199,7 +203,7 @@ void checkModesAgainstSerial(uint64_t seed, long count) {
 TEST(TriangleSetup, SnapsHalfwayCoordinatesAndAttributesToEven) {
   // Every vertex coordinate and attribute code is rounded half to even, as Fixed::fromDouble
   // with Quant::RoundHalfEven: at S = 4 a coordinate k/32 is a half subpixel.
-  RasterConfig c = configFor(SpanMode::Serial, 64, 64);
+  RasterConfig c = configFor("serial", 64, 64);
   c.attr_frac_bits = {0, 1, 12, 28};
   const std::vector<double> xs = {1 + 1 / 32.0, 1 + 3 / 32.0, 2 - 1 / 32.0, 40.5 + 5 / 32.0, -1 - 1 / 32.0, -1 - 3 / 32.0};
   const std::vector<double> as = {2.5, 3.5, -2.5, 0.25, 0.75, 1 + std::ldexp(1.0, -13), std::ldexp(3.0, -29)};
@@ -221,7 +225,7 @@ TEST(TriangleSetup, SnapsHalfwayCoordinatesAndAttributesToEven) {
   EXPECT_EQ(setupTriangle({vtx(1 + 3 / 32.0, 1), vtx(20, 3), vtx(4, 30)}, 1, c).tri.X[0], 18);
   // Setup rounds below 2^51 by adding and subtracting 1.5 * 2^52, above through nearbyint:
   // ties on both sides of the switch, both signs, up to the widest attribute (AttrBits 62).
-  RasterConfig wide = configFor(SpanMode::Serial, 64, 64);
+  RasterConfig wide = configFor("serial", 64, 64);
   wide.unit.AttrBits = 62;
   wide.attr_frac_bits = {0, 1, 0, 28};
   for (double a : {0x1p51 - 0.5, 0x1p51 - 1.5, 0x1p51 + 0.5, 0x1p51 + 1.5, 0x1p51 + 1, 0x1p51 + 3, -(0x1p51 - 0.5),
@@ -236,7 +240,7 @@ TEST(TriangleSetup, SnapsHalfwayCoordinatesAndAttributesToEven) {
 }
 
 TEST(TriangleSetup, TopLeftBiasAndPlaneOfAHandTriangle) {
-  RasterConfig c = configFor(SpanMode::Serial, 8, 8);
+  RasterConfig c = configFor("serial", 8, 8);
   // Right triangle with legs on pixel-centre lines: (0.5,0.5) (4.5,0.5) (0.5,4.5).
   const SetupResult s = setupTriangle({vtx(0.5, 0.5, {0, 0, 0, 0}), vtx(4.5, 0.5, {64, 0, 0, 0}), vtx(0.5, 4.5, {0, 32, 0, 0})}, 1, c);
   ASSERT_TRUE(s.desc);
@@ -257,7 +261,7 @@ TEST(TriangleSetup, TopLeftBiasAndPlaneOfAHandTriangle) {
 }
 
 TEST(TriangleSetup, DegenerateAndOutsideAreDroppedWithAReason) {
-  const RasterConfig c = configFor(SpanMode::Serial);
+  const RasterConfig c = configFor("serial");
   EXPECT_EQ(setupTriangle({vtx(1, 1), vtx(1, 1), vtx(5, 9)}, 1, c).dropped, "zero area");
   EXPECT_EQ(setupTriangle({vtx(1, 1), vtx(3, 3), vtx(7, 7)}, 1, c).dropped, "zero area");
   EXPECT_EQ(setupTriangle({vtx(-20, -20), vtx(-10, -20), vtx(-20, -5)}, 1, c).dropped, "outside the viewport");
@@ -267,14 +271,14 @@ TEST(TriangleSetup, DegenerateAndOutsideAreDroppedWithAReason) {
 }
 
 TEST(SpanUnitModel, SerialWalkEqualsDirectEdgeEvaluation) {
-  const RasterConfig c = configFor(SpanMode::Serial);
+  const RasterConfig c = configFor("serial");
   std::mt19937_64 rng(11);
   long frags = 0;
   for (int n = 0; n < 20000; ++n) {
     const auto v = randomTriangle(rng, c.width, c.height);
     const SetupResult s = setupTriangle(v, static_cast<uint32_t>(n), c);
     const auto ref = rasterizeReference(s, c);
-    const auto got = sorted(runMode(SpanMode::Serial, v, c));
+    const auto got = sorted(runMode("serial", v, c));
     ASSERT_EQ(got.size(), ref.size()) << "triangle " << n << " (" << v[0].x << "," << v[0].y << ") (" << v[1].x << ","
                                       << v[1].y << ") (" << v[2].x << "," << v[2].y << ")";
     for (size_t i = 0; i < ref.size(); ++i) {
@@ -288,30 +292,30 @@ TEST(SpanUnitModel, SerialWalkEqualsDirectEdgeEvaluation) {
 }
 
 TEST(SpanUnitModel, EveryModeEqualsSerial) {
-  const RasterConfig c = configFor(SpanMode::Serial);
+  const RasterConfig c = configFor("serial");
   std::mt19937_64 rng(12);
   for (int n = 0; n < 20000; ++n) {
     const auto v = randomTriangle(rng, c.width, c.height);
-    const auto serial = sorted(runMode(SpanMode::Serial, v, c));
-    for (SpanMode m : allSpanModes()) {
+    const auto serial = sorted(runMode("serial", v, c));
+    for (const std::string& m : spanModes()) {
       const auto got = sorted(runMode(m, v, c));
-      ASSERT_EQ(got.size(), serial.size()) << toString(m) << " triangle " << n << " (" << v[0].x << "," << v[0].y
+      ASSERT_EQ(got.size(), serial.size()) << m << " triangle " << n << " (" << v[0].x << "," << v[0].y
                                            << ") (" << v[1].x << "," << v[1].y << ") (" << v[2].x << "," << v[2].y << ")";
       for (size_t i = 0; i < got.size(); ++i) {
-        ASSERT_EQ(got[i].x, serial[i].x) << toString(m) << " triangle " << n;
-        ASSERT_EQ(got[i].y, serial[i].y) << toString(m) << " triangle " << n;
-        ASSERT_EQ(got[i].attr, serial[i].attr) << toString(m) << " triangle " << n;
+        ASSERT_EQ(got[i].x, serial[i].x) << m << " triangle " << n;
+        ASSERT_EQ(got[i].y, serial[i].y) << m << " triangle " << n;
+        ASSERT_EQ(got[i].attr, serial[i].attr) << m << " triangle " << n;
       }
     }
   }
 }
 
 TEST(SpanUnitModel, CycleCountFollowsTheFormula) {
-  const RasterConfig c = configFor(SpanMode::Serial);
+  const RasterConfig c = configFor("serial");
   std::mt19937_64 rng(13);
-  for (SpanMode m : allSpanModes()) {
+  for (const std::string& m : spanModes()) {
     RasterConfig cm = c;
-    cm.unit = SpanParams::forMode(m);
+    cm.unit = spanParams(m);
     for (int n = 0; n < 2000; ++n) {
       const auto v = randomTriangle(rng, c.width, c.height);
       const SetupResult s = setupTriangle(v, 1, cm);
@@ -326,7 +330,7 @@ TEST(SpanUnitModel, CycleCountFollowsTheFormula) {
 }
 
 TEST(SpanUnitModel, StalledConsumerLosesNothing) {
-  const RasterConfig c = configFor(SpanMode::Seg4);
+  const RasterConfig c = configFor("seg4");
   std::mt19937_64 rng(14);
   for (int n = 0; n < 500; ++n) {
     const auto v = randomTriangle(rng, c.width, c.height);
@@ -366,7 +370,7 @@ TEST(SpanUnitModel, StalledConsumerLosesNothing) {
 }
 
 TEST(TriangleSetup, PlaneWithinTheDerivedBoundOfTheExactPlane) {
-  const RasterConfig c = configFor(SpanMode::Serial);
+  const RasterConfig c = configFor("serial");
   std::mt19937_64 rng(15);
   double worst = 0;  // in units of the bound
   for (int n = 0; n < 3000; ++n) {
@@ -386,7 +390,7 @@ TEST(TriangleSetup, PlaneWithinTheDerivedBoundOfTheExactPlane) {
 TEST(SpanUnitModel, SerialEqualsDirectEvaluationOnGeneratorClasses) {
   // Every size class and shape of raster/trigen.h, 512 x 512, against direct edge evaluation.
   RasterConfig c;
-  c.unit = SpanParams::forMode(SpanMode::Serial);
+  c.unit = spanParams("serial");
   TriangleGenerator gen(21);
   SpanUnitModel unit(c.unit);
   std::map<std::string, long> seen;
@@ -416,9 +420,9 @@ TEST(SpanUnitModel, EveryModeEqualsSerialOnAMillionTriangles) { checkModesAgains
 // units of narrower AttrBits, where colour codes (up to 2^20) and depth codes (up to 2^28)
 // overflow, and with the single lane-triangle of the serial and lane modes flipped.
 TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
-  for (SpanMode m : allSpanModes()) {
+  for (const std::string& m : spanModes()) {
     RasterConfig c;
-    c.unit = SpanParams::forMode(m);
+    c.unit = spanParams(m);
     DescriptorStream stream(5, 2000, c);
     uint64_t fragments = 0, wrapped = 0, run_rows = 0, fragment_rows = 0;
     SpanDesc d;
@@ -440,11 +444,11 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
           walkSpanUnit(p, x, walked);
           wide.clear();
           walkSpanUnit(c.unit, x, wide);  // AttrBits 32: nothing wraps
-          ASSERT_EQ(walked.size(), run.fragments.size()) << toString(m) << " AttrBits " << bits;
+          ASSERT_EQ(walked.size(), run.fragments.size()) << m << " AttrBits " << bits;
           for (size_t i = 0; i < walked.size(); ++i) {
             ASSERT_TRUE(walked[i].x == run.fragments[i].x && walked[i].y == run.fragments[i].y &&
                         walked[i].attr == run.fragments[i].attr)
-                << toString(m) << " AttrBits " << bits << " flip " << flip << " fragment " << i << " of triangle "
+                << m << " AttrBits " << bits << " flip " << flip << " fragment " << i << " of triangle "
                 << d.tag;
             wrapped += walked[i].attr != wide[i].attr ? 1 : 0;
           }
@@ -455,20 +459,20 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
           const RunWalk rw = walkWithRuns(p, x, walked);
           run_rows += rw.run_rows;
           fragment_rows += rw.fragment_rows;
-          ASSERT_EQ(walked.size(), run.fragments.size()) << toString(m) << " AttrBits " << bits << " runs";
+          ASSERT_EQ(walked.size(), run.fragments.size()) << m << " AttrBits " << bits << " runs";
           for (size_t i = 0; i < walked.size(); ++i)
             ASSERT_TRUE(walked[i].x == run.fragments[i].x && walked[i].y == run.fragments[i].y &&
                         walked[i].attr == run.fragments[i].attr)
-                << toString(m) << " AttrBits " << bits << " flip " << flip << " run fragment " << i << " of triangle "
+                << m << " AttrBits " << bits << " flip " << flip << " run fragment " << i << " of triangle "
                 << d.tag;
         }
       }
     }
-    EXPECT_GT(wrapped, fragments / 2) << toString(m);  // both loops ran: most rows wrap, some fit
-    EXPECT_LT(wrapped, fragments) << toString(m);
+    EXPECT_GT(wrapped, fragments / 2) << m;  // both loops ran: most rows wrap, some fit
+    EXPECT_LT(wrapped, fragments) << m;
     if (c.unit.NumTri == 1) {  // both paths ran: rows within one window and rows across windows
-      EXPECT_GT(run_rows, 0u) << toString(m);
-      EXPECT_GT(fragment_rows, 0u) << toString(m);
+      EXPECT_GT(run_rows, 0u) << m;
+      EXPECT_GT(fragment_rows, 0u) << m;
     }
   }
 }
@@ -491,7 +495,7 @@ TEST(TriangleSetup, PlaneCodesAreTheExactRationalsRoundedHalfToEven) {
   };
   for (const std::vector<int>& frac : {std::vector<int>{12, 12, 12, 28}, std::vector<int>{40, 40, 40, 28}}) {
     RasterConfig c;  // 512 x 512
-    c.unit = SpanParams::forMode(SpanMode::Serial);
+    c.unit = spanParams("serial");
     c.unit.AttrBits = frac[0] > 30 ? 62 : 32;
     c.attr_frac_bits = frac;
     TriangleGenerator gen(31);
@@ -528,9 +532,9 @@ TEST(SpanUnitModel, SharedEdgesOfMeshesDrawnExactlyOnce) {
   // drawn exactly once, in every mode; no pixel twice anywhere.
   std::mt19937_64 rng(23);
   TriGenOptions opt;
-  for (SpanMode m : allSpanModes()) {
+  for (const std::string& m : spanModes()) {
     RasterConfig c;
-    c.unit = SpanParams::forMode(m);
+    c.unit = spanParams(m);
     SpanUnitModel unit(c.unit);
     for (int trial = 0; trial < 6; ++trial) {
       MeshGenOptions mo;
@@ -554,7 +558,7 @@ TEST(SpanUnitModel, SharedEdgesOfMeshesDrawnExactlyOnce) {
       for (int y = 0; y < c.height; ++y)
         for (int x = 0; x < c.width; ++x) {
           const int h = hits[static_cast<size_t>(y) * c.width + x];
-          ASSERT_LE(h, 1) << toString(m) << " pixel " << x << "," << y << " drawn twice";
+          ASSERT_LE(h, 1) << m << " pixel " << x << "," << y << " drawn twice";
           const double px = x + 0.5, py = y + 0.5;
           // Interior of the region. Fan: ring vertices lie at radii in [radius/2, radius] and
           // angular gaps below 1.6 times the mean (jitter 0.3), so the disc of radius
@@ -562,7 +566,7 @@ TEST(SpanUnitModel, SharedEdgesOfMeshesDrawnExactlyOnce) {
           const bool in = fan ? std::hypot(px - cx, py - cy) < 0.5 * radius * std::cos(1.6 * M_PI / (37 + trial)) - 1e-9
                               : (px > mo.x0 && px < mo.x1 && py > mo.y0 && py < mo.y1);
           if (in) {
-            ASSERT_EQ(h, 1) << toString(m) << (fan ? " fan" : " grid") << " gap at pixel " << x << "," << y;
+            ASSERT_EQ(h, 1) << m << (fan ? " fan" : " grid") << " gap at pixel " << x << "," << y;
             ++inside;
           }
         }

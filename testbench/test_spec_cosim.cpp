@@ -8,11 +8,12 @@
 
 #include <fmt/format.h>
 
+#include "config/registry.h"
 #include "device/prom.h"
 #include "device/prom_io.h"
-#include "replay.h"
-#include "spec_cosim.h"
-#include "vector_gen.h"
+#include "cosim/replay.h"
+#include "cosim/spec_cosim.h"
+#include "vectors/vector_gen.h"
 
 using namespace shd;
 namespace fs = std::filesystem;
@@ -28,7 +29,7 @@ struct CosimSetup {
 // The configuration's table, written as the hex file the simulator loads.
 CosimSetup setup(const std::string& name) {
   CosimSetup s;
-  s.cfg = SpecUnitConfig::load(configPath(name));
+  s.cfg = specConfig(name);
   s.table = buildPromTable(PromRequest::fromContent(s.cfg.prom), s.cfg.rtl);
   const fs::path dir = shd::testutil::freshTestDir("spec_cosim");
   fs::create_directories(dir);
@@ -127,7 +128,7 @@ TEST(SpecCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
   // The counterpart of the saved failing window: the correct model's expectations pass.
   const CosimSetup s = setup("narrow");
   const std::string vec = (fs::path(s.prom_path).parent_path() / "narrow.vec").string();
-  writeSpecVectors(vec, generateSpecVectors("narrow", 2000, 5, s.prom_path, fs::path(vec).parent_path().string()));
+  writeSpecVectors(vec, generateSpecVectors(specConfig("narrow"), 2000, 5, s.prom_path, fs::path(vec).parent_path().string()));
   const ReplayResult rr = replayVectorFile(vec);
   EXPECT_EQ(rr.cycles, 2000u);
   EXPECT_GT(rr.results, 1000u);

@@ -1,5 +1,6 @@
 // SpecUnitModel: the datapath against an independent straight-line integer formulation, its
 // accuracy bound, the pipeline timing, and the configuration checks.
+#include "config/registry.h"
 #include "device/spec_unit.h"
 
 #include <gtest/gtest.h>
@@ -16,15 +17,15 @@ using namespace shd;
 namespace {
 
 PromTable tableFor(const std::string& name) {
-  const SpecUnitConfig c = SpecUnitConfig::load(configPath(name));
+  const SpecUnitConfig c = specConfig(name);
   return buildPromTable(PromRequest::fromContent(c.prom), c.rtl);
 }
 
 }  // namespace
 
 TEST(SpecUnitConfig, CheckedInConfigurationsLoad) {
-  for (const std::string& name : builtinConfigNames()) {
-    const SpecUnitConfig c = SpecUnitConfig::load(configPath(name));
+  for (const std::string& name : builtinConfigNames("spec")) {
+    const SpecUnitConfig c = specConfig(name);
     EXPECT_EQ(c.name, name);
     EXPECT_NO_THROW(c.rtl.validate());
     EXPECT_NO_THROW(tableFor(name)) << name;
@@ -67,7 +68,7 @@ TEST(SpecUnitConfig, CoefficientThatDoesNotFitIsNamed) {
 }
 
 TEST(SpecPromWord, EncodeDecodeRoundTrip) {
-  for (const std::string& name : builtinConfigNames()) {
+  for (const std::string& name : builtinConfigNames("spec")) {
     const PromTable t = tableFor(name);
     for (const PromEntry& e : t.entries) {
       const SpecCoef d = decodePromWord(t.words[e.address], t.unit);
@@ -81,7 +82,7 @@ TEST(SpecPromWord, EncodeDecodeRoundTrip) {
 TEST(SpecUnitModel, FastPathEqualsFixedFormulation) {
   // evaluate() (raw integers) against trace() (Fixed values in their formats): every
   // (shininess, cos) pair of the narrow configuration, a sample of the others.
-  for (const std::string& name : builtinConfigNames()) {
+  for (const std::string& name : builtinConfigNames("spec")) {
     const PromTable t = tableFor(name);
     const SpecUnitModel m(t.unit, t.words);
     const uint32_t ncos = 2u << t.unit.CosFracBits;
@@ -147,7 +148,7 @@ TEST(SpecUnitModel, ExactCasesAndSaturation) {
 }
 
 TEST(SpecUnitModel, PipelineLatencyHoldAndReset) {
-  for (const std::string& name : builtinConfigNames()) {
+  for (const std::string& name : builtinConfigNames("spec")) {
     const PromTable t = tableFor(name);
     SpecUnitModel m(t.unit, t.words);
     const int lat = t.unit.latency();

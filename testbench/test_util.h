@@ -8,7 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "config/registry.h"
+
 namespace shd::testutil {
+
+// The registry's span configurations (the lane modes), and one's parameters.
+inline std::vector<std::string> spanModes() { return builtinConfigNames("span"); }
+inline SpanParams spanParams(const std::string& mode) { return spanConfig(mode).rtl; }
 
 // A fresh, empty directory for the running test: <TempDir>/<area>/<Suite.Test> ('/' of
 // parameterised names replaced). ctest runs the tests of a file as parallel processes, so each

@@ -10,11 +10,12 @@
 
 #include <fmt/format.h>
 
+#include "config/registry.h"
 #include "device/prom.h"
 #include "device/prom_io.h"
-#include "replay.h"
-#include "vector_file.h"
-#include "vector_gen.h"
+#include "cosim/replay.h"
+#include "vectors/vector_file.h"
+#include "vectors/vector_gen.h"
 
 using namespace shd;
 namespace fs = std::filesystem;
@@ -38,18 +39,18 @@ void spit(const fs::path& p, const std::string& text) { std::ofstream(p) << text
 
 // A spec-unit vector file of `config` in dir, with its PROM beside it.
 fs::path specFile(const fs::path& dir, const std::string& config, uint64_t cycles, uint64_t seed) {
-  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(config));
+  const SpecUnitConfig cfg = specConfig(config);
   const PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
   writeFileAtomic((dir / (config + ".hex")).string(), renderProm(t, PromFormat::Hex));
   const fs::path vec = dir / ("spec_" + config + ".vec");
-  writeSpecVectors(vec.string(), generateSpecVectors(config, cycles, seed, (dir / (config + ".hex")).string(), dir.string()));
+  writeSpecVectors(vec.string(), generateSpecVectors(specConfig(config), cycles, seed, (dir / (config + ".hex")).string(), dir.string()));
   return vec;
 }
 
 fs::path spanFile(const fs::path& dir, const std::string& config, uint64_t cycles, uint64_t seed,
                   VectorGenSummary* summary = nullptr) {
   const fs::path vec = dir / ("span_" + config + ".vec");
-  writeSpanVectors(vec.string(), generateSpanVectors(config, cycles, seed, summary));
+  writeSpanVectors(vec.string(), generateSpanVectors(spanConfig(config), cycles, seed, summary));
   return vec;
 }
 
@@ -80,7 +81,7 @@ TEST(VectorFile, SpecRoundTripsExactly) {
 
 TEST(VectorFile, SpanRoundTripsExactly) {
   const fs::path dir = testutil::freshTestDir("vectors");
-  for (const std::string& mode : builtinSpanConfigNames()) {
+  for (const std::string& mode : builtinConfigNames("span")) {
     const fs::path vec = spanFile(dir, mode, 1500, 3);
     SpanVectors v = loadSpanVectors(vec.string());
     EXPECT_EQ(v.config, mode);
@@ -88,7 +89,7 @@ TEST(VectorFile, SpanRoundTripsExactly) {
     EXPECT_GT(v.descs.size(), 10u) << mode;
     // Re-render with the generator's notes: identical text (every field survives the trip,
     // signed ones through their port width).
-    v.notes = generateSpanVectors(mode, 1500, 3).notes;
+    v.notes = generateSpanVectors(spanConfig(mode), 1500, 3).notes;
     EXPECT_EQ(renderSpanVectors(v), slurp(vec)) << mode;
   }
 }
@@ -118,7 +119,7 @@ TEST(VectorFile, CheckedInSpanFilesCoverTheDirectedPhasesAndTheControlCorners) {
   // the cycle counts of scripts/regen_vectors.sh are long enough for the directed phases, and
   // counts the control corners again by running the model on each file's inputs (the file alone
   // cannot tell a ROW cycle from a SPAN cycle without a valid lane).
-  for (const std::string& mode : builtinSpanConfigNames()) {
+  for (const std::string& mode : builtinConfigNames("span")) {
     const fs::path path = fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("span_" + mode + ".vec");
     const std::string text = slurp(path);
     ASSERT_FALSE(text.empty()) << mode;
@@ -160,7 +161,7 @@ TEST(VectorFile, CheckedInSpanFilesCoverTheDirectedPhasesAndTheControlCorners) {
 }
 
 TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
-  for (const std::string& config : builtinConfigNames()) {
+  for (const std::string& config : builtinConfigNames("spec")) {
     const fs::path path = fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("spec_" + config + ".vec");
     const SpecVectors v = loadSpecVectors(path.string());
     const SpecUnitParams& p = v.params;
@@ -266,7 +267,7 @@ TEST(Replay, CorrectFilesPassAndOneWrongValueFailsThere) {
       writeSpecVectors(vec.string(), v);
     } else {
       SpanVectors v = loadSpanVectors(vec.string());
-      v.notes = generateSpanVectors("evenodd", 800, 11).notes;
+      v.notes = generateSpanVectors(spanConfig("evenodd"), 800, 11).notes;
       for (size_t i = 400; i < v.cycles.size() && !cycle; ++i)
         if (v.cycles[i].expected.lane[1].valid) {
           v.cycles[i].expected.lane[1].y ^= 1;
@@ -312,7 +313,7 @@ TEST(Replay, RefusesFilesItCannotReplayFaithfully) {
   // A PROM that is missing, or holds another configuration's table.
   fs::remove(dir / "default.hex");
   EXPECT_NE(errorOf([&] { replayVectorFile(spec.string()); }).find("cannot open PROM file"), std::string::npos);
-  const SpecUnitConfig narrow = SpecUnitConfig::load(configPath("narrow"));
+  const SpecUnitConfig narrow = specConfig("narrow");
   writeFileAtomic((dir / "default.hex").string(),
                   renderProm(buildPromTable(PromRequest::fromContent(narrow.prom), narrow.rtl), PromFormat::Hex));
   // It parses (16-bit words fit the 24-bit ones), loads, and must not pass.
@@ -321,16 +322,18 @@ TEST(Replay, RefusesFilesItCannotReplayFaithfully) {
 
 TEST(VectorGen, RefusesAStalePromAndUnknownConfigurations) {
   const fs::path dir = testutil::freshTestDir("vectors");
-  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath("default"));
+  const SpecUnitConfig cfg = specConfig("default");
   PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
   t.words[17] ^= 1;
   writeFileAtomic((dir / "stale.hex").string(), renderProm(t, PromFormat::Hex));
-  EXPECT_NE(errorOf([&] { generateSpecVectors("default", 10, 1, (dir / "stale.hex").string(), dir.string()); })
+  EXPECT_NE(errorOf([&] { generateSpecVectors(cfg, 10, 1, (dir / "stale.hex").string(), dir.string()); })
                 .find("word 17"),
             std::string::npos);
-  EXPECT_NE(errorOf([&] { generateSpecVectors("nosuch", 10, 1, (dir / "stale.hex").string(), dir.string()); })
-                .find("known: default, narrow, wide, cubic"),
-            std::string::npos);
-  EXPECT_NE(errorOf([&] { generateSpanVectors("nosuch", 10, 1); }).find("no span configuration 'nosuch'"),
-            std::string::npos);
+  // Unknown names: the registry's message, which lists its names.
+  const std::string spec_err = errorOf([&] { specConfig("nosuch"); });
+  EXPECT_NE(spec_err.find("no specular-unit configuration 'nosuch'"), std::string::npos) << spec_err;
+  EXPECT_NE(spec_err.find("default"), std::string::npos) << spec_err;
+  const std::string span_err = errorOf([&] { spanConfig("nosuch"); });
+  EXPECT_NE(span_err.find("no span-unit configuration 'nosuch'"), std::string::npos) << span_err;
+  EXPECT_NE(span_err.find("serial"), std::string::npos) << span_err;
 }

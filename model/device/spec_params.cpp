@@ -1,13 +1,7 @@
 #include "device/spec_params.h"
 
-#include <fstream>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-
-#ifndef SHD_SOURCE_DIR
-#error "SHD_SOURCE_DIR must be defined by the build"
-#endif
 
 namespace shd {
 
@@ -114,52 +108,5 @@ nlohmann::json SpecUnitParams::toJson() const {
   for (const Member& m : kMembers) j[m.name] = this->*(m.field);
   return j;
 }
-
-SpecUnitConfig SpecUnitConfig::load(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::invalid_argument(fmt::format("cannot open configuration file {}", path));
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw std::invalid_argument(fmt::format("{}: not valid JSON: {}", path, e.what()));
-  }
-  if (!j.is_object()) throw std::invalid_argument(fmt::format("{}: must hold a JSON object", path));
-  SpecUnitConfig c;
-  c.path = path;
-  for (const auto& [key, value] : j.items()) {
-    if (key == "name") {
-      if (!value.is_string()) throw std::invalid_argument(fmt::format("{}: name must be a string", path));
-      c.name = value.get<std::string>();
-    } else if (key == "description") {
-      // free text
-    } else if (key == "rtl") {
-      c.rtl = SpecUnitParams::fromJson(value, path);
-    } else if (key == "prom") {
-      if (!value.is_object()) throw std::invalid_argument(fmt::format("{}: prom must be an object", path));
-      for (const auto& [pk, pv] : value.items()) {
-        if (pk == "fit" && pv.is_string()) c.prom.fit = pv.get<std::string>();
-        else if (pk == "level" && pv.is_number()) c.prom.level = pv.get<double>();
-        else if (pk == "n" && pv.is_string()) c.prom.n = pv.get<std::string>();
-        else if (pk == "n_list" && pv.is_string()) { c.prom.n = pv.get<std::string>(); c.prom.is_list = true; }
-        else
-          throw std::invalid_argument(fmt::format(
-              "{}: prom.{} is unknown or has the wrong type (fit: string, level: number, n or "
-              "n_list: string)",
-              path, pk));
-      }
-    } else {
-      throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", path, key));
-    }
-  }
-  if (c.name.empty()) throw std::invalid_argument(fmt::format("{}: missing \"name\"", path));
-  return c;
-}
-
-std::string configPath(const std::string& name) {
-  return fmt::format("{}/vectors/config/spec_{}.json", SHD_SOURCE_DIR, name);
-}
-
-std::vector<std::string> builtinConfigNames() { return {"default", "narrow", "wide", "cubic"}; }
 
 }  // namespace shd

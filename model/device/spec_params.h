@@ -1,16 +1,9 @@
-// Parameters of shd_spec_unit, named exactly as the Verilog parameters, and the unit
-// configurations (vectors/config/spec_*.json) that CMake, the model and the CLI all read.
-//
-// A configuration file:
-//   { "name": "default",
-//     "rtl":  { "Degree": 2, "CosFracBits": 15, ... },      // -G parameters of the RTL
-//     "prom": { "fit": "inflection", "level": 0.5, "n": "1:1000" } }
-// CMake passes every member of "rtl" to verilate() as -G<Name>=<value>; the model reads the
-// same members here. Missing members take the defaults below; unknown members are errors.
+// Parameters of shd_spec_unit, named exactly as the Verilog parameters: the "rtl" object of a
+// specular-unit configuration (config/registry.h). Missing members take the defaults below;
+// unknown members are errors.
 #pragma once
 
 #include <string>
-#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -62,19 +55,5 @@ struct PromContent {
   std::string n = "1:1000";        // "lo:hi[:step]" range or, with is_list, "8,32,200"
   bool is_list = false;
 };
-
-struct SpecUnitConfig {
-  std::string name;
-  std::string path;  // file it was read from, "" for built-in
-  SpecUnitParams rtl;
-  PromContent prom;
-
-  static SpecUnitConfig load(const std::string& path);
-};
-
-// The checked-in configurations: vectors/config/spec_<name>.json under the source tree
-// (SHD_SOURCE_DIR, compiled in).
-std::string configPath(const std::string& name);
-std::vector<std::string> builtinConfigNames();
 
 }  // namespace shd

@@ -337,8 +337,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   // Lane-triangles in the walker frame, built in place in the descriptor.
   SpanDesc& d = res.desc.emplace();
   auto& lanes = d.tri;
-  const SpanMode mode = p.mode();
-  if (mode != SpanMode::Sierpinski) {
+  if (p.NumTri == 1) {
     buildLaneTri(lanes, whole, false, 0, 0, cfg);
   } else {
     // Split at the edge midpoints (exact in u units): T0 = (V0, M01, M20) is the walker frame,

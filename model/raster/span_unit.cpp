@@ -6,57 +6,12 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
 
 namespace shd {
 
 using namespace span_detail;
-
-const char* toString(SpanMode m) {
-  switch (m) {
-    case SpanMode::Serial: return "serial";
-    case SpanMode::EvenOdd: return "evenodd";
-    case SpanMode::Seg2: return "seg2";
-    case SpanMode::Seg4: return "seg4";
-    case SpanMode::Seg8: return "seg8";
-    case SpanMode::Sierpinski: return "sierpinski";
-  }
-  return "?";
-}
-
-const std::vector<SpanMode>& allSpanModes() {
-  static const std::vector<SpanMode> modes{SpanMode::Serial, SpanMode::EvenOdd, SpanMode::Seg2,
-                                           SpanMode::Seg4,   SpanMode::Seg8,    SpanMode::Sierpinski};
-  return modes;
-}
-
-SpanMode parseSpanMode(const std::string& s) {
-  for (SpanMode m : allSpanModes())
-    if (s == toString(m)) return m;
-  throw std::invalid_argument(
-      fmt::format("unknown span mode '{}' (expected serial, evenodd, seg2, seg4, seg8 or sierpinski)", s));
-}
-
-SpanParams SpanParams::forMode(SpanMode m) {
-  SpanParams p;
-  switch (m) {
-    case SpanMode::Serial: break;
-    case SpanMode::EvenOdd: p.LanesPerTri = 2, p.AlignLanes = 1; break;
-    case SpanMode::Seg2: p.LanesPerTri = 2; break;
-    case SpanMode::Seg4: p.LanesPerTri = 4; break;
-    case SpanMode::Seg8: p.LanesPerTri = 8; break;
-    case SpanMode::Sierpinski: p.NumTri = 4; break;
-  }
-  return p;
-}
-
-SpanMode SpanParams::mode() const {
-  for (SpanMode m : allSpanModes()) {
-    const SpanParams f = forMode(m);
-    if (f.NumTri == NumTri && f.LanesPerTri == LanesPerTri && f.AlignLanes == AlignLanes) return m;
-  }
-  throw std::invalid_argument(fmt::format("no span mode has NumTri {} LanesPerTri {} AlignLanes {}", NumTri,
-                                          LanesPerTri, AlignLanes));
-}
 
 void SpanParams::validate() const {
   auto need = [](bool ok, const char* name, int v, const char* rule) {
@@ -72,7 +27,56 @@ void SpanParams::validate() const {
   need(RemBits >= 2 && RemBits <= 60, "RemBits", RemBits, "must be in 2..60");
   need(PixBits >= 1 && PixBits < CoordBits, "PixBits", PixBits, "must be in 1..CoordBits-1");
   need(TagBits >= 1 && TagBits <= 32, "TagBits", TagBits, "must be in 1..32");
-  mode();
+}
+
+namespace {
+
+struct SpanMember {
+  const char* name;
+  int SpanParams::*field;
+};
+
+// In the vector files' order (sim/vector_file.h).
+constexpr SpanMember kSpanMembers[] = {
+    {"NumTri", &SpanParams::NumTri},       {"LanesPerTri", &SpanParams::LanesPerTri},
+    {"AlignLanes", &SpanParams::AlignLanes}, {"NumAttr", &SpanParams::NumAttr},
+    {"AttrBits", &SpanParams::AttrBits},   {"CoordBits", &SpanParams::CoordBits},
+    {"RemBits", &SpanParams::RemBits},     {"PixBits", &SpanParams::PixBits},
+    {"TagBits", &SpanParams::TagBits}};
+
+}  // namespace
+
+SpanParams SpanParams::fromJson(const nlohmann::json& rtl, const std::string& where) {
+  if (!rtl.is_object()) throw std::invalid_argument(fmt::format("{}: 'rtl' is not an object", where));
+  SpanParams p;
+  for (const auto& [key, value] : rtl.items()) {
+    const SpanMember* m = nullptr;
+    for (const SpanMember& cand : kSpanMembers)
+      if (key == cand.name) m = &cand;
+    if (m == nullptr) {
+      std::vector<std::string> known;
+      for (const SpanMember& k : kSpanMembers) known.emplace_back(k.name);
+      throw std::invalid_argument(
+          fmt::format("{}: unknown span parameter '{}' (known: {})", where, key, fmt::join(known, " ")));
+    }
+    if (!value.is_number_integer())
+      throw std::invalid_argument(fmt::format("{}: span parameter {} is not an integer", where, key));
+    p.*(m->field) = value.get<int>();
+  }
+  for (const SpanMember& m : kSpanMembers)
+    if (!rtl.contains(m.name)) throw std::invalid_argument(fmt::format("{}: span parameter {} missing", where, m.name));
+  try {
+    p.validate();
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
+  }
+  return p;
+}
+
+nlohmann::json SpanParams::toJson() const {
+  nlohmann::json j = nlohmann::json::object();
+  for (const SpanMember& m : kSpanMembers) j[m.name] = this->*(m.field);
+  return j;
 }
 
 SpanUnitModel::SpanUnitModel(SpanParams p) : p_(p) {

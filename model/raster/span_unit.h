@@ -8,7 +8,8 @@
 //   The unit walks a *walker frame*: rows w (integers) and columns x (integers), signed.
 //   It holds NumTri *lane-triangles*, each a triangle given in the walker frame by up to three
 //   edges in solved (DDA) form, with its own row range and clip box, and an output map from the
-//   walker frame to screen pixels. Each lane-triangle drives LanesPerTri lanes.
+//   walker frame to screen pixels. Each lane-triangle drives LanesPerTri lanes. The lane modes
+//   are the span configurations (vectors/config/span_<mode>.json); those of the registry:
 //     serial      NumTri 1, LanesPerTri 1
 //     evenodd     NumTri 1, LanesPerTri 2, AlignLanes 1: lane i takes the pixels x = i (mod 2),
 //                 as a framebuffer interleaved in two banks by x parity would
@@ -20,6 +21,8 @@
 //                 one) is point-reflected, so its pixels are walked in the opposite direction.
 //                 Each lane-triangle carries its own exact edges, so when an edge delta is odd
 //                 (the paper's "cut points") every lane still covers exactly its own pixels.
+//   Any product of the two works (NumTri 4 with LanesPerTri 2: each sub-triangle in segments
+//   of two): setup splits by NumTri, the walker shows LanesPerTri columns per lane-triangle.
 //   Every lane reads the same walker attribute plane: I_w(x, w) = iref + didx*(x - xref)
 //   + didy*(w - row_first), exact integer (two's complement) arithmetic on attribute codes. A
 //   lane's fragment at walker (x, w) has
@@ -81,6 +84,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "raster/inline_vec.h"
 
 namespace shd {
@@ -89,12 +94,8 @@ constexpr size_t kMaxAttr = 16;    // NumAttr <= 16
 constexpr size_t kMaxLaneTri = 4;  // NumTri is 1 or 4
 using AttrVec = InlineVec<int64_t, kMaxAttr>;  // attribute codes, held in place (no heap)
 
-enum class SpanMode { Serial, EvenOdd, Seg2, Seg4, Seg8, Sierpinski };
-const char* toString(SpanMode m);        // "serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"
-SpanMode parseSpanMode(const std::string& s);  // std::invalid_argument naming the choices
-const std::vector<SpanMode>& allSpanModes();
-
-// Parameters of shd_span_unit, named as in the Verilog.
+// Parameters of shd_span_unit, named as in the Verilog: the "rtl" object of a span-unit
+// configuration (config/registry.h), whose name is its lane mode's.
 struct SpanParams {
   int NumTri = 1;       // lane-triangles: 1, or 4 (sierpinski)
   int LanesPerTri = 1;  // 1, 2, 4 or 8
@@ -106,10 +107,13 @@ struct SpanParams {
   int PixBits = 12;     // unsigned screen pixel coordinates on the fragment ports
   int TagBits = 32;     // triangle tag carried to the fragments
 
-  static SpanParams forMode(SpanMode m);  // the defaults above with the mode's lane layout
-  SpanMode mode() const;                  // std::invalid_argument for a layout no mode has
   int lanes() const { return NumTri * LanesPerTri; }
   void validate() const;  // std::invalid_argument naming the parameter
+
+  // Reads the "rtl" object: every member required; unknown or non-integer members and values
+  // validate() refuses are std::invalid_argument naming `where`.
+  static SpanParams fromJson(const nlohmann::json& rtl, const std::string& where);
+  nlohmann::json toJson() const;
 };
 
 struct SpanEdge {

@@ -262,8 +262,6 @@ std::vector<Method> allMethods() {
   return v;
 }
 
-std::string specConfigForLobe(Lobe l) { return l == Lobe::Cubic ? "cubic" : "default"; }
-
 uint64_t ModelSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) {
   out.resize(in.size());
   for (size_t i = 0; i < in.size(); ++i) out[i] = unit_.evaluate(in[i].shin, in[i].cos, in[i].light).rgb;

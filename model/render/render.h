@@ -156,7 +156,6 @@ class ModelSpecEngine final : public SpecEngine {
 struct RenderOptions {
   Method method = Method::Gouraud;
   std::string brdf;  // "" : each material's own
-  SpanMode span_mode = SpanMode::Serial;
   int subpixel_bits = 4;
   double modified_threshold_lsb = 4;  // modified-gouraud: split where exact - Gouraud exceeds this
   double bisection_threshold = 0.02;  // normal-bisection: the listing's error bound per segment
@@ -212,8 +211,8 @@ struct RenderResult {
 
 // The specular units of the device lobes (null where the scene does not use the lobe).
 struct SpecEngines {
-  SpecEngine* quadratic = nullptr;  // configuration "default"
-  SpecEngine* cubic = nullptr;      // configuration "cubic"
+  SpecEngine* quadratic = nullptr;  // a degree-2 unit
+  SpecEngine* cubic = nullptr;      // a degree-3 unit
   SpecEngine* forLobe(Lobe l) const { return l == Lobe::Cubic ? cubic : (l == Lobe::Quadratic ? quadratic : nullptr); }
 };
 
@@ -225,8 +224,5 @@ std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt);
 RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& spec);
 // The same into `res`, reusing its buffers (a frame loop allocates nothing after the first frame).
 void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& spec, RenderResult& res);
-
-// The specular unit configuration for a lobe: "default" (quadratic) or "cubic".
-std::string specConfigForLobe(Lobe l);
 
 }  // namespace shd

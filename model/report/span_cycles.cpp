@@ -20,18 +20,32 @@ double medianMs(std::vector<double> v) {
 
 }  // namespace
 
+std::vector<SpanUnitConfig> spanCyclesConfigs() {
+  std::vector<SpanUnitConfig> all;
+  for (const std::string& n : builtinConfigNames("span")) all.push_back(spanConfig(n));
+  const auto serial = std::find_if(all.begin(), all.end(), [](const SpanUnitConfig& c) { return c.rtl.lanes() == 1; });
+  if (serial == all.end())
+    throw std::invalid_argument("span-cycles: the speed-ups are relative to a one-lane span configuration; the "
+                                "registry has none");
+  std::rotate(all.begin(), serial, serial + 1);
+  return all;
+}
+
 TriangleSetCycles measureSpanCycles(const std::string& name, const TriangleList& tris, const RasterConfig& base,
-                                    const std::vector<int>& divider_latency, int soft_repeats) {
+                                    const std::vector<SpanUnitConfig>& modes, const std::vector<int>& divider_latency,
+                                    int soft_repeats) {
+  if (modes.empty() || modes.front().rtl.lanes() != 1)
+    throw std::invalid_argument("span-cycles: the first configuration measured must have one lane (the serial unit)");
   TriangleSetCycles out;
   out.name = name;
   out.input_triangles = tris.size();
   out.divider_latency = divider_latency;
-  for (SpanMode m : allSpanModes()) {
+  for (const SpanUnitConfig& m : modes) {
     RasterConfig c = base;
-    c.unit = SpanParams::forMode(m);
+    c.unit = m.rtl;
     SpanUnitModel unit(c.unit);
     ModeCycles mc;
-    mc.mode = m;
+    mc.mode = m.name;
     mc.lanes = c.unit.lanes();
     uint32_t tag = 0;
     for (const auto& v : tris) {
@@ -43,7 +57,7 @@ TriangleSetCycles measureSpanCycles(const std::string& name, const TriangleList&
       mc.cycles += run.cycles;
       mc.row_cycles += run.row_cycles;
       mc.span_cycles += run.span_cycles;
-      if (m == SpanMode::Serial) {
+      if (out.modes.empty()) {  // the serial unit's rows
         std::map<int32_t, int> per_row;
         for (const SpanFragment& f : run.fragments) ++per_row[f.y];
         for (const auto& [y, n] : per_row) out.divisions += n >= 2 ? 1 : 0;
@@ -83,7 +97,7 @@ nlohmann::json toJson(const TriangleSetCycles& s) {
   nlohmann::json modes = nlohmann::json::array();
   const double serial = static_cast<double>(s.modes.front().cycles);
   for (const ModeCycles& m : s.modes)
-    modes.push_back({{"mode", toString(m.mode)},
+    modes.push_back({{"mode", m.mode},
                      {"lanes", m.lanes},
                      {"triangles", m.triangles},
                      {"fragments", m.fragments},
@@ -114,7 +128,7 @@ std::string renderSpanCyclesTable(const std::vector<TriangleSetCycles>& sets) {
       "Span unit cycles per triangle set (cycle-accurate model, consumer always ready).\n"
       "Speed-up over the serial unit; the paper claims 2x for even/odd and 4x for the 4-way split.\n\n";
   out += fmt::format("{:<16} {:>9} {:>11} |", "set", "triangles", "px/tri");
-  for (SpanMode m : allSpanModes()) out += fmt::format(" {:>14}", toString(m));
+  for (const ModeCycles& m : sets.front().modes) out += fmt::format(" {:>14}", m.mode);
   out += "\n";
   for (const TriangleSetCycles& s : sets) {
     const ModeCycles& serial = s.modes.front();

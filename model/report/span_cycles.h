@@ -15,12 +15,13 @@
 
 #include <nlohmann/json_fwd.hpp>
 
+#include "config/registry.h"
 #include "raster/setup.h"
 
 namespace shd {
 
 struct ModeCycles {
-  SpanMode mode = SpanMode::Serial;
+  std::string mode;  // the span configuration's name
   uint64_t triangles = 0;  // drawn (setup kept them)
   uint64_t fragments = 0;
   uint64_t cycles = 0;
@@ -34,7 +35,7 @@ struct ModeCycles {
 struct TriangleSetCycles {
   std::string name;
   uint64_t input_triangles = 0;
-  std::vector<ModeCycles> modes;  // allSpanModes() order
+  std::vector<ModeCycles> modes;  // the order of the configurations measured: serial first
   uint64_t divisions = 0;         // serial raster lines with >= 2 pixels
   std::vector<int> divider_latency;
   double soft_ms_classical = 0, soft_ms_constant = 0;  // median over repeats
@@ -43,8 +44,15 @@ struct TriangleSetCycles {
 
 using TriangleList = std::vector<std::array<SetupVertex, 3>>;
 
+// The span configurations of the registry, the serial unit (the first with one lane) first and
+// the others in registry order. std::invalid_argument when no configuration has one lane.
+std::vector<SpanUnitConfig> spanCyclesConfigs();
+
+// modes: the configurations to measure, the serial unit (one lane) first: the speed-ups and
+// the classical unit's cycles are relative to it.
 TriangleSetCycles measureSpanCycles(const std::string& name, const TriangleList& tris, const RasterConfig& base,
-                                    const std::vector<int>& divider_latency, int soft_repeats);
+                                    const std::vector<SpanUnitConfig>& modes, const std::vector<int>& divider_latency,
+                                    int soft_repeats);
 
 nlohmann::json toJson(const TriangleSetCycles& s);
 std::string renderSpanCyclesTable(const std::vector<TriangleSetCycles>& sets);

@@ -17,7 +17,7 @@
 
 #include <fmt/format.h>
 
-#include "progress.h"
+#include "cli/progress.h"
 #include "sc_common.h"
 
 namespace shd {

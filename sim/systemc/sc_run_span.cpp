@@ -11,12 +11,13 @@
 #include <verilated.h>
 #include <verilated_fst_sc.h>
 
+#include "config/registry.h"
 #include "raster/desc_stream.h"
 #include "sc_run.h"
 #include "scene_descs.h"
 #include "span_rtl.h"
 #include "span_tb.h"
-#include "vector_file.h"
+#include "vectors/vector_file.h"
 
 
 namespace shd {
@@ -82,14 +83,13 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   if (std::find(built.begin(), built.end(), o.config) == built.end())
     throw ArgError(fmt::format("--config {}: no SystemC model of the span unit by that name (built: {})", o.config,
                                fmt::join(built, ", ")));
-  if (!o.fst.empty()) Verilated::traceEverOn(true);  // before the model (TOOLCHAIN pitfall 4)
+  if (!o.fst.empty()) Verilated::traceEverOn(true);  // before the model, or it traces nothing
   std::unique_ptr<SpanRtl> rtl = makeSpanRtl(o.config, "span_rtl");
   const SpanParams p = rtl->params();
-  const SpanParams json_params = spanConfigParams(o.config);
-  if (describe(json_params) != describe(p))
-    throw ArgError(fmt::format("--config {}: vectors/config/span_{}.json now holds {}, the SystemC model was verilated "
-                               "with {}: rebuild",
-                               o.config, o.config, describe(json_params), describe(p)));
+  const SpanUnitConfig cfg = spanConfig(o.config);
+  if (describe(cfg.rtl) != describe(p))
+    throw ArgError(fmt::format("--config {}: {} holds {}, the SystemC model was verilated with {}: rebuild", o.config,
+                               cfg.path, describe(cfg.rtl), describe(p)));
   if (!o.save_vectors.empty()) prepareOutput(o.save_vectors, "--save-vectors");
   if (!o.fst.empty()) prepareOutput(o.fst, "--fst");
 

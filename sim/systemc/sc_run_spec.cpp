@@ -8,17 +8,19 @@
 #include <memory>
 #include <optional>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 #include <verilated.h>
 #include <verilated_fst_sc.h>
 
 #include "device/prom.h"
 #include "device/prom_io.h"
-#include "device/spec_params.h"
+#include "config/registry.h"
 #include "sc_run.h"
 #include "spec_rtl.h"
 #include "spec_tb.h"
-#include "vector_file.h"
+#include "vectors/vector_file.h"
 
 namespace fs = std::filesystem;
 
@@ -34,16 +36,27 @@ std::string describe(const SpecUnitParams& p) {
                      p.HornerFracBits, p.SpecFracBits, p.LightBits, p.PipeStages);
 }
 
-// The PROM file: --prom, else the vector file's own (relative to the file), else the checked-in
-// table of the configuration.
+// The PROM file: --prom, else the vector file's own (relative to the file), else "" (the
+// configuration's table, written to a temporary file).
 std::string promPath(const ScOptions& o, const SpecVectors* file) {
   if (!o.prom.empty()) return fs::absolute(o.prom).string();
   if (file && !file->prom.empty()) {
     const fs::path p(file->prom);
     return (p.is_absolute() ? p : fs::absolute(o.vector_file).parent_path() / p).lexically_normal().string();
   }
-  return fmt::format("{}/vectors/prom/spec_{}.hex", SHD_SOURCE_DIR, o.config);
+  return "";
 }
+
+// A temporary PROM file, removed with this object.
+struct TempProm {
+  std::string path;
+  ~TempProm() {
+    if (!path.empty()) {
+      std::error_code ec;
+      fs::remove(path, ec);
+    }
+  }
+};
 
 // The failing case (sc_run.h, ScFailCase): the captured window of inputs, from reset, with the
 // golden module's predictions replayed on it (the fault included: that is what differs from the
@@ -104,7 +117,7 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   if (std::find(built.begin(), built.end(), o.config) == built.end())
     throw ArgError(fmt::format("--config {}: no SystemC model of the specular unit by that name (built: {})", o.config,
                                fmt::join(built, ", ")));
-  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(o.config));
+  const SpecUnitConfig cfg = specConfig(o.config);
   const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
 
   std::unique_ptr<SpecVectors> file;
@@ -118,7 +131,12 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
       throw ArgError(fmt::format("--vector-file {}: made for configuration {} ({}), not for {} ({})", o.vector_file,
                                  file->config, describe(file->params), o.config, describe(cfg.rtl)));
   }
-  const std::string prom = promPath(o, file.get());
+  std::string prom = promPath(o, file.get());
+  TempProm temp_prom;
+  if (prom.empty()) {
+    temp_prom.path = prom = (fs::temp_directory_path() / fmt::format("shadesim_systemc-{}-spec_{}.hex", getpid(), o.config)).string();
+    writeFileAtomic(prom, renderProm(table, PromFormat::Hex));
+  }
   // The file first, strictly (the simulators only warn about a missing or short file) ...
   std::vector<PromWord> file_words;
   try {
@@ -138,12 +156,12 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   const std::string prom_arg = "+prom=" + prom;
   const char* vargv[] = {"shadesim_systemc", prom_arg.c_str()};
   Verilated::commandArgs(2, vargv);
-  if (!o.fst.empty()) Verilated::traceEverOn(true);  // before the model (TOOLCHAIN pitfall 4)
+  if (!o.fst.empty()) Verilated::traceEverOn(true);  // before the model, or it traces nothing
 
   std::unique_ptr<SpecRtl> rtl = makeSpecRtl(o.config, "spec_rtl");
   if (describe(rtl->params()) != describe(cfg.rtl))
     throw ArgError(fmt::format("--config {}: {} now holds {}, the SystemC model was verilated with {}: rebuild",
-                               o.config, configPath(o.config), describe(cfg.rtl), describe(rtl->params())));
+                               o.config, cfg.path, describe(cfg.rtl), describe(rtl->params())));
   SpecUnitParams model_params = cfg.rtl;
   if (o.fault == "value") {
     // One bit less of c^2 - c in the model than in the RTL (the datapath fault of test_spec_cosim).
@@ -254,6 +272,11 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
     v.config = o.config;
     v.params = cfg.rtl;  // the unit's: the file replays on it (a fault shows in the source line)
     v.prom = prom;
+    if (!temp_prom.path.empty()) {  // the configuration's table, kept beside the file
+      const std::string kept = o.save_vectors + ".hex";
+      writeFileAtomic(kept, renderProm(table, PromFormat::Hex));
+      v.prom = fs::path(kept).filename().string();
+    }
     v.source = fmt::format("shadesim_systemc --unit spec --config {} {} (the golden-model module's predictions{})",
                            o.config, file ? "--vector-file " + o.vector_file : fmt::format("--seed {} --vectors {}", o.seed, o.vectors),
                            o.fault == "none" ? "" : ", fault " + o.fault);

@@ -2,7 +2,7 @@
 
 #include <memory>
 
-#include "device/prom.h"
+#include "render/lobe_units.h"
 #include "render/render.h"
 #include "scene/scene.h"
 
@@ -31,17 +31,11 @@ SceneDescriptors recordSceneDescriptors(const std::string& scene, const SpanPara
   const Scene sc = loadScene(scene);
   RenderOptions ro;
   ro.method = Method::Gouraud;
-  ro.span_mode = p.mode();
-  // Device lobes (quadratic, cubic) need a specular unit: the model's, as `shadesim render` builds it.
-  std::vector<std::unique_ptr<SpecEngine>> owned;
-  SpecEngines engines;
-  for (Lobe l : deviceLobesUsed(sc, ro)) {
-    const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(specConfigForLobe(l)));
-    owned.push_back(std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl)));
-    (l == Lobe::Cubic ? engines.cubic : engines.quadratic) = owned.back().get();
-  }
+  // Device lobes (quadratic, cubic) need a specular unit: the model's, as `shadesim render` builds
+  // it by default.
+  const LobeEngines lobes = modelLobeEngines(sc, ro, LobeConfigs{});
   RecordingSpanEngine rec(p);
-  const RenderResult r = render(sc, ro, rec, engines);
+  const RenderResult r = render(sc, ro, rec, lobes.view);
   SceneDescriptors out;
   out.descs = std::move(rec.descs());
   out.scene_triangles = r.stats.triangles;

@@ -12,7 +12,7 @@
 #include <verilated.h>
 
 #include "span_rtl.h"
-#include "verilated_ports.h"
+#include "harness/verilated_ports.h"
 
 namespace shd {
 

@@ -31,7 +31,7 @@
 #include "raster/span_unit.h"
 #include "sc_common.h"
 #include "span_rtl.h"
-#include "vector_file.h"
+#include "vectors/vector_file.h"
 
 namespace shd {
 

@@ -9,7 +9,7 @@
 #include <verilated.h>
 
 #include "spec_rtl.h"
-#include "verilated_ports.h"
+#include "harness/verilated_ports.h"
 
 namespace shd {
 

@@ -30,7 +30,7 @@
 #include "device/spec_stimulus.h"
 #include "device/spec_unit.h"
 #include "sc_common.h"
-#include "vector_file.h"
+#include "vectors/vector_file.h"
 
 namespace shd {
 

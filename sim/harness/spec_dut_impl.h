@@ -8,9 +8,9 @@
 
 #include <verilated.h>
 
-#include "spec_dut.h"
-#include "verilated_harness.h"
-#include "verilated_ports.h"
+#include "harness/spec_dut.h"
+#include "harness/verilated_harness.h"
+#include "harness/verilated_ports.h"
 
 namespace shd {
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "config/registry.h"
 #include "device/spec_unit.h"
 
 namespace shd {
@@ -32,9 +33,13 @@ class SpecDut {
   virtual void finish() = 0;
 };
 
-// Configurations built into this binary (one verilate() per vectors/config/spec_*.json).
+// Configurations built into this binary (one verilate() per registry file, config/registry.h).
 std::vector<std::string> rtlSpecConfigs();
 // std::invalid_argument naming the configuration and the ones available when it is unknown.
 std::unique_ptr<SpecDut> makeSpecDut(const std::string& config, const SpecDutOptions& opts);
+// The verilated model of `cfg` is the one of its name, whose parameters must be cfg.rtl:
+// std::invalid_argument saying how to add a model when the build has none (a user's file).
+void requireVerilated(const SpecUnitConfig& cfg);
+std::unique_ptr<SpecDut> makeSpecDut(const SpecUnitConfig& cfg, const SpecDutOptions& opts);
 
 }  // namespace shd

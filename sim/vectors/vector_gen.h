@@ -30,7 +30,8 @@
 #include <cstdint>
 #include <string>
 
-#include "vector_file.h"
+#include "config/registry.h"
+#include "vectors/vector_file.h"
 
 namespace shd {
 
@@ -46,10 +47,10 @@ struct VectorGenSummary {
 // The configuration's PROM table is built from its JSON; `prom_file` must hold exactly its words
 // (std::runtime_error naming the first differing address otherwise) and is referred to in the
 // header relative to `out_dir` (the directory the vector file goes to).
-SpecVectors generateSpecVectors(const std::string& config, uint64_t cycles, uint64_t seed, const std::string& prom_file,
+SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& prom_file,
                                 const std::string& out_dir, VectorGenSummary* summary = nullptr);
 
-SpanVectors generateSpanVectors(const std::string& config, uint64_t cycles, uint64_t seed,
+SpanVectors generateSpanVectors(const SpanUnitConfig& cfg, uint64_t cycles, uint64_t seed,
                                 VectorGenSummary* summary = nullptr);
 
 }  // namespace shd

@@ -19,8 +19,8 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include "raster/span_unit.h"
-#include "span_dut.h"
-#include "vector_file.h"
+#include "harness/span_dut.h"
+#include "vectors/vector_file.h"
 
 namespace shd {
 

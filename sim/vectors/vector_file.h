@@ -103,10 +103,4 @@ void writeSpanVectors(const std::string& path, const SpanVectors& v);
 SpecVectors loadSpecVectors(const std::string& path);
 SpanVectors loadSpanVectors(const std::string& path);
 
-// The span unit's parameters from vectors/config/span_<name>.json of the source tree (the file
-// CMake verilates from). std::invalid_argument naming the file or the member.
-SpanParams spanConfigParams(const std::string& name);
-nlohmann::json toJson(const SpanParams& p);
-std::vector<std::string> builtinSpanConfigNames();  // serial evenodd seg2 seg4 seg8 sierpinski
-
 }  // namespace shd

@@ -24,8 +24,8 @@
 #include "device/prom.h"
 #include "device/spec_stimulus.h"
 #include "device/spec_unit.h"
-#include "spec_dut.h"
-#include "vector_file.h"
+#include "harness/spec_dut.h"
+#include "vectors/vector_file.h"
 
 namespace shd {
 

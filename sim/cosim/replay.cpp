@@ -1,4 +1,4 @@
-#include "replay.h"
+#include "cosim/replay.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "device/prom_io.h"
-#include "span_dut.h"
-#include "spec_cosim.h"
-#include "spec_dut.h"
-#include "vector_file.h"
+#include "harness/span_dut.h"
+#include "cosim/spec_cosim.h"
+#include "harness/spec_dut.h"
+#include "vectors/vector_file.h"
 
 namespace fs = std::filesystem;
 
@@ -59,13 +59,13 @@ ReplayResult replaySpec(const std::string& path, const ReplayOptions& opts) {
   r.unit = "spec";
   r.config = v.config;
   const SpecUnitParams& p = v.params;
-  // The verilated configuration is made from vectors/config/spec_<name>.json: its parameters
-  // must be the file's.
+  // The verilated configuration is made from the registry's file of that name: its parameters
+  // must be the vector file's.
   const std::vector<std::string> built = rtlSpecConfigs();
   if (std::find(built.begin(), built.end(), v.config) == built.end())
     throw std::invalid_argument(fmt::format("{}: configuration '{}' is not verilated into this build (built: {})", path,
                                             v.config, fmt::join(built, ", ")));
-  const SpecUnitParams built_p = SpecUnitConfig::load(configPath(v.config)).rtl;
+  const SpecUnitParams built_p = specConfig(v.config).rtl;
   if (built_p.toJson() != p.toJson())
     throw std::invalid_argument(fmt::format("{}: made for parameters {}, the verilated '{}' has {}: regenerate the file",
                                             path, p.toJson().dump(), v.config, built_p.toJson().dump()));
@@ -101,9 +101,9 @@ ReplayResult replaySpan(const std::string& path, const ReplayOptions& opts) {
   r.config = v.config;
   auto dut = makeSpanDut(v.config, opts.fst_path);  // names the built configurations if unknown
   const SpanParams& p = v.params;
-  if (toJson(dut->params()) != toJson(p))
+  if (dut->params().toJson() != p.toJson())
     throw std::invalid_argument(fmt::format("{}: made for parameters {}, the verilated '{}' has {}: regenerate the file",
-                                            path, toJson(p).dump(), v.config, toJson(dut->params()).dump()));
+                                            path, p.toJson().dump(), v.config, dut->params().toJson().dump()));
   dut->reset();
   Checker chk(r, opts);
   SpanOut got;

@@ -1,4 +1,4 @@
-#include "vector_file.h"
+#include "vectors/vector_file.h"
 
 #include <fstream>
 #include <map>
@@ -190,62 +190,6 @@ class FieldCursor {
 
 }  // namespace
 
-// ------------------------------------------------------------------ span parameters
-
-nlohmann::json toJson(const SpanParams& p) {
-  return {{"NumTri", p.NumTri},     {"LanesPerTri", p.LanesPerTri}, {"AlignLanes", p.AlignLanes},
-          {"NumAttr", p.NumAttr},   {"AttrBits", p.AttrBits},       {"CoordBits", p.CoordBits},
-          {"RemBits", p.RemBits},   {"PixBits", p.PixBits},         {"TagBits", p.TagBits}};
-}
-
-namespace {
-
-SpanParams spanParamsFromJson(const nlohmann::json& rtl, const std::string& where) {
-  if (!rtl.is_object()) throw std::invalid_argument(fmt::format("{}: 'rtl' is not an object", where));
-  SpanParams p;
-  std::map<std::string, int*> members = {{"NumTri", &p.NumTri},       {"LanesPerTri", &p.LanesPerTri},
-                                         {"AlignLanes", &p.AlignLanes}, {"NumAttr", &p.NumAttr},
-                                         {"AttrBits", &p.AttrBits},   {"CoordBits", &p.CoordBits},
-                                         {"RemBits", &p.RemBits},     {"PixBits", &p.PixBits},
-                                         {"TagBits", &p.TagBits}};
-  for (auto it = rtl.begin(); it != rtl.end(); ++it) {
-    auto m = members.find(it.key());
-    if (m == members.end())
-      throw std::invalid_argument(fmt::format("{}: unknown span parameter '{}' (known: {})", where, it.key(), kSpanParamOrder));
-    if (!it.value().is_number_integer())
-      throw std::invalid_argument(fmt::format("{}: span parameter {} is not an integer", where, it.key()));
-    *m->second = it.value().get<int>();
-  }
-  for (const auto& [name, ptr] : members)
-    if (!rtl.contains(name)) throw std::invalid_argument(fmt::format("{}: span parameter {} missing", where, name));
-  try {
-    p.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
-  }
-  return p;
-}
-
-}  // namespace
-
-std::vector<std::string> builtinSpanConfigNames() { return {"serial", "evenodd", "seg2", "seg4", "seg8", "sierpinski"}; }
-
-SpanParams spanConfigParams(const std::string& name) {
-  const std::string path = fmt::format("{}/vectors/config/span_{}.json", SHD_SOURCE_DIR, name);
-  std::ifstream in(path);
-  if (!in)
-    throw std::invalid_argument(fmt::format("no span configuration '{}' ({} cannot be read; known: {})", name, path,
-                                            fmt::join(builtinSpanConfigNames(), ", ")));
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw std::invalid_argument(fmt::format("{}: {}", path, e.what()));
-  }
-  if (!j.contains("rtl")) throw std::invalid_argument(fmt::format("{}: no 'rtl' object", path));
-  return spanParamsFromJson(j["rtl"], path);
-}
-
 // ------------------------------------------------------------------ spec
 
 std::string renderSpecVectors(const SpecVectors& v) {
@@ -323,7 +267,7 @@ SpecVectors loadSpecVectors(const std::string& path) {
 std::string renderSpanVectors(const SpanVectors& v) {
   const SpanParams& p = v.params;
   const int CB = p.CoordBits, AB = p.AttrBits, RB = p.RemBits, PB = p.PixBits, K = p.NumAttr, L = p.lanes();
-  std::string t = header("span", v.config, toJson(p), spanParamList(p), v.source, v.notes);
+  std::string t = header("span", v.config, p.toJson(), spanParamList(p), v.source, v.notes);
   t += fmt::format(
       "# parameter order: {}\n"
       "# Records (hex, port widths, signed values in two's complement; see sim/vector_file.h):\n"
@@ -395,7 +339,7 @@ SpanVectors loadSpanVectors(const std::string& path) {
   SpanVectors v;
   v.config = r.config();
   try {
-    v.params = spanParamsFromJson(r.rtl(), path);
+    v.params = SpanParams::fromJson(r.rtl(), path);
   } catch (const std::invalid_argument& e) {
     throw r.error(r.field("config").no, e.what());
   }

@@ -7,8 +7,8 @@
 #include <string>
 
 #include "render/render.h"
-#include "span_dut.h"
-#include "spec_dut.h"
+#include "harness/span_dut.h"
+#include "harness/spec_dut.h"
 
 namespace shd {
 
@@ -16,12 +16,14 @@ namespace shd {
 // cycles and the fragments; the ROW/SPAN split of the cycles is internal (left 0).
 // The cycle-accurate model ticks beside the RTL and every output is compared on every cycle. On
 // the first difference the triangle is saved alone, from reset, as a vector file
-// <fail_dir>/render_span_<mode>_fail.vec with the model's expected outputs, replayed into an FST
+// <fail_dir>/render_span_<config>_fail.vec with the model's expected outputs, replayed into an FST
 // beside it, and run() throws std::runtime_error naming the triangle, the cycle, both values
 // and the files. (model_params: fault injection for the tests, a model of another layout.)
 class RtlSpanEngine final : public SpanEngine {
  public:
-  explicit RtlSpanEngine(SpanMode mode, std::string fail_dir = ".", std::optional<SpanParams> model_params = {});
+  // config: a span configuration (lane mode) verilated into this build.
+  explicit RtlSpanEngine(const SpanUnitConfig& config, std::string fail_dir = ".",
+                         std::optional<SpanParams> model_params = {});
   const SpanParams& params() const override { return dut_->params(); }
   SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override;
 
@@ -41,7 +43,8 @@ class RtlSpanEngine final : public SpanEngine {
 // (model_words: fault injection for the tests, the model's PROM words.)
 class RtlSpecEngine final : public SpecEngine {
  public:
-  RtlSpecEngine(const std::string& config, PromTable table, const std::string& prom_path, std::string fail_dir = ".",
+  // config: verilated into this build; table: its PROM (table.unit must be config.rtl).
+  RtlSpecEngine(const SpecUnitConfig& config, PromTable table, const std::string& prom_path, std::string fail_dir = ".",
                 std::optional<std::vector<PromWord>> model_words = {});
   const PromTable& table() const override { return t_; }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;

@@ -1,4 +1,4 @@
-#include "spec_cosim.h"
+#include "cosim/spec_cosim.h"
 
 #include <chrono>
 #include <filesystem>
@@ -116,7 +116,7 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
     v.config = config;
     // The header names the verilated configuration's parameters (the model's may differ: that
     // is what fault injection does), so that the file replays on that configuration.
-    v.params = SpecUnitConfig::load(configPath(config)).rtl;
+    v.params = specConfig(config).rtl;
     v.prom = fs::path(res.prom_copy_path).filename().string();
     v.source = fmt::format("shadesim cosim: the failing window, cycles {}..{} of the run, replayed from reset",
                            res.first->cycle + 1 - fail_window.size(), res.first->cycle);

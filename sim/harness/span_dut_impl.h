@@ -7,9 +7,9 @@
 #include <string>
 
 #include "raster/span_walk.h"
-#include "span_dut.h"
-#include "verilated_harness.h"
-#include "verilated_ports.h"
+#include "harness/span_dut.h"
+#include "harness/verilated_harness.h"
+#include "harness/verilated_ports.h"
 
 namespace shd {
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "config/registry.h"
 #include "raster/span_unit.h"
 
 namespace shd {
@@ -35,8 +36,12 @@ class SpanDut {
   virtual void finish() = 0;
 };
 
+// Configurations built into this binary (one verilate() per registry file, config/registry.h).
 std::vector<std::string> rtlSpanConfigs();
-// config: a span mode name (serial, evenodd, seg2, seg4, seg8, sierpinski). fst_path "": no trace.
+// config: a span configuration (lane mode) of the registry. fst_path "": no trace.
 std::unique_ptr<SpanDut> makeSpanDut(const std::string& config, const std::string& fst_path);
+// As for the specular unit (spec_dut.h): the model of cfg's name with cfg.rtl's parameters.
+void requireVerilated(const SpanUnitConfig& cfg);
+std::unique_ptr<SpanDut> makeSpanDut(const SpanUnitConfig& cfg, const std::string& fst_path);
 
 }  // namespace shd

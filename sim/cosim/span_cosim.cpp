@@ -1,4 +1,4 @@
-#include "span_cosim.h"
+#include "cosim/span_cosim.h"
 
 #include <array>
 #include <chrono>

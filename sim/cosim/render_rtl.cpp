@@ -1,15 +1,16 @@
-#include "render_rtl.h"
+#include "cosim/render_rtl.h"
 
 #include <filesystem>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "device/prom_io.h"
-#include "replay.h"
-#include "span_cosim.h"
-#include "spec_cosim.h"
-#include "vector_file.h"
+#include "cosim/replay.h"
+#include "cosim/span_cosim.h"
+#include "cosim/spec_cosim.h"
+#include "vectors/vector_file.h"
 
 namespace shd {
 
@@ -27,10 +28,10 @@ std::string replayAlone(const std::string& vec, const std::string& fst) {
 
 }  // namespace
 
-RtlSpanEngine::RtlSpanEngine(SpanMode mode, std::string fail_dir, std::optional<SpanParams> model_params)
-    : mode_(toString(mode)),
+RtlSpanEngine::RtlSpanEngine(const SpanUnitConfig& config, std::string fail_dir, std::optional<SpanParams> model_params)
+    : mode_(config.name),
       fail_dir_(std::move(fail_dir)),
-      dut_(makeSpanDut(mode_, "")),
+      dut_(makeSpanDut(config, "")),
       model_(model_params ? *model_params : dut_->params()) {
   dut_->reset();
   model_.reset();
@@ -96,12 +97,15 @@ SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
   return run;
 }
 
-RtlSpecEngine::RtlSpecEngine(const std::string& config, PromTable table, const std::string& prom_path,
+RtlSpecEngine::RtlSpecEngine(const SpecUnitConfig& config, PromTable table, const std::string& prom_path,
                              std::string fail_dir, std::optional<std::vector<PromWord>> model_words)
-    : config_(config),
+    : config_(config.name),
       fail_dir_(std::move(fail_dir)),
       t_(std::move(table)),
       model_(t_.unit, model_words ? *model_words : t_.words) {
+  if (t_.unit.toJson() != config.rtl.toJson())
+    throw std::invalid_argument(fmt::format("RtlSpecEngine: the table's unit {} is not configuration {}'s {}",
+                                            t_.unit.toJson().dump(), config.name, config.rtl.toJson().dump()));
   writeFileAtomic(prom_path, renderProm(t_, PromFormat::Hex));
   dut_ = makeSpecDut(config, SpecDutOptions{prom_path, ""});
   verifyLoadedProm(*dut_, t_.words, prom_path, t_.unit);

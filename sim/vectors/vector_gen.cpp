@@ -1,4 +1,4 @@
-#include "vector_gen.h"
+#include "vectors/vector_gen.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -14,7 +14,7 @@
 #include "raster/desc_stream.h"
 #include "raster/setup.h"
 #include "raster/trigen.h"
-#include "spec_cosim.h"
+#include "device/spec_stimulus.h"
 
 namespace fs = std::filesystem;
 
@@ -29,13 +29,9 @@ std::string VectorGenSummary::text() const {
 
 // ------------------------------------------------------------------ spec
 
-SpecVectors generateSpecVectors(const std::string& config, uint64_t cycles, uint64_t seed, const std::string& prom_file,
+SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& prom_file,
                                 const std::string& out_dir, VectorGenSummary* summary) {
-  const std::vector<std::string> names = builtinConfigNames();
-  if (std::find(names.begin(), names.end(), config) == names.end())
-    throw std::invalid_argument(
-        fmt::format("no specular-unit configuration '{}' (known: {})", config, fmt::join(names, ", ")));
-  const SpecUnitConfig cfg = SpecUnitConfig::load(configPath(config));
+  const std::string& config = cfg.name;
   const SpecUnitParams& p = cfg.rtl;
   const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), p);
   // The file the vectors refer to must hold this very table: the expected outputs depend on it.
@@ -52,7 +48,7 @@ SpecVectors generateSpecVectors(const std::string& config, uint64_t cycles, uint
   v.params = p;
   v.prom = fs::absolute(prom_file).lexically_normal().lexically_relative(fs::absolute(out_dir).lexically_normal())
                .generic_string();
-  v.source = fmt::format("shadesim vectors --unit spec --config {} --cycles {} --seed {}", config, cycles, seed);
+  v.source = fmt::format("shadesim vectors --unit spec --config {} --cycles {} --seed {}", cfg.ref(), cycles, seed);
 
   // The corners, valid on every cycle.
   std::vector<SpecIn> corners;
@@ -246,11 +242,11 @@ class SpanVectorStimulus {
 
 }  // namespace
 
-SpanVectors generateSpanVectors(const std::string& config, uint64_t cycles, uint64_t seed, VectorGenSummary* summary) {
+SpanVectors generateSpanVectors(const SpanUnitConfig& cfg, uint64_t cycles, uint64_t seed, VectorGenSummary* summary) {
   SpanVectors v;
-  v.config = config;
-  v.params = spanConfigParams(config);
-  v.source = fmt::format("shadesim vectors --unit span --config {} --cycles {} --seed {}", config, cycles, seed);
+  v.config = cfg.name;
+  v.params = cfg.rtl;
+  v.source = fmt::format("shadesim vectors --unit span --config {} --cycles {} --seed {}", cfg.ref(), cycles, seed);
   SpanVectorStimulus stim(v.params, seed);
   SpanUnitModel model(v.params);
   model.reset();

@@ -1,0 +1,134 @@
+#include "config/registry.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+namespace shd {
+
+namespace config_detail {
+// Generated at configure time (scripts/shd_config.py cmake): the registry's files.
+extern const BuiltinConfig kBuiltin[];
+extern const size_t kBuiltinCount;
+}  // namespace config_detail
+
+namespace {
+
+nlohmann::json parseObject(const std::string& text, const std::string& where) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw std::invalid_argument(fmt::format("{}: not valid JSON: {}", where, e.what()));
+  }
+  if (!j.is_object()) throw std::invalid_argument(fmt::format("{}: must hold a JSON object", where));
+  return j;
+}
+
+std::string stringMember(const nlohmann::json& v, const std::string& where, const char* key) {
+  if (!v.is_string()) throw std::invalid_argument(fmt::format("{}: \"{}\" must be a string", where, key));
+  return v.get<std::string>();
+}
+
+PromContent promFromJson(const nlohmann::json& value, const std::string& where) {
+  if (!value.is_object()) throw std::invalid_argument(fmt::format("{}: prom must be an object", where));
+  PromContent c;
+  for (const auto& [pk, pv] : value.items()) {
+    if (pk == "fit" && pv.is_string()) c.fit = pv.get<std::string>();
+    else if (pk == "level" && pv.is_number()) c.level = pv.get<double>();
+    else if (pk == "n" && pv.is_string()) c.n = pv.get<std::string>();
+    else if (pk == "n_list" && pv.is_string()) {
+      c.n = pv.get<std::string>();
+      c.is_list = true;
+    } else {
+      throw std::invalid_argument(fmt::format(
+          "{}: prom.{} is unknown or has the wrong type (fit: string, level: number, n or n_list: string)", where, pk));
+    }
+  }
+  return c;
+}
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument(fmt::format("cannot open configuration file {}", path));
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The registry entry or the file, parsed by Config::parse.
+template <class Config>
+Config resolve(const std::string& unit, const char* unit_label, const std::string& arg) {
+  if (isConfigFile(arg)) return Config::parse(readFile(arg), arg);
+  for (const BuiltinConfig& b : builtinConfigs())
+    if (unit == b.unit && arg == b.name) {
+      Config c = Config::parse(b.json, b.file);
+      c.builtin = true;
+      return c;
+    }
+  throw std::invalid_argument(fmt::format("no {} configuration '{}' (built in: {}; or give a JSON file)", unit_label, arg,
+                                          fmt::join(builtinConfigNames(unit), ", ")));
+}
+
+}  // namespace
+
+const std::vector<BuiltinConfig>& builtinConfigs() {
+  static const std::vector<BuiltinConfig> all(config_detail::kBuiltin,
+                                              config_detail::kBuiltin + config_detail::kBuiltinCount);
+  return all;
+}
+
+std::vector<std::string> builtinConfigNames(const std::string& unit) {
+  std::vector<std::string> names;
+  for (const BuiltinConfig& b : builtinConfigs())
+    if (unit == b.unit) names.emplace_back(b.name);
+  return names;
+}
+
+SpecUnitConfig SpecUnitConfig::parse(const std::string& text, const std::string& where) {
+  const nlohmann::json j = parseObject(text, where);
+  SpecUnitConfig c;
+  c.path = where;
+  for (const auto& [key, value] : j.items()) {
+    if (key == "name") c.name = stringMember(value, where, "name");
+    else if (key == "description") c.description = stringMember(value, where, "description");
+    else if (key == "rtl") c.rtl = SpecUnitParams::fromJson(value, where);
+    else if (key == "prom") c.prom = promFromJson(value, where);
+    else throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", where, key));
+  }
+  if (c.name.empty()) throw std::invalid_argument(fmt::format("{}: missing \"name\"", where));
+  return c;
+}
+
+SpanUnitConfig SpanUnitConfig::parse(const std::string& text, const std::string& where) {
+  const nlohmann::json j = parseObject(text, where);
+  SpanUnitConfig c;
+  c.path = where;
+  bool has_rtl = false;
+  for (const auto& [key, value] : j.items()) {
+    if (key == "name") c.name = stringMember(value, where, "name");
+    else if (key == "description") c.description = stringMember(value, where, "description");
+    else if (key == "rtl") c.rtl = SpanParams::fromJson(value, where), has_rtl = true;
+    else throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", where, key));
+  }
+  if (c.name.empty()) throw std::invalid_argument(fmt::format("{}: missing \"name\"", where));
+  if (!has_rtl) throw std::invalid_argument(fmt::format("{}: missing \"rtl\"", where));
+  return c;
+}
+
+bool isConfigFile(const std::string& arg) {
+  const bool json_suffix = arg.size() >= 5 && arg.compare(arg.size() - 5, 5, ".json") == 0;
+  std::error_code ec;
+  return arg.find('/') != std::string::npos || json_suffix || std::filesystem::is_regular_file(arg, ec);
+}
+
+SpecUnitConfig specConfig(const std::string& arg) { return resolve<SpecUnitConfig>("spec", "specular-unit", arg); }
+SpanUnitConfig spanConfig(const std::string& arg) { return resolve<SpanUnitConfig>("span", "span-unit", arg); }
+
+}  // namespace shd

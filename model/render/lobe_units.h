@@ -1,0 +1,32 @@
+// The specular units behind the device lobes (quadratic, cubic) of a render: which
+// configuration each lobe uses, and the model's engines for the lobes a scene uses.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "config/registry.h"
+#include "render/render.h"
+
+namespace shd {
+
+// A registry name or a JSON file per lobe; the quadratic lobe needs a degree-2 unit, the cubic
+// a degree-3 one. The defaults are the registry's reference configurations of each degree.
+struct LobeConfigs {
+  std::string quadratic = "default";
+  std::string cubic = "cubic";
+  const std::string& forLobe(Lobe l) const { return l == Lobe::Cubic ? cubic : quadratic; }
+  // The configuration of a device lobe, checked against its degree (std::invalid_argument).
+  SpecUnitConfig load(Lobe l) const;
+};
+
+// The model's engines (bit-exact specular units with their PROM tables) for the device lobes
+// the scene uses with these options; `view` points into `owned`.
+struct LobeEngines {
+  std::vector<std::unique_ptr<SpecEngine>> owned;
+  SpecEngines view;
+};
+LobeEngines modelLobeEngines(const Scene& scene, const RenderOptions& opt, const LobeConfigs& configs);
+
+}  // namespace shd

@@ -1,0 +1,48 @@
+// The shadesim program's subcommands. Each is a Command in its own file of sim/cli/, listed
+// once in commands.cpp; main.cpp only wires them to CLI11 and reports their errors.
+// Exit status of run(): 0 success, 1 a check failed (a mismatch), 2 bad input (main.cpp prints
+// "shadesim <command>: error: ..." for an exception and returns 2).
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "config/registry.h"
+
+namespace shd::cli {
+
+class Command {
+ public:
+  virtual ~Command() = default;
+  virtual void add(CLI::App& app) = 0;  // the options
+  virtual int run(const CLI::App& app) = 0;
+};
+
+struct CommandInfo {
+  const char* name;
+  const char* help;
+  std::unique_ptr<Command> (*make)();
+};
+
+// Every subcommand, in the order `shadesim --help` lists them.
+const std::vector<CommandInfo>& commands();
+
+// A usage error: the message names the argument.
+struct ArgError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A configuration option (registry name or JSON file), errors as ArgError naming the option.
+SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg);
+SpanUnitConfig spanConfigArg(const std::string& option, const std::string& arg);
+// "name | name | ... or a JSON file": the registry's names of a unit, for help texts.
+std::string configChoices(const std::string& unit);
+
+// The text to `path`, atomically; "" or "-": stdout.
+void writeOut(const std::string& path, const std::string& text);
+
+}  // namespace shd::cli
