@@ -40,39 +40,17 @@ struct OptionRefs {
   CLI::Option *vectors = nullptr, *triangles = nullptr, *gap = nullptr, *ready = nullptr, *desc_gap = nullptr;
 };
 
-// Cross-option checks CLI11 cannot express.
-void checkOptions(const ScOptions& o, const OptionRefs& given) {
-  auto only = [&](bool is_given, const char* opt, const char* unit) {
-    if (is_given) throw ArgError(fmt::format("{} applies to --unit {} only", opt, unit));
-  };
-  const bool spec = o.unit == "spec";
-  only(!spec && given.vectors->count() > 0, "--vectors", "spec");
-  only(!spec && !o.prom.empty(), "--prom", "spec");
-  only(!spec && given.gap->count() > 0, "--gap", "spec");
-  only(spec && given.triangles->count() > 0, "--triangles", "span");
-  only(spec && !o.scene.empty(), "--scene", "span");
-  only(spec && given.ready->count() > 0, "--ready", "span");
-  only(spec && given.desc_gap->count() > 0, "--desc-gap", "span");
-  if (!o.vector_file.empty()) {
-    for (auto [opt, name] : {std::pair{given.vectors, "--vectors"}, {given.gap, "--gap"}, {given.triangles, "--triangles"},
-                             {given.ready, "--ready"}, {given.desc_gap, "--desc-gap"}})
-      if (opt->count() > 0) throw ArgError(fmt::format("{} and --vector-file exclude each other (the file is the stimulus)", name));
-    if (!o.scene.empty()) throw ArgError("--scene and --vector-file exclude each other");
-  }
-}
-
-nlohmann::json toJson(const ScReport::Value& v) {
-  return std::visit([](const auto& x) { return nlohmann::json(x); }, v);
-}
-
-}  // namespace
-
-int sc_main(int argc, char* argv[]) {
+// The command line: the run's options and what sc_main itself does with the result.
+struct CommandLine {
   ScOptions o;
-  OptionRefs given;
+  OptionRefs given;  // the options whose presence matters, not only their value
   bool json = false;
-  CLI::App app{"shadesim_systemc: the verilated specular or span unit in a SystemC testbench (clock, reset, driver, "
-               "golden-model module, scoreboard), checked value by value and cycle by cycle"};
+  bool no_fail_save = false;
+};
+
+void addOptions(CLI::App& app, CommandLine& c) {
+  ScOptions& o = c.o;
+  OptionRefs& given = c.given;
   app.add_option("--unit", o.unit, "spec (specular unit) or span (span unit)")
       ->required()
       ->check(CLI::IsMember({"spec", "span"}));
@@ -114,78 +92,96 @@ int sc_main(int argc, char* argv[]) {
                  "on a mismatch, save the failing case alone here: <unit>_<config>_fail.vec (from reset, the failing "
                  "cycle last; spec: and the PROM copy .hex) and the FST waveform of its replay, "
                  "<unit>_<config>_fail.fst (default: the current directory)");
-  bool no_fail_save = false;
-  app.add_flag("--no-fail-save", no_fail_save, "do not save the failing case (the replay of a saved case runs so)");
-  app.add_flag("--json", json, "print the result as one JSON object on stdout");
+  app.add_flag("--no-fail-save", c.no_fail_save, "do not save the failing case (the replay of a saved case runs so)");
+  app.add_flag("--json", c.json, "print the result as one JSON object on stdout");
   app.add_flag("--quiet", o.quiet, "no progress on stderr");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
-  if (o.config.empty()) o.config = o.unit == "spec" ? "default" : "serial";
-  o.argv0 = argv[0];
-  o.save_fail = !no_fail_save;
-  o.triangles_given = given.triangles->count() > 0;
+}
 
-  ScReport r;
-  try {
-    checkOptions(o, given);
-    // 10 ns clock, rising edges at 10, 20, ... ns (sc_common.h); rst_n low from time 0.
-    sc_core::sc_clock clk("clk", scPeriod(), 0.5, scPeriod(), true);
-    sc_core::sc_signal<bool> rst_n("rst_n", false);
-    ScResetGen reset("reset");
-    reset.clk(clk);
-    reset.rst_n(rst_n);
-    r = o.unit == "spec" ? runSpecSc(o, clk, rst_n) : runSpanSc(o, clk, rst_n);
-  } catch (const std::exception& e) {  // ArgError, files, configurations, SystemC elaboration errors
-    std::fprintf(stderr, "shadesim_systemc: error: %s\n", e.what());
-    return 2;
+// Cross-option checks CLI11 cannot express.
+void checkOptions(const ScOptions& o, const OptionRefs& given) {
+  auto only = [&](bool is_given, const char* opt, const char* unit) {
+    if (is_given) throw ArgError(fmt::format("{} applies to --unit {} only", opt, unit));
+  };
+  const bool spec = o.unit == "spec";
+  only(!spec && given.vectors->count() > 0, "--vectors", "spec");
+  only(!spec && !o.prom.empty(), "--prom", "spec");
+  only(!spec && given.gap->count() > 0, "--gap", "spec");
+  only(spec && given.triangles->count() > 0, "--triangles", "span");
+  only(spec && !o.scene.empty(), "--scene", "span");
+  only(spec && given.ready->count() > 0, "--ready", "span");
+  only(spec && given.desc_gap->count() > 0, "--desc-gap", "span");
+  if (!o.vector_file.empty()) {
+    for (auto [opt, name] : {std::pair{given.vectors, "--vectors"}, {given.gap, "--gap"}, {given.triangles, "--triangles"},
+                             {given.ready, "--ready"}, {given.desc_gap, "--desc-gap"}})
+      if (opt->count() > 0) throw ArgError(fmt::format("{} and --vector-file exclude each other (the file is the stimulus)", name));
+    if (!o.scene.empty()) throw ArgError("--scene and --vector-file exclude each other");
   }
+}
 
-  const ScScore& s = r.score;
-  const bool ok = s.passed() && r.complete;
-  const ScFailCase& fc = r.fail;
+// The unit's run between sc_main's clock and reset generator.
+ScReport runUnit(const ScOptions& o) {
+  // 10 ns clock, rising edges at 10, 20, ... ns (sc_common.h); rst_n low from time 0.
+  sc_core::sc_clock clk("clk", scPeriod(), 0.5, scPeriod(), true);
+  sc_core::sc_signal<bool> rst_n("rst_n", false);
+  ScResetGen reset("reset");
+  reset.clk(clk);
+  reset.rst_n(rst_n);
+  return o.unit == "spec" ? runSpecSc(o, clk, rst_n) : runSpanSc(o, clk, rst_n);
+}
+
+// The failing case the run saved, replayed alone in a child process (sc_fail_case.h).
+struct FailReplay {
   ScFailReplay replay;
-  if (!fc.vec.empty()) replay = replayFailCase(o, fc);
-  const bool reproduced = !fc.vec.empty() && replay.failsAtLastCycle(fc.cycles);
-  if (json) {
-    nlohmann::json j = {{"unit", o.unit}, {"config", o.config}, {"fault", o.fault}};
-    for (const auto& [key, value] : r.fields) j[key] = toJson(value);
-    j["samples"] = s.samples;
-    j["sample_mismatches"] = s.sample_mismatches;
-    j["item_mismatches"] = s.item_mismatches;
-    j["passed"] = ok;
-    if (!s.first.empty()) j["first_mismatch"] = s.first;
-    if (!s.first_item.empty()) j["first_item_mismatch"] = s.first_item;
-    if (!r.complete) j["incomplete"] = r.incomplete;
-    if (!o.fst.empty()) j["fst"] = o.fst;
-    if (fc.attempted) {
-      nlohmann::json f = {{"saved", !fc.vec.empty()}};
-      if (fc.vec.empty()) {
-        f["not_saved"] = fc.not_saved;
-      } else {
-        f["vectors"] = fc.vec;
-        if (!fc.prom.empty()) f["prom"] = fc.prom;
-        f["fst"] = fc.fst;
-        f["cycles"] = fc.cycles;
-        f["run_cycles"] = {fc.run_first, fc.run_first + fc.cycles - 1};
-        f["replay"] = {{"command", replay.command()},
-                       {"status", replay.status},
-                       {"mismatch_file_cycle", replay.mismatch_cycle},
-                       {"file_mismatch_cycle", replay.file_mismatch_cycle},
-                       {"first_mismatch", replay.first},
-                       {"fst_written", replay.fst_written},
-                       {"fails_at_last_cycle", reproduced}};
-        if (!replay.error.empty()) f["replay"]["error"] = replay.error;
-      }
-      j["fail_case"] = f;
-    }
-    std::cout << j.dump(2) << std::endl;
-  } else {
-    std::cout << r.summary << std::endl;
+  bool reproduced = false;  // it fails at its last cycle, as the run did
+};
+
+nlohmann::json toJson(const ScReport::Value& v) {
+  return std::visit([](const auto& x) { return nlohmann::json(x); }, v);
+}
+
+nlohmann::json failCaseJson(const ScFailCase& fc, const FailReplay& fr) {
+  nlohmann::json f = {{"saved", !fc.vec.empty()}};
+  if (fc.vec.empty()) {
+    f["not_saved"] = fc.not_saved;
+    return f;
   }
-  if (ok) return 0;
+  const ScFailReplay& replay = fr.replay;
+  f["vectors"] = fc.vec;
+  if (!fc.prom.empty()) f["prom"] = fc.prom;
+  f["fst"] = fc.fst;
+  f["cycles"] = fc.cycles;
+  f["run_cycles"] = {fc.run_first, fc.run_first + fc.cycles - 1};
+  f["replay"] = {{"command", replay.command()},
+                 {"status", replay.status},
+                 {"mismatch_file_cycle", replay.mismatch_cycle},
+                 {"file_mismatch_cycle", replay.file_mismatch_cycle},
+                 {"first_mismatch", replay.first},
+                 {"fst_written", replay.fst_written},
+                 {"fails_at_last_cycle", fr.reproduced}};
+  if (!replay.error.empty()) f["replay"]["error"] = replay.error;
+  return f;
+}
+
+// --json: the report as one object.
+nlohmann::json reportJson(const ScOptions& o, const ScReport& r, const FailReplay& fr) {
+  const ScScore& s = r.score;
+  nlohmann::json j = {{"unit", o.unit}, {"config", o.config}, {"fault", o.fault}};
+  for (const auto& [key, value] : r.fields) j[key] = toJson(value);
+  j["samples"] = s.samples;
+  j["sample_mismatches"] = s.sample_mismatches;
+  j["item_mismatches"] = s.item_mismatches;
+  j["passed"] = s.passed() && r.complete;
+  if (!s.first.empty()) j["first_mismatch"] = s.first;
+  if (!s.first_item.empty()) j["first_item_mismatch"] = s.first_item;
+  if (!r.complete) j["incomplete"] = r.incomplete;
+  if (!o.fst.empty()) j["fst"] = o.fst;
+  if (r.fail.attempted) j["fail_case"] = failCaseJson(r.fail, fr);
+  return j;
+}
+
+// A failed run on stderr: the first mismatches, what is incomplete, the files written.
+void printFailure(const ScOptions& o, const ScReport& r) {
+  const ScScore& s = r.score;
   const char* items = o.unit == "spec" ? "results" : "fragments";
   if (!s.first.empty())
     std::fprintf(stderr, "MISMATCH (first of %llu samples) %s\n", static_cast<unsigned long long>(s.sample_mismatches),
@@ -200,37 +196,82 @@ int sc_main(int argc, char* argv[]) {
   if (!r.complete) std::fprintf(stderr, "INCOMPLETE %s\n", r.incomplete.c_str());
   if (!o.fst.empty()) std::fprintf(stderr, "waveform: %s\n", o.fst.c_str());
   if (!o.save_vectors.empty()) std::fprintf(stderr, "vectors:  %s\n", o.save_vectors.c_str());
-  if (!fc.vec.empty()) {
-    std::string saved = fmt::format("failing case: {} ({} cycles from reset, the run's cycles {}..{} after reset, the "
-                                    "failing one last{})",
-                                    fc.vec, fc.cycles, fc.run_first, fc.run_first + fc.cycles - 1,
-                                    fc.prom.empty() ? std::string() : "; PROM " + fc.prom);
-    std::fprintf(stderr, "%s\n", saved.c_str());
-    if (replay.fst_written)
-      std::fprintf(stderr, "failing case waveform: %s (gtkwave %s)\n", fc.fst.c_str(), fc.fst.c_str());
-    else
-      std::fprintf(stderr, "failing case waveform: NOT WRITTEN (%s)\n", fc.fst.c_str());
-    if (reproduced) {
-      std::fprintf(stderr, "replayed alone (%s): fails at its last cycle %llu, as the run did: %s\n",
-                   replay.command().c_str(), static_cast<unsigned long long>(fc.cycles), replay.first.c_str());
-    } else {
-      // Both sides, so that the difference can be judged.
-      std::string why = !replay.error.empty() ? replay.error
-                        : replay.status == 0 ? std::string("it passes")
-                                             : fmt::format("exit status {}, first mismatch at file cycle {} (against "
-                                                           "the file: cycle {}): {}",
-                                                           replay.status, replay.mismatch_cycle,
-                                                           replay.file_mismatch_cycle, replay.first);
-      std::fprintf(stderr,
-                   "REPLAY DOES NOT REPRODUCE the failure at the file's last cycle %llu (%s): %s; the run: %s\n",
-                   static_cast<unsigned long long>(fc.cycles), replay.command().c_str(), why.c_str(), fc.what.c_str());
-    }
-  } else {
+}
+
+// The failing case on stderr: where it was saved and whether its replay reproduced the failure,
+// or why it was not saved and how to keep the case.
+void printFailCase(const ScOptions& o, const ScFailCase& fc, const FailReplay& fr) {
+  const ScFailReplay& replay = fr.replay;
+  if (fc.vec.empty()) {
     if (fc.attempted) std::fprintf(stderr, "failing case not saved: %s\n", fc.not_saved.c_str());
     if (o.save_vectors.empty())
       std::fprintf(stderr, "to keep this case: the same command with --save-vectors <file.vec> --fst <file.fst> (the "
                            "run is deterministic); the file replays alone (--vector-file, shadesim replay, Icarus)\n");
+    return;
   }
+  std::string saved = fmt::format("failing case: {} ({} cycles from reset, the run's cycles {}..{} after reset, the "
+                                  "failing one last{})",
+                                  fc.vec, fc.cycles, fc.run_first, fc.run_first + fc.cycles - 1,
+                                  fc.prom.empty() ? std::string() : "; PROM " + fc.prom);
+  std::fprintf(stderr, "%s\n", saved.c_str());
+  if (replay.fst_written)
+    std::fprintf(stderr, "failing case waveform: %s (gtkwave %s)\n", fc.fst.c_str(), fc.fst.c_str());
+  else
+    std::fprintf(stderr, "failing case waveform: NOT WRITTEN (%s)\n", fc.fst.c_str());
+  if (fr.reproduced) {
+    std::fprintf(stderr, "replayed alone (%s): fails at its last cycle %llu, as the run did: %s\n",
+                 replay.command().c_str(), static_cast<unsigned long long>(fc.cycles), replay.first.c_str());
+    return;
+  }
+  // Both sides, so that the difference can be judged.
+  std::string why = !replay.error.empty() ? replay.error
+                    : replay.status == 0  ? std::string("it passes")
+                                          : fmt::format("exit status {}, first mismatch at file cycle {} (against "
+                                                        "the file: cycle {}): {}",
+                                                        replay.status, replay.mismatch_cycle,
+                                                        replay.file_mismatch_cycle, replay.first);
+  std::fprintf(stderr, "REPLAY DOES NOT REPRODUCE the failure at the file's last cycle %llu (%s): %s; the run: %s\n",
+               static_cast<unsigned long long>(fc.cycles), replay.command().c_str(), why.c_str(), fc.what.c_str());
+}
+
+}  // namespace
+
+int sc_main(int argc, char* argv[]) {
+  CommandLine c;
+  ScOptions& o = c.o;
+  CLI::App app{"shadesim_systemc: the verilated specular or span unit in a SystemC testbench (clock, reset, driver, "
+               "golden-model module, scoreboard), checked value by value and cycle by cycle"};
+  addOptions(app, c);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (o.config.empty()) o.config = o.unit == "spec" ? "default" : "serial";
+  o.argv0 = argv[0];
+  o.save_fail = !c.no_fail_save;
+  o.triangles_given = c.given.triangles->count() > 0;
+
+  ScReport r;
+  try {
+    checkOptions(o, c.given);
+    r = runUnit(o);
+  } catch (const std::exception& e) {  // ArgError, files, configurations, SystemC elaboration errors
+    std::fprintf(stderr, "shadesim_systemc: error: %s\n", e.what());
+    return 2;
+  }
+
+  const ScFailCase& fc = r.fail;
+  FailReplay fr;
+  if (!fc.vec.empty()) {
+    fr.replay = replayFailCase(o, fc);
+    fr.reproduced = fr.replay.failsAtLastCycle(fc.cycles);
+  }
+  if (c.json) std::cout << reportJson(o, r, fr).dump(2) << std::endl;
+  else std::cout << r.summary << std::endl;
+  if (r.score.passed() && r.complete) return 0;
+  printFailure(o, r);
+  printFailCase(o, fc, fr);
   return 1;
 }
 
