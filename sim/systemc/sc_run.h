@@ -1,11 +1,10 @@
-// One shadesim_systemc run: the options of the command line (sc_main.cpp) and what a run of
-// either unit reports (sc_run_spec.cpp, sc_run_span.cpp). Kept free of CLI11 and JSON headers so
-// that the runners, the heavy SystemC translation units, compile in parallel with sc_main.cpp.
+// One shadesim_systemc run: the options of the command line (sc_main.cpp), what a run of either
+// unit reports (sc_run_spec.cpp, sc_run_span.cpp), and what both runners share (sc_run.cpp).
+// Kept free of CLI11, JSON and Verilator headers so that the runners, the heavy SystemC
+// translation units, compile in parallel with sc_main.cpp.
 #pragma once
 
 #include <cstdint>
-#include <filesystem>
-#include <fstream>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -15,10 +14,10 @@
 
 #include <systemc>
 
-#include <fmt/format.h>
-
-#include "cli/progress.h"
 #include "sc_common.h"
+
+class VerilatedFstC;
+class VerilatedFstSc;
 
 namespace shd {
 
@@ -69,24 +68,55 @@ struct ScReport {
 ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n);
 ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n);
 
-// An output file named by `option`: its directory is created and the file opened for writing
-// now, so that a path that cannot be written fails before the run (ArgError), not after it.
-inline void prepareOutput(const std::string& path, const char* option) {
-  namespace fs = std::filesystem;
-  const fs::path dir = fs::absolute(path).parent_path();
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw ArgError(fmt::format("{} {}: cannot create {}: {}", option, path, dir.string(), ec.message()));
-  std::ofstream probe(path, std::ios::app);
-  if (!probe) throw ArgError(fmt::format("{} {}: cannot write it", option, path));
-}
+// --- Shared by the runners (sc_run.cpp) ---
 
-// The paths of a failing case: <fail-dir>/<unit>_<config>_fail.<ext>.
-inline std::string failPath(const ScOptions& o, const char* ext) {
-  const std::string name = fmt::format("{}_{}_fail.{}", o.unit, o.config, ext);
-  if (o.fail_dir.empty() || o.fail_dir == ".") return name;
-  return (std::filesystem::path(o.fail_dir) / name).string();
-}
+// ArgError unless this program holds a SystemC model of configuration o.config of `unit`
+// ("specular unit", "span unit"); built: the configurations it holds.
+void requireBuilt(const ScOptions& o, const std::vector<std::string>& built, const char* unit);
+
+// ArgError for a --vector-file made for other parameters than the unit's (each as text).
+void requireFileParams(const ScOptions& o, const std::string& file_config, const std::string& file_params,
+                       const std::string& unit_params);
+
+// The output files named by --save-vectors and --fst: their directories are created and the
+// files opened for writing now, so that a path that cannot be written fails before the run
+// (ArgError), not after it.
+void prepareOutputs(const ScOptions& o);
+
+// The stimulus as the command line gave it: "--vector-file F", "--scene S", "--seed N --vectors M"
+// (spec) or "--seed N --triangles M" (span). The source lines of the files a run writes name it.
+std::string stimulusArgs(const ScOptions& o);
+// The source line of the --save-vectors file.
+std::string savedVectorsSource(const ScOptions& o);
+
+// The --fst waveform: every signal of the verilated unit.
+class ScWaveform {
+ public:
+  // Before the unit's model is built (Verilated::traceEverOn, or it traces nothing); path empty:
+  // no waveform.
+  explicit ScWaveform(std::string path);
+  // After elaboration (VerilatedFstSc::open requires it): trace adds the unit's signals.
+  void open(const std::function<void(VerilatedFstC&)>& trace);
+  void close();
+
+ private:
+  std::string path_;
+  // The kernel keeps the trace file in its list until the process ends, so it is not deleted.
+  VerilatedFstSc* tfp_ = nullptr;
+};
+
+// The simulated cycles of a run and the wall time they took.
+struct ScRunTime {
+  uint64_t cycles = 0;
+  double secs = 0;
+  // "<cycles> cycles simulated in <secs> s wall (<rate> cycles/s)", for the summaries.
+  std::string describe() const;
+};
+
+// sc_start() in slices of 20000 cycles until ctl.done, progress on stderr (unless o.quiet) as
+// done() of total `unit`s, under "systemc <unit>/<config>".
+ScRunTime scSimulate(ScRunControl& ctl, const ScOptions& o, const char* unit, double total,
+                     const std::function<double()>& done);
 
 // The run's first mismatching sample, as the runners capture it for the failing case.
 template <class Out>
@@ -96,15 +126,18 @@ struct ScFirstMismatch {
   bool from_file = false;   // ... the vector file's (else the golden model's)
 };
 
-// sc_start() in slices of 20000 cycles until ctl.done, progress on stderr (unless quiet) as
-// done() of total.
-inline void scSimulate(ScRunControl& ctl, bool quiet, const std::string& what, const char* unit, double total,
-                       const std::function<double()>& done) {
-  Progress progress(what, !quiet);
-  while (!ctl.done) {
-    sc_core::sc_start(20000 * scPeriod());
-    progress.update(done(), total, unit);
-  }
-}
+// The paths of a failing case: <fail-dir>/<unit>_<config>_fail.<ext>.
+std::string failPath(const ScOptions& o, const char* ext);
+
+// Saves a failing case of `cycles` cycles (ScFailCase), the first of them the run's cycle
+// run_first; what: the run's first mismatch. With no cycle, nothing is saved and why_none says
+// why. Else creates --fail-dir and has write() write the vector file at the path it is given;
+// an exception it throws becomes the reason the case was not saved.
+ScFailCase saveFailCase(const ScOptions& o, const std::string& what, uint64_t cycles, uint64_t run_first,
+                        const char* why_none, const std::function<void(const std::string& vec)>& write);
+// The failing case's source line ...
+std::string failCaseSource(const ScOptions& o, uint64_t run_first, uint64_t cycles);
+// ... and its note on where its expected outputs come from.
+std::string failCaseExpectedNote(const ScOptions& o, bool from_file);
 
 }  // namespace shd

@@ -2,14 +2,10 @@
 // (SpanRtl), a driver (SpanDriver for generator triangles or a scene's descriptors,
 // SpanFileDriver for a vector file), SpanGolden and SpanScoreboard (span_tb.h).
 #include <algorithm>
-#include <chrono>
-#include <filesystem>
 #include <memory>
 #include <optional>
 
 #include <fmt/format.h>
-#include <verilated.h>
-#include <verilated_fst_sc.h>
 
 #include "config/registry.h"
 #include "raster/desc_stream.h"
@@ -37,61 +33,32 @@ std::string describe(const SpanParams& p) {
 // the expectation the run failed when that was the vector file's.
 ScFailCase saveSpanFail(const ScOptions& o, const ScFirstMismatch<SpanOut>& first, SpanVectors v, uint64_t run_first,
                         bool from_accept, SpanFault fault, const std::string& what) {
-  ScFailCase f;
-  f.attempted = true;
-  f.what = what;
-  if (v.cycles.empty()) {
-    f.not_saved = "no captured cycle up to the failing sample";
-    return f;
-  }
-  try {
-    if (!o.fail_dir.empty()) std::filesystem::create_directories(o.fail_dir);
-    const std::string vec = failPath(o, "vec");
+  const auto write = [&](const std::string& vec) {
     v.config = o.config;
     spanGoldenReplay(v, v.params, fault);
     if (first.from_file) v.cycles.back().expected = first.expected;
-    const uint64_t run_last = run_first + v.cycles.size() - 1;
-    v.source = fmt::format(
-        "shadesim_systemc --unit span --config {} {}{}: the failing case, the run's cycles {}..{} after reset replayed "
-        "from reset",
-        o.config,
-        !o.vector_file.empty() ? "--vector-file " + o.vector_file
-        : !o.scene.empty()     ? "--scene " + o.scene
-                               : fmt::format("--seed {} --triangles {}", o.seed, o.triangles),
-        o.fault == "none" ? "" : " --fault " + o.fault, run_first, run_last);
+    v.source = failCaseSource(o, run_first, v.cycles.size());
     v.notes = {from_accept ? "the failing triangle alone: from the cycle that accepted it to the failing cycle"
                            : "from the run's first cycle (no triangle accepted before) to the failing cycle",
-               fmt::format("expected outputs: the golden-model module{} replayed on these inputs from reset{}",
-                           o.fault == "none" ? "" : " (fault " + o.fault + ")",
-                           first.from_file ? "; the last cycle: the run's vector file's expectation, which it failed" : ""),
+               failCaseExpectedNote(o, first.from_file),
                fmt::format("the run's first mismatch (the outputs during the last cycle): {}", what)};
     writeSpanVectors(vec, v);
-    f.vec = vec;
-    f.fst = failPath(o, "fst");
-    f.cycles = v.cycles.size();
-    f.run_first = run_first;
-  } catch (const std::exception& e) {
-    f.not_saved = e.what();
-  }
-  return f;
+  };
+  return saveFailCase(o, what, v.cycles.size(), run_first, "no captured cycle up to the failing sample", write);
 }
 
 }  // namespace
 
 ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n) {
-  const std::vector<std::string> built = scSpanRtlConfigs();
-  if (std::find(built.begin(), built.end(), o.config) == built.end())
-    throw ArgError(fmt::format("--config {}: no SystemC model of the span unit by that name (built: {})", o.config,
-                               fmt::join(built, ", ")));
-  if (!o.fst.empty()) Verilated::traceEverOn(true);  // before the model, or it traces nothing
+  requireBuilt(o, scSpanRtlConfigs(), "span unit");
+  ScWaveform wave(o.fst);
   std::unique_ptr<SpanRtl> rtl = makeSpanRtl(o.config, "span_rtl");
   const SpanParams p = rtl->params();
   const SpanUnitConfig cfg = spanConfig(o.config);
   if (describe(cfg.rtl) != describe(p))
     throw ArgError(fmt::format("--config {}: {} holds {}, the SystemC model was verilated with {}: rebuild", o.config,
                                cfg.path, describe(cfg.rtl), describe(p)));
-  if (!o.save_vectors.empty()) prepareOutput(o.save_vectors, "--save-vectors");
-  if (!o.fst.empty()) prepareOutput(o.fst, "--fst");
+  prepareOutputs(o);
 
   // The stimulus: a vector file, the scene's descriptors, or seeded generator triangles.
   std::unique_ptr<SpanVectors> file;
@@ -106,9 +73,7 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
     } catch (const std::exception& e) {
       throw ArgError(fmt::format("--vector-file: {}", e.what()));
     }
-    if (describe(file->params) != describe(p))
-      throw ArgError(fmt::format("--vector-file {}: made for configuration {} ({}), not for {} ({})", o.vector_file,
-                                 file->config, describe(file->params), o.config, describe(p)));
+    requireFileParams(o, file->config, describe(file->params), describe(p));
     total = file->cycles.size();
   } else if (!o.scene.empty()) {
     try {
@@ -200,37 +165,20 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
     };
 
   sc_core::sc_start(sc_core::SC_ZERO_TIME);
-  // Tracing starts after elaboration (VerilatedFstSc::open requires it). The kernel keeps the
-  // trace file in its list until the process ends, so it is not deleted here.
-  VerilatedFstSc* tfp = nullptr;
-  if (!o.fst.empty()) {
-    tfp = new VerilatedFstSc;
-    rtl->traceFst(*tfp, 99);
-    tfp->open(o.fst.c_str());
-  }
-
-  const auto t0 = std::chrono::steady_clock::now();
-  if (file)
-    scSimulate(ctl, o.quiet, fmt::format("systemc span/{}", o.config), "cycles", static_cast<double>(total),
-               [&] { return static_cast<double>(file_driver->cyclesDriven()); });
-  else
-    scSimulate(ctl, o.quiet, fmt::format("systemc span/{}", o.config), "triangles", static_cast<double>(total),
-               [&] { return static_cast<double>(driver->acceptedByRtl()); });
-  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const uint64_t cycles = scCycle(sc_core::sc_time_stamp());
+  wave.open([&](VerilatedFstC& tfp) { rtl->traceFst(tfp, 99); });
+  const ScRunTime time =
+      file ? scSimulate(ctl, o, "cycles", static_cast<double>(total),
+                        [&] { return static_cast<double>(file_driver->cyclesDriven()); })
+           : scSimulate(ctl, o, "triangles", static_cast<double>(total),
+                        [&] { return static_cast<double>(driver->acceptedByRtl()); });
   rtl->finalize();
-  if (tfp) tfp->close();
+  wave.close();
   board.finish();
 
   if (!o.save_vectors.empty()) {
     SpanVectors v = golden.recorded();
     v.config = o.config;
-    v.source = fmt::format("shadesim_systemc --unit span --config {} {} (the golden-model module's predictions{})",
-                           o.config,
-                           file ? "--vector-file " + o.vector_file
-                                : scene ? "--scene " + o.scene
-                                        : fmt::format("--seed {} --triangles {}", o.seed, o.triangles),
-                           o.fault == "none" ? "" : ", fault " + o.fault);
+    v.source = savedVectorsSource(o);
     writeSpanVectors(o.save_vectors, v);
   }
 
@@ -277,12 +225,12 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   }
   r.summary = fmt::format(
       "systemc span/{} {}: descriptors accepted by {}the model {}, {} fragments (model {}, rtl {}, {} equal in value "
-      "and cycle), {} samples compared{}, {} mismatches; {} cycles simulated in {:.2f} s wall ({:.0f} cycles/s)",
+      "and cycle), {} samples compared{}, {} mismatches; {}",
       o.config, what, driver ? fmt::format("the RTL {}, ", driver->acceptedByRtl()) : std::string(), golden.accepted(),
       s.matched_items, s.expected_items,
       s.observed_items, s.matched_items, s.samples,
       file ? fmt::format(" ({} also against the file's expected outputs)", board.fileChecks()) : std::string(),
-      s.mismatches(), cycles, secs, secs > 0 ? cycles / secs : 0.0);
+      s.mismatches(), time.describe());
   r.add("stimulus", std::string(file ? "vector-file" : scene ? "scene" : "random"));
   if (file) {
     r.add("vector_file", o.vector_file);
@@ -310,8 +258,8 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   r.add("fragments_expected", s.expected_items);
   r.add("fragments_observed", s.observed_items);
   r.add("fragments_matched", s.matched_items);
-  r.add("cycles", cycles);
-  r.add("seconds", secs);
+  r.add("cycles", time.cycles);
+  r.add("seconds", time.secs);
   if (!o.save_vectors.empty()) r.add("saved_vectors", o.save_vectors);
   return r;
 }
