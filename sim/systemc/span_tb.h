@@ -84,7 +84,7 @@ class SpanDriver : public sc_core::sc_module {
   uint64_t offered_ = 0, accepted_ = 0;
 };
 
-// Replays a vector file's cycles (sim/vector_file.h): desc_valid, out_ready and the descriptor
+// Replays a vector file's cycles (sim/vectors/vector_file.h): desc_valid, out_ready and the descriptor
 // on the ports as the file gives them (not following desc_ready: the file's own expectations
 // say when a descriptor is taken), and the file's expected outputs to the scoreboard. Each
 // descriptor goes to the golden model as a transaction when the file starts offering it. The
@@ -162,7 +162,8 @@ class SpanGolden : public sc_core::sc_module {
   // capture: keep what the failing case is saved from, bounded by one triangle: the inputs on
   // the ports (desc_valid, out_ready, the descriptor) of every active cycle since the one at
   // which the current triangle was accepted (from reset before the first), as
-  // sim/span_cosim.cpp does: the unit loads every register it uses when it accepts a descriptor.
+  // sim/cosim/span_cosim.cpp does: the unit loads every register it uses when it accepts a
+  // descriptor.
   SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record, bool capture = false);
   SC_HAS_PROCESS(SpanGolden);
   uint64_t accepted() const { return core_.accepted(); }

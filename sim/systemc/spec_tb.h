@@ -70,7 +70,7 @@ class RandomSpecSource final : public SpecSource {
   RandomSpecStimulus stim_;
 };
 
-// The cycles of a vector file (sim/vector_file.h), one per active cycle, with their expected
+// The cycles of a vector file (sim/vectors/vector_file.h), one per active cycle, with their expected
 // outputs.
 class FileSpecSource final : public SpecSource {
  public:
