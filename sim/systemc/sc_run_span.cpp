@@ -44,6 +44,18 @@ std::unique_ptr<SpanRtl> makeRtl(const ScOptions& o) {
   return rtl;
 }
 
+// --vector-file, made for the unit's parameters p.
+std::unique_ptr<SpanVectors> loadSpanFile(const ScOptions& o, const SpanParams& p) {
+  std::unique_ptr<SpanVectors> file;
+  try {
+    file = std::make_unique<SpanVectors>(loadSpanVectors(o.vector_file));
+  } catch (const std::exception& e) {
+    throw ArgError(fmt::format("--vector-file: {}", e.what()));
+  }
+  requireFileParams(o, file->config, describe(file->params), describe(p));
+  return file;
+}
+
 // The stimulus: a vector file, the scene's descriptors, or seeded generator triangles. next()
 // hands the descriptors of the latter two to SpanDriver.
 struct SpanStimulus {
@@ -56,12 +68,7 @@ struct SpanStimulus {
 
   SpanStimulus(const ScOptions& o, const SpanParams& p) {
     if (!o.vector_file.empty()) {
-      try {
-        file = std::make_unique<SpanVectors>(loadSpanVectors(o.vector_file));
-      } catch (const std::exception& e) {
-        throw ArgError(fmt::format("--vector-file: {}", e.what()));
-      }
-      requireFileParams(o, file->config, describe(file->params), describe(p));
+      file = loadSpanFile(o, p);
       total = file->cycles.size();
     } else if (!o.scene.empty()) {
       try {
@@ -123,7 +130,7 @@ struct SpanBench {
   SpanScoreboard board;
   SpanFailCapture fail;  // filled unless --no-fail-save
 
-  SpanBench(const ScOptions& o, SpanRtl& rtl, SpanStimulus& stim, sc_core::sc_clock& clk,
+  SpanBench(const ScOptions& o, SpanRtl& rtl, const SpanStimulus& stim, sc_core::sc_clock& clk,
             sc_core::sc_signal<bool>& rst_n)
       : file_driver(stim.file ? std::make_unique<SpanFileDriver>("driver", *stim.file, ctl) : nullptr),
         driver(stim.file ? nullptr : std::make_unique<SpanDriver>("driver", stim.next, driverOptions(o), ctl)),
@@ -267,6 +274,7 @@ std::string describeSpanStimulus(const ScOptions& o, const SpanStimulus& stim, u
                      stim.stream->dropped());
 }
 
+// The report's fields (--json), in print order.
 void addSpanFields(const ScOptions& o, const SpanStimulus& stim, const SpanBench& tb, uint64_t descs,
                    const ScRunTime& time, ScReport& r) {
   const ScScore& s = r.score;
@@ -302,7 +310,7 @@ void addSpanFields(const ScOptions& o, const SpanStimulus& stim, const SpanBench
   if (!o.save_vectors.empty()) r.add("saved_vectors", o.save_vectors);
 }
 
-// The report's counts, completeness and summary (r.score and r.fail already in).
+// The report's fields, completeness and summary (r.score and r.fail already in).
 void reportSpan(const ScOptions& o, const SpanStimulus& stim, const SpanBench& tb, const ScRunTime& time,
                 ScReport& r) {
   const ScScore& s = r.score;
@@ -330,13 +338,13 @@ void reportSpan(const ScOptions& o, const SpanStimulus& stim, const SpanBench& t
 
 ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signal<bool>& rst_n) {
   requireBuilt(o, scSpanRtlConfigs(), "span unit");
-  ScWaveform wave(o.fst);
+  ScWaveform wave(o.fst);  // before the model
   const std::unique_ptr<SpanRtl> rtl = makeRtl(o);
   prepareOutputs(o);
   SpanStimulus stim(o, rtl->params());
   SpanBench tb(o, *rtl, stim, clk, rst_n);
 
-  sc_core::sc_start(sc_core::SC_ZERO_TIME);
+  sc_core::sc_start(sc_core::SC_ZERO_TIME);  // elaborate: the waveform opens after it
   wave.open([&](VerilatedFstC& tfp) { rtl->traceFst(tfp, 99); });
   const ScRunTime time = tb.simulate(o, stim);
   rtl->finalize();

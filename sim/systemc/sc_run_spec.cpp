@@ -281,7 +281,7 @@ void checkSpecComplete(const SpecVectors* file, const SpecSource& src, const Spe
   }
 }
 
-// The report's counts, completeness and summary (r.score and r.fail already in).
+// The report's fields, completeness and summary (r.score and r.fail already in).
 void reportSpec(const ScOptions& o, const SpecVectors* file, const SpecSource& src, const SpecBench& tb,
                 const std::string& prom, const ScRunTime& time, ScReport& r) {
   const ScScore& s = r.score;
@@ -327,7 +327,7 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   checkPromFile(o, prom, cfg, table);
   prepareOutputs(o);
 
-  ScWaveform wave(o.fst);
+  ScWaveform wave(o.fst);  // before the model
   const std::unique_ptr<SpecRtl> rtl = makeRtl(o, cfg, prom);
   SpecUnitModel model(modelParams(o, cfg.rtl), table.words);
   std::unique_ptr<SpecSource> src;

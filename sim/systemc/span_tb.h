@@ -84,11 +84,11 @@ class SpanDriver : public sc_core::sc_module {
   uint64_t offered_ = 0, accepted_ = 0;
 };
 
-// Replays a vector file's cycles (sim/vectors/vector_file.h): desc_valid, out_ready and the descriptor
-// on the ports as the file gives them (not following desc_ready: the file's own expectations
-// say when a descriptor is taken), and the file's expected outputs to the scoreboard. Each
-// descriptor goes to the golden model as a transaction when the file starts offering it. The
-// run ends two cycles after the file's last cycle.
+// Replays a vector file's cycles (sim/vectors/vector_file.h): desc_valid, out_ready and the
+// descriptor on the ports as the file gives them (not following desc_ready: the file's own
+// expectations say when a descriptor is taken), and the file's expected outputs to the
+// scoreboard. Each descriptor goes to the golden model as a transaction when the file starts
+// offering it. The run ends two cycles after the file's last cycle.
 class SpanFileDriver : public sc_core::sc_module {
  public:
   sc_core::sc_in<bool> clk{"clk"}, rst_n{"rst_n"};

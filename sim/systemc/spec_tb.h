@@ -70,8 +70,8 @@ class RandomSpecSource final : public SpecSource {
   RandomSpecStimulus stim_;
 };
 
-// The cycles of a vector file (sim/vectors/vector_file.h), one per active cycle, with their expected
-// outputs.
+// The cycles of a vector file (sim/vectors/vector_file.h), one per active cycle, with their
+// expected outputs.
 class FileSpecSource final : public SpecSource {
  public:
   explicit FileSpecSource(const SpecVectors& v);
