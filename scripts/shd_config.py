@@ -2,7 +2,9 @@
 """The unit configurations, for every tool that is not the C++ model.
 
 A configuration is one JSON file `<unit>_<name>.json` in vectors/config/ (the registry; a build
-may add directories with SHD_CONFIG_DIRS):
+may add directories with SHD_CONFIG_DIRS). The files generated from it live beside its
+directory: the PROM table <dir>/../prom/spec_<name>.hex and the vector file
+<dir>/../cycles/<unit>_<name>.vec (vectors/prom/ and vectors/cycles/ for the registry).
 
     { "name": "<name>", "description": "...", "rtl": { "<Parameter>": <integer>, ... }, ... }
 
@@ -17,7 +19,7 @@ model/config/registry.h) and validates the parameters' ranges.
         CONFIG: a JSON file, "<unit>:<name>" from the registry, or "-" (the JSON on stdin).
         verilator: one -G<Name>=<value> per line; icarus: -P<top>.<Name>=<value> (--top, default
         the unit's top module); yosys: one line "-set <Name> <value> ..." for chparam
-  shd_config.py unit UNIT                                    the unit's top module and RTL files
+  shd_config.py unit UNIT            the unit's top module, then its RTL files, one per line
   shd_config.py cmake --dir DIR ... --cmake-out F --cpp-out F  what CMake includes, and the C++
         source that embeds every configuration's text (written only when it changed)
 Exit status 0, or 2 with "shd_config.py: error: ..." naming the file and the member.
@@ -54,6 +56,12 @@ class Config:
     def top(self):
         return UNITS[self.unit]["top"]
 
+    def generated(self, kind):
+        """Where its generated file of `kind` ("prom" or "cycles") lives."""
+        ext = {"prom": ".hex", "cycles": ".vec"}[kind]
+        base = os.path.dirname(os.path.dirname(os.path.abspath(self.path)))
+        return os.path.join(base, kind, f"{self.unit}_{self.name}{ext}")
+
 
 def parse(text, where, unit=None, name=None):
     """A Config from JSON text; unit and name, when known from the file name, must match."""
@@ -73,8 +81,10 @@ def parse(text, where, unit=None, name=None):
     if not isinstance(rtl, dict) or not rtl:
         raise ConfigError(f"{where}: \"rtl\" must be a non-empty object of Verilog parameters")
     for k, v in rtl.items():
-        if not PARAM_RE.fullmatch(k) or type(v) is not int:
-            raise ConfigError(f"{where}: rtl.{k} = {v!r} is not an integer parameter (UpperCamelCase name)")
+        if not PARAM_RE.fullmatch(k):
+            raise ConfigError(f"{where}: rtl.{k}: a parameter name is UpperCamelCase letters and digits")
+        if type(v) is not int:
+            raise ConfigError(f"{where}: rtl.{k} = {json.dumps(v)} is not an integer")
     if RAW_END in text:
         raise ConfigError(f"{where}: contains {RAW_END!r}, which cannot be embedded")
     return Config(unit, jname, rtl, where, text)
@@ -89,8 +99,12 @@ def load_file(path, unit=None):
             text = f.read()
     except OSError as e:
         raise ConfigError(f"{path}: cannot read: {e.strerror}")
+    except UnicodeDecodeError as e:
+        raise ConfigError(f"{path}: not UTF-8 text ({e.reason} at byte {e.start})")
     if m:
-        return parse(text, path, unit or m.group(1), m.group(2) if unit in (None, m.group(1)) else None)
+        if unit not in (None, m.group(1)):
+            raise ConfigError(f"{path}: the file name says unit {m.group(1)}, not {unit}")
+        return parse(text, path, m.group(1), m.group(2))
     if unit is None:
         raise ConfigError(f"{path}: name it <unit>_<name>.json (unit spec or span), or name the unit")
     return parse(text, path, unit)
@@ -122,6 +136,8 @@ def resolve(ref, dirs, unit=None):
         return parse(sys.stdin.read(), "<stdin>", unit)
     m = re.fullmatch(r"(spec|span):([a-z][a-z0-9]*)", ref)
     if m and not os.path.exists(ref):
+        if unit not in (None, m.group(1)):
+            raise ConfigError(f"{ref} is a {m.group(1)} configuration, not {unit}")
         for c in registry(dirs):
             if (c.unit, c.name) == (m.group(1), m.group(2)):
                 return c
@@ -165,6 +181,8 @@ def cmake_outputs(configs):
     for c in configs:
         key = f"SHD_CFG_{c.unit}_{c.name}"
         cm.append(f"set({key}_FILE \"{c.path}\")")
+        cm.append(f"set({key}_PROM \"{c.generated('prom')}\")")
+        cm.append(f"set({key}_VEC \"{c.generated('cycles')}\")")
         cm.append(f"set({key}_GARGS {' '.join(tool_args(c, 'verilator'))})")
         assign = "".join(f"  p.{k} = {v};\\n" for k, v in c.rtl.items())
         cm.append(f"set({key}_ASSIGN \"{assign}\")")
@@ -213,7 +231,8 @@ def main(argv):
         elif a.cmd == "unit":
             u = UNITS[a.unit]
             print(u["top"])
-            print(" ".join(os.path.join(ROOT, "rtl", f) for f in u["rtl"]))
+            for f in u["rtl"]:
+                print(os.path.join(ROOT, "rtl", f))
         else:
             configs = registry([os.path.abspath(d) for d in a.dir])
             for u in UNITS:

@@ -74,7 +74,7 @@ while IFS= read -r p; do [ -z "$p" ] || pargs+=("$p"); done <<<"$params"
 
 # The unit's RTL files: `shd_config.py unit` prints its top module, then the files.
 unit_info=$(shd_config unit "$unit") || die "shd_config.py unit $unit failed"
-read -ra sources <<<"$(sed -n 2p <<<"$unit_info")"
+mapfile -t sources < <(sed -n '2,$p' <<<"$unit_info")
 [ ${#sources[@]} -gt 0 ] || die "no RTL files for the $unit unit"
 for f in "${sources[@]}"; do [ -f "$f" ] || die "RTL file $f not found"; done
 
