@@ -15,9 +15,9 @@
 #   config     registry  shown only when `shd_config.py list` rejects a configuration file
 #                        (a FAIL: the configuration checks are skipped)
 # Any warning or error fails the check: Icarus exits 0 on warnings (an unknown -P parameter, an
-# out-of-range part select), so any output at all counts as a failure. Lint waivers, if the
-# project adds them, are Verilator configuration files rtl/*.vlt and are passed to every
-# Verilator run.
+# out-of-range part select), so any output at all counts as a failure. Lint waivers would be
+# Verilator configuration files (.vlt) in rtl/, passed to every Verilator run; there are none:
+# the RTL is lint-clean without them.
 #
 # Usage: scripts/lint.sh [-v]   (-v prints the tool output of passing checks too)
 # Exit status: 0 all checks pass, 1 some check failed, 2 a tool or input is missing.

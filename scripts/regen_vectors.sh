@@ -51,7 +51,7 @@ if [ "$config_dir" = "$root/vectors/config" ]; then
   done
 fi
 
-# Cycle-by-cycle vector files (sim/vector_file.h) of every unit configuration, replayed under
+# Cycle-by-cycle vector files (sim/vectors/vector_file.h) of every unit configuration, replayed under
 # Icarus and Verilator by ctest. The span files are long enough for the generator's directed
 # phases (every size class x shape, the wide viewport) to finish in every mode; each file's
 # "# coverage" lines say by which cycle (test_vectors checks it).

@@ -1,10 +1,9 @@
 // Frame time of the golden model on builtin:sphere (512 x 512, the idx3d sphere), per shading
 // method, with the frame buffers reused from frame to frame as a renderer does. Figures, not
-// pass/fail. The peer: idx3d III renders this sphere in about 1.3 ms (flat) and 1.8 ms (its
-// lookup-table "Phong") per frame; the targets are constant-increment Gouraud and the
-// fixed-point Phong (phong-fixed: the whole per-pixel lighting in integers; its label says
-// whether the AVX-512 kernel ran) at least as fast. The RTL-in-the-loop frame time is printed by
-// `shadesim render --rtl`.
+// pass/fail. The peer is idx3d III on the same sphere (its flat and lookup-table "Phong"):
+// compare only runs taken side by side, interleaved, and report ratios (docs/performance.md).
+// phong-fixed's label says whether the AVX-512 kernel ran. The RTL-in-the-loop frame time is
+// printed by `shadesim render --rtl`.
 //   build/testbench/bench_render [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 

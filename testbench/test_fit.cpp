@@ -120,7 +120,7 @@ TEST(QuadraticFit, InflectionMatchesCosPowerAtInflectionPoint) {
     const Approx f = fitApprox(FitKind::Inflection, 2, n);
     const double t = inflectionCos(n);
     EXPECT_NEAR(f.eval(t), std::pow(t, n), 1e-12) << "n=" << n;
-    // The errata's closed form evaluated naively in long double (independent of the
+    // The corrected closed form evaluated naively in long double (independent of the
     // expm1/log1p form): relative 1e-12.
     if (n > 1.0) {
       const long double tl = std::sqrt((long double)(n - 1) / n);
@@ -191,7 +191,7 @@ TEST(CubicFit, CoefficientsAgreeWithLongDoubleClosedFormsAnd2x2Solve) {
         s = std::exp(std::log(Q) / nl);
         f = fitApprox(FitKind::Level, 3, n, (double)Q);
       }
-      // The paper's general closed forms (correct per the errata).
+      // The paper's general closed forms (correct as printed).
       const long double den = s * s * (s - 1) * (s - 1);
       const long double a1 = (nl * Q * (s - 1) - Q * (2 * s - 1) + s * s) / den;
       const long double b1 = (nl * Q * (1 - s * s) + Q * (3 * s * s - 1) - 2 * s * s * s) / den;
@@ -205,7 +205,7 @@ TEST(CubicFit, CoefficientsAgreeWithLongDoubleClosedFormsAnd2x2Solve) {
       const long double det = m11 * m22 - m12 * m21;
       EXPECT_NEAR(f.a1, (double)((r1 * m22 - m12 * r2) / det), 1e-10 * std::fabs((double)a1));
       EXPECT_NEAR(f.b1, (double)((m11 * r2 - r1 * m21) / det), 1e-10 * std::fabs((double)b1));
-      // The errata's reading of the Q = 0.5 special case, q = 0.5^(1/n) = exp(-ln 2 / n).
+      // The reading of the Q = 0.5 special case (docs/paper-corrections.md), q = 0.5^(1/n) = exp(-ln 2 / n).
       if (which == 1) {
         const long double q = s;
         const long double d2 = 2 * (q - 1) * (q - 1) * q * q;
@@ -361,7 +361,7 @@ TEST(FitPaperClaims, InflectionFitErrorUpToInflectionPoint) {
 
 TEST(FitPaperClaims, ShortcutIsFarWorseThanClaimed) {
   // Paper: a = 0.786 n gives a relative error below 0.3 % for 21 <= n <= 1000 and below 4 %
-  // otherwise. Errata: does not hold. Measured near the peak (c^n >= 0.5) the shortcut's
+  // otherwise. It does not hold. Measured near the peak (c^n >= 0.5) the shortcut's
   // relative error exceeds 0.3 % for EVERY n in [21, 1000] (it is about 9-10 %), and even read
   // as the error of the coefficient a itself the claim fails (3 % at n = 21).
   double min_rel = 1e9;
@@ -398,7 +398,7 @@ TEST(FitPaperClaims, CubicEpicentreErrorAndSchlickRatioDependOnRegion) {
   // most 0.67 % for n in [1, 256], more than 17 times less than Schlick's.
   // Measured (integer n): in both peak regions the cubic's maximum relative error is at
   // n = 256 and slightly above the claim (about 0.69 %, below 0.7 %). The Schlick ratio depends
-  // on the region (errata): over c^n >= 0.5 it is above 17 (about 26); over the paper's
+  // on the region: over c^n >= 0.5 it is above 17 (about 26); over the paper's
   // "up to the inflection point" region it is below 17 (about 14).
   double cub_infl = 0, cub_p50 = 0, sch_infl = 0, sch_p50 = 0;
   for (int n = 1; n <= 256; ++n) {
@@ -419,7 +419,7 @@ TEST(FitPaperClaims, CubicEpicentreErrorAndSchlickRatioDependOnRegion) {
 }
 
 TEST(FitPaperClaims, WholeLobeErrorIsMuchLargerThanPeakError) {
-  // Errata: over the whole lobe the clamped quadratic is much worse than near the peak, and the
+  // Over the whole lobe the clamped quadratic is much worse than near the peak, and the
   // inflection choice of a is not the best for whole-lobe error. Checked at every 10th n.
   for (int n = 10; n <= 1000; n += 10) {
     SCOPED_TRACE(n);

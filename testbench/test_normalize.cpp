@@ -1,4 +1,4 @@
-// The normalisation hardware of phong-incremental: the squared-norm recurrence of errata 4.1
+// The normalisation hardware of phong-incremental: the corrected squared-norm recurrence of paper 4.1 (docs/paper-corrections.md)
 // against direct evaluation, and the fixed-point reciprocal square root's error.
 #include "render/normalize.h"
 

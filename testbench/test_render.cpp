@@ -235,7 +235,7 @@ TEST(Render, BadOptionsAreNamed) {
 }
 
 TEST(EdgeMaximum, MatchesDenseSamplingOfTheNormalisedCosine) {
-  // errata 4.4: the root t1 maximises (N_A + t (N_B - N_A)).H / |N_A + t (N_B - N_A)| on (0, 1)
+  // paper 4.4 as corrected (docs/paper-corrections.md): the root t1 maximises (N_A + t (N_B - N_A)).H / |N_A + t (N_B - N_A)| on (0, 1)
   // when cos alpha + cos chi > 0; otherwise the maximum is at an end.
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> u(-1, 1);

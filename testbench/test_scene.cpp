@@ -307,7 +307,7 @@ TEST(BuiltinScenes, NamesLoad) {
 
 TEST(BuiltinScenes, SphereIsTheDesignDefaultScene) {
   const Scene s = loadScene("builtin:sphere");
-  // DESIGN.md "Default scene": 512x512, camera (0,0,-3) at the origin, 512 px per unit.
+  // The default scene (model/scene/scene.h): 512x512, camera (0,0,-3) at the origin, 512 px per unit.
   EXPECT_EQ(s.camera.width, 512); EXPECT_EQ(s.camera.height, 512);
   EXPECT_EQ(s.camera.px_per_unit, 512.0);
   EXPECT_EQ(s.camera.eye.x, 0.0); EXPECT_EQ(s.camera.eye.y, 0.0); EXPECT_EQ(s.camera.eye.z, -3.0);

@@ -1,4 +1,4 @@
-// Vector files (sim/vector_file.h): generation from the model, the strict readers, and the replay
+// Vector files (sim/vectors/vector_file.h): generation from the model, the strict readers, and the replay
 // on the verilated configurations, which passes on a correct file and fails on a wrong one.
 #include <gtest/gtest.h>
 

@@ -1,15 +1,15 @@
-// The paper's polynomial approximations of cos^n (section 4.3, as corrected by ERRATA.md) and
+// The paper's polynomial approximations of cos^n (section 4.3, with the corrections of docs/paper-corrections.md) and
 // the fits of their coefficients. c = cos(gamma) = N.H in [0, 1], n = shininess in [1, 1000].
 //
 // Degree 2 (the device of Fig. 11):  p(c) = a c^2 + (1 - a) c = c - a c (1 - c)
 //   f(c) = max(0, p(c)). p(0) = 0, p(1) = 1; for a > 1 p is negative on (0, 1 - 1/a), so the
-//   clamp is mandatory (errata). For a >= 0 (every fit below) p <= c <= 1, so f <= 1 as well.
+//   clamp is mandatory (the paper omits it). For a >= 0 (every fit below) p <= c <= 1, so f <= 1 as well.
 //
 // Degree 3:  p(c) = a1 c^3 + b1 c^2 + c1 c,  c1 = 1 - a1 - b1  (p(0) = 0, p(1) = 1)
 //   Written as p(c) = c - c (1 - c) (a1 c + v), v = a1 + b1, which is how it is evaluated: the
 //   coefficients reach |a1| ~ 3e5 at n = 1000 and the monomial sum would lose ~1e-10 near c = 1,
 //   while this form keeps p(0) = 0 and p(1) = 1 exact and loses < 1e-13 near the peak.
-//   Cut-off rule (the paper gives none, errata): for n >= 3 the fitted cubics have no root in
+//   Cut-off rule (the paper gives none): for n >= 3 the fitted cubics have no root in
 //   (0, 1) and rise to a large local maximum away from the peak, so clamping at 0 does nothing.
 //     cut = the local minimum of p inside (0, 1), if p has one (a cubic has at most one local
 //           minimum; p'(cut) = 0, p''(cut) > 0); cut = 0 otherwise.
@@ -27,16 +27,16 @@
 //
 // Fits (FitKind):
 //   Inflection  match cos^n at the inflection point of cos^n(gamma): c = t = sqrt((n-1)/n).
-//               Degree 2: a = (t^(n-1) - 1)/(t - 1) (errata), a = 0 at n = 1 (p = c) and a = 1
+//               Degree 2: a = (t^(n-1) - 1)/(t - 1) (corrected), a = 0 at n = 1 (p = c) and a = 1
 //               at n = 2 (p = c^2), both exact. Degree 3: value and slope matched at t (the
 //               Level rule with Q = t^n); n = 1, 2, 3 give c, c^2, c^3 exactly; for real n in
 //               (1, 3) the matched cubic is well defined since t is in (0, 1).
 //   Level       match at the level q: c_q = q^(1/n), so cos^n(c_q) = q. Degree 2:
-//               a = (q^((n-1)/n) - 1)/(q^(1/n) - 1) (errata). Degree 3: value Q = q and slope
+//               a = (q^((n-1)/n) - 1)/(q^(1/n) - 1) (the printed form is garbled). Degree 3: value Q = q and slope
 //               n Q / c_Q at c_Q (the printed general closed forms for a1, b1, evaluated here in
 //               a cancellation-free form; exact c^n at n = 1, 2, 3).
 //   Shortcut    degree 2 only: a = 0.786 n, the paper's cheap formula; offered as a labelled
-//               option only, its error claims do not hold (errata, test_fit).
+//               option only, its error claims do not hold (test_fit).
 //   Minimax     the coefficients minimising the whole-lobe (c in [0, 1]) maximum absolute error
 //               of the CLAMPED (and, degree 3, cut) approximation. See minimaxQuadratic and
 //               minimaxCubic.

@@ -1,5 +1,5 @@
 // Input streams for the specular unit: every input exhaustively, or seeded random vectors with
-// valid gaps. Pure model code, shared by the C++ co-simulation (sim/spec_cosim.h), the vector
+// valid gaps. Pure model code, shared by the C++ co-simulation (sim/cosim/spec_cosim.h), the vector
 // file generator and the SystemC testbench.
 #pragma once
 

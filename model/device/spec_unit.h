@@ -1,6 +1,6 @@
 // SpecUnitModel: the bit-exact, cycle-accurate twin of rtl/shd_spec_unit.v.
 //
-// Datapath (paper Fig. 11, errata 4.3), formats from SpecUnitParams, rounding named where the
+// Datapath (paper Fig. 11, with the corrections of docs/paper-corrections.md 4.3), formats from SpecUnitParams, rounding named where the
 // RTL rounds:
 //   c   = min(cos_i, 1.0)                              uQ1.Wc   (RG2; N.H may overshoot 1)
 //   sq  = c * c                                        MUL1, exact

@@ -22,7 +22,7 @@
 //   covers no pixel and is dropped at setup without a division; so is a triangle with no pixel
 //   centre inside the viewport. setupTriangle() then returns no descriptor and says why.
 //
-// Attribute planes (errata 4.1: the plane gradient with det as denominator)
+// Attribute planes (the corrected 4.1 of docs/paper-corrections.md: the plane gradient with det as denominator)
 //   Vertex attribute k is quantised to a code a_i = round(value * 2^F_k) (F_k = attr_frac_bits).
 //   The gradients per pixel are the exact rationals
 //     dI/dx = 2^S ((a1-a0)(Y2-Y0) - (a2-a0)(Y1-Y0)) / det,

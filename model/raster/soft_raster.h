@@ -5,7 +5,7 @@
 //                      edge, then divide by the span length (one division per line) for the
 //                      step dI = (I_R - I_L) / (x_R - x_L); the idx3d-style loop of the
 //                      paper's listings.
-//   constant increment dI/dx is computed once per triangle (the plane gradient, errata 4.1);
+//   constant increment dI/dx is computed once per triangle (the plane gradient, docs/paper-corrections.md 4.1);
 //                      per line only the left-edge value is needed; no division per line.
 //
 // Both walk the same spans (edges interpolated in float, pixel centres, the same rounding of

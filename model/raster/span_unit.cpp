@@ -36,7 +36,7 @@ struct SpanMember {
   int SpanParams::*field;
 };
 
-// In the vector files' order (sim/vector_file.h).
+// In the vector files' order (sim/vectors/vector_file.h).
 constexpr SpanMember kSpanMembers[] = {
     {"NumTri", &SpanParams::NumTri},       {"LanesPerTri", &SpanParams::LanesPerTri},
     {"AlignLanes", &SpanParams::AlignLanes}, {"NumAttr", &SpanParams::NumAttr},

@@ -1,6 +1,6 @@
 // Normalising interpolated normals in hardware terms (phong-incremental, phong-fixed).
 //
-// Squared norm along a span (paper 4.1, as corrected by the errata): with N_i = N_0 + i dN,
+// Squared norm along a span (paper 4.1, as corrected in docs/paper-corrections.md): with N_i = N_0 + i dN,
 //   F_i = |N_i|^2 = A + 2 i B + i^2 C,  A = |N_0|^2, B = N_0 . dN, C = |dN|^2,
 // and by finite differences F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, with F_0 = A and
 // C_1 = C (the paper's seed "C_0 = 1" is wrong). After the three products of A, B and C once per

@@ -2,7 +2,7 @@
 // triangle setup, the span unit, per-pixel shading and a z-buffer.
 //
 // The span unit and the specular unit are engines: their bit-exact models here, or their
-// verilated RTL (sim/render_rtl.h), with the same interface, so the same scene rendered either
+// verilated RTL (sim/cosim/render_rtl.h), with the same interface, so the same scene rendered either
 // way must give the same framebuffer, pixel for pixel. Everything else is shared code.
 //
 // Attributes through the span unit (interpolated linearly in screen space, as the paper's
@@ -22,7 +22,7 @@
 //                      edges and divided by the span length (one division per line, float, as
 //                      the idx3d listings)
 //   phong              vertex normals interpolated by the span unit, normalised exactly per pixel
-//   phong-incremental  the same normals; |N|^2 along each span by the recurrence of errata 4.1
+//   phong-incremental  the same normals; |N|^2 along each span by the corrected recurrence (docs/paper-corrections.md, 4.1)
 //                      (F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, C_1 = C: additions
 //                      only) and a fixed-point reciprocal square root (table + one Newton step)
 //   phong-fixed        the same normals and recurrence, and the whole per-pixel lighting as a
@@ -44,7 +44,7 @@
 //                      I = sum c_i l_i (2 l_i - 1) + sum 4 c_ij l_i l_j, evaluated here
 //                      directly: no solve, no conditioning problem. Per pixel (not a span-unit
 //                      increment: a quadratic has no constant step); coverage from the span unit.
-//   modified-gouraud   paper 4.4 with the errata: on each edge the point where N(t).H peaks,
+//   modified-gouraud   paper 4.4 as corrected (docs/paper-corrections.md, 4.4): on each edge the point where N(t).H peaks,
 //                      t1 = (cos chi cos psi - cos alpha) / ((cos psi - 1)(cos alpha + cos chi)),
 //                      a maximum only when cos alpha + cos chi > 0 and t1 in (0, 1) (equal or
 //                      opposite normals: no interior maximum). Where the exactly shaded colour
@@ -192,7 +192,7 @@ struct Framebuffer {
   bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
 };
 
-// The errata 4.4 edge maximum of the specular cosine between unit normals na and nb for the
+// The corrected 4.4 edge maximum of the specular cosine between unit normals na and nb for the
 // half vector h: t in (0, 1), or -1 when the edge has no interior maximum.
 double edgeMaximumT(Vec3 na, Vec3 nb, Vec3 h);
 

@@ -1,4 +1,5 @@
-// The error report of the specular unit, split as DESIGN.md asks:
+// The error report of the specular unit, split in two (error against run time is only useful
+// when one knows which part of it the hardware adds):
 //   (a) approximation: the ideal device (the fit's real coefficients, clamp and cut-off, in
 //       double precision) against cos^n, over continuous c, exact maxima (lobe_error.h):
 //       whole lobe [0, 1]; peak50 (c^n >= 0.5); inflection (c from 1 down to the inflection

@@ -59,7 +59,7 @@
 // +z at the mirrored model). A model authored facing +z faces the default camera.
 //
 // Builtin scenes (loadScene("builtin:<name>"); builtinSceneNames() lists them):
-//   sphere     DESIGN.md's default scene: idx3dSphere(1, 64), Camera{} (eye (0,0,-3), target
+//   sphere     the default scene (the idx3d III sphere the paper's software was built on): idx3dSphere(1, 64), Camera{} (eye (0,0,-3), target
 //              origin, 512 px per unit, 512x512, z_near 0.1), one white directional light with
 //              direction (-1, 1, -1)/sqrt 3 ("toward the upper left front": -x is left, +y up,
 //              -z is toward the viewer), material Material{} (0x3070C0, kd 1, ks 1, n 32,

@@ -1,4 +1,4 @@
-// builtin:sphere, the idx3d III sphere of the default scene (DESIGN.md "Default scene"), and the
+// builtin:sphere, the idx3d III sphere of the default scene (model/scene/scene.h), and the
 // camera that views it: transform, back-face cull and perspective projection to screen space.
 //
 // ---------------------------------------------------------------------------------------------

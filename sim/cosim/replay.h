@@ -1,4 +1,4 @@
-// Replay of a vector file (sim/vector_file.h) on the verilated configuration it names: reset,
+// Replay of a vector file (sim/vectors/vector_file.h) on the verilated configuration it names: reset,
 // then per cycle the file's inputs, and every output compared with the file's expectation on
 // every cycle. The same files run under Icarus (testbench/icarus/); `shadesim replay FILE`.
 //

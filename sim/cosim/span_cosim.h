@@ -5,7 +5,7 @@
 //
 // On the first mismatch the failing triangle is replayed alone from reset, with the run's
 // inputs from the cycle that accepted it to the failing one, into a traced instance (an FST
-// waveform), and saved as a vector file (sim/vector_file.h: the descriptor, the inputs and the
+// waveform), and saved as a vector file (sim/vectors/vector_file.h: the descriptor, the inputs and the
 // model's expected outputs, cycle by cycle) that `shadesim replay` and the Icarus testbench
 // replay alone; its descriptor and out_ready pattern are also written as JSON.
 #pragma once

@@ -8,7 +8,7 @@
 //
 // On a mismatch the run records the first failing cycle with the input that produced it and
 // both outputs, keeps counting up to max_mismatches, then replays the last few cycles from reset
-// into a traced instance to write an FST waveform and a vector file (sim/vector_file.h) of the
+// into a traced instance to write an FST waveform and a vector file (sim/vectors/vector_file.h) of the
 // failing window: the model's expected outputs for the verilated configuration, with a copy of
 // the PROM beside it, so that `shadesim replay` and the Icarus testbench reproduce the mismatch
 // from the file alone.

@@ -47,7 +47,7 @@ class VerilatedHarness {
     std::vector<const char*> argv{"shadesim"};
     for (const std::string& a : plusargs) argv.push_back(a.c_str());
     ctx_->commandArgs(static_cast<int>(argv.size()), argv.data());
-    if (!fst_path.empty()) ctx_->traceEverOn(true);  // before the model (TOOLCHAIN 4)
+    if (!fst_path.empty()) ctx_->traceEverOn(true);  // before the model (otherwise Verilator traces nothing)
     dut_ = std::make_unique<V>(ctx_.get(), "dut");
     if (!fst_path.empty()) {
       fst_ = std::make_unique<VerilatedFstC>();

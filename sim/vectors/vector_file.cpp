@@ -41,7 +41,7 @@ std::string hx(int64_t v, int bits) { return fmt::format("{:x}", lowBits(v, bits
 std::string header(const std::string& unit, const std::string& config, const nlohmann::json& rtl,
                    const std::vector<int>& params, const std::string& source, const std::vector<std::string>& notes) {
   std::string h = fmt::format(
-      "# shadesim vector file, format {} (described in sim/vector_file.h)\n"
+      "# shadesim vector file, format {} (described in sim/vectors/vector_file.h)\n"
       "# unit {}\n# config {} {}\n# params {}\n",
       kVectorFormat, unit, config, rtl.dump(), fmt::join(params, " "));
   if (!source.empty()) h += fmt::format("# source {}\n", source);
@@ -270,7 +270,7 @@ std::string renderSpanVectors(const SpanVectors& v) {
   std::string t = header("span", v.config, p.toJson(), spanParamList(p), v.source, v.notes);
   t += fmt::format(
       "# parameter order: {}\n"
-      "# Records (hex, port widths, signed values in two's complement; see sim/vector_file.h):\n"
+      "# Records (hex, port widths, signed values in two's complement; see sim/vectors/vector_file.h):\n"
       "# D tag row_first row_last xref {{iref didx didy}}*NumAttr {{row_first row_last clip_x0 clip_x1 ox oy flip\n"
       "#   {{aoff}}*NumAttr {{right row_first row_last q r div k m}}*3}}*NumTri: the descriptor ports from the next C on\n"
       "# C desc_valid out_ready  exp_desc_ready exp_out_valid exp_tag exp_lane_valid {{x y {{attr}}*NumAttr}}*valid lanes:\n"

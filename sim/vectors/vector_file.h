@@ -1,5 +1,5 @@
 // Vector files: a unit's inputs and expected outputs, cycle by cycle from reset, as plain text
-// that the Verilator replay (sim/replay.h, `shadesim replay`), the Icarus testbenches
+// that the Verilator replay (sim/cosim/replay.h, `shadesim replay`), the Icarus testbenches
 // (testbench/icarus/tb_*_unit.v) and a person read alike. `shadesim vectors` writes them from the
 // golden model (checked in under vectors/cycles/), and a failing co-simulation saves its failing
 // case in the same format, so that the case replays alone.
@@ -15,7 +15,7 @@
 //   prom     spec only: the PROM $readmemh file, relative to the vector file's directory
 //   latency  spec only: 2 + PipeStages (informative; the readers check it)
 //   source   how the file was made (informative)
-// The spec header keeps the lines of the failing-window files sim/spec_cosim.cpp wrote before
+// The spec header keeps the lines of the failing-window files sim/cosim/spec_cosim.cpp wrote before
 // this format ("# config <name> <json>", "# latency", "# prom"), so readers of those still work.
 // Every value is hex, lowercase, without 0x, in the width of its port; a signed value is its
 // two's complement in that width (the port's bits). Reset, before the first cycle: rst_ni low

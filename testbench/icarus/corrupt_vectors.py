@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""corrupt_vectors.py IN OUT: a copy of a shadesim vector file (sim/vector_file.h) with exactly one
+"""corrupt_vectors.py IN OUT: a copy of a shadesim vector file (sim/vectors/vector_file.h) with exactly one
 expected output value wrong, to prove that a replay fails when it should.
 
 The value changed is the least significant bit of

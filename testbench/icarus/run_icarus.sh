@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# run_icarus.sh: replays a shadesim vector file (sim/vector_file.h) under Icarus Verilog.
+# run_icarus.sh: replays a shadesim vector file (sim/vectors/vector_file.h) under Icarus Verilog.
 # The file's header names the unit and the configuration ("# config <name> <json>"); the testbench
 # is compiled with that configuration's parameters and the specular unit loads the PROM the header
 # names (relative to the file). The parameters come from scripts/shd_config.py: when <name> is a

@@ -1,4 +1,4 @@
-// tb_span_unit: replays a shadesim vector file (format: sim/vector_file.h, unit span) on
+// tb_span_unit: replays a shadesim vector file (format: sim/vectors/vector_file.h, unit span) on
 // rtl/shd_span_unit.v under Icarus Verilog, and compares every output on every cycle.
 // Why:      the vector files hold the golden model's outputs cycle by cycle; the same files pass
 //           under Verilator (`shadesim replay`), so the RTL means the same in both simulators.
@@ -19,7 +19,7 @@
 //           malformed input, else prints the counts.
 // Timing:   rst_ni low for two cycles (desc_valid_i 0, out_ready_i 1); then per C record: inputs
 //           set while clk_i is low, outputs compared 1 time unit later (they are functions of
-//           the registers), then the rising edge (sim/span_dut.h does the same).
+//           the registers), then the rising edge (sim/harness/span_dut.h does the same).
 module tb_span_unit #(
   parameter integer NumTri      = 1,
   parameter integer LanesPerTri = 1,

@@ -1,4 +1,4 @@
-// tb_spec_unit: replays a shadesim vector file (format: sim/vector_file.h, unit spec) on
+// tb_spec_unit: replays a shadesim vector file (format: sim/vectors/vector_file.h, unit spec) on
 // rtl/shd_spec_unit.v under Icarus Verilog, and compares every output on every cycle.
 // Why:      the vector files hold the golden model's outputs cycle by cycle; the same files pass
 //           under Verilator (`shadesim replay`), so the RTL means the same in both simulators.
@@ -16,7 +16,7 @@
 //           mismatch). Prints the first 10 mismatches (cycle, signal, both values), ends with
 //           $fatal (exit status 1) on any mismatch or malformed input, else prints the counts.
 // Timing:   rst_ni low for two cycles with valid_i low; then per line: inputs set while clk_i is
-//           low, rising edge, outputs compared 1 time unit later (sim/spec_dut.h does the same).
+//           low, rising edge, outputs compared 1 time unit later (sim/harness/spec_dut.h does the same).
 module tb_spec_unit #(
   parameter integer Degree         = 2,
   parameter integer CosFracBits    = 15,
