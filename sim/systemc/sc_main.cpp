@@ -59,8 +59,8 @@ void addOptions(CLI::App& app, CommandLine& c) {
   given.vectors = app.add_option("--vectors", o.vectors, "spec: seeded random vectors (default 20000)")
                       ->check(CLI::PositiveNumber);
   app.add_option("--vector-file", o.vector_file,
-                 "replay a vector file (sim/vector_file.h, e.g. vectors/cycles/<unit>_<config>.vec): its inputs, and "
-                 "its expected outputs checked as well")
+                 "replay a vector file (sim/vectors/vector_file.h, e.g. vectors/cycles/<unit>_<config>.vec): its "
+                 "inputs, and its expected outputs checked as well")
       ->check(CLI::ExistingFile);
   app.add_option("--save-vectors", o.save_vectors,
                  "write the run as a vector file: the inputs on the ports every cycle and the golden model's outputs");
