@@ -193,9 +193,13 @@ TEST(CliSpanCycles, ReportChecksTheRtlCycles) {
   const CmdResult r = run("span-cycles --triangles 400 --soft-repeats 1 --rtl --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
+  // Every span configuration of the registry is measured, the serial unit first.
+  const auto configs = nlohmann::json::parse(run("configs --unit span --json").out);
+  ASSERT_GE(configs.size(), 2u);
   ASSERT_EQ(j["sets"].size(), 7u);  // five size classes, the mixed stream, the sphere
   for (const auto& set : j["sets"]) {
-    ASSERT_EQ(set["modes"].size(), 6u);
+    ASSERT_EQ(set["modes"].size(), configs.size());
+    EXPECT_EQ(set["modes"][0]["lanes"], 1);
     const double serial = set["modes"][0]["cycles"].get<double>();
     for (const auto& m : set["modes"]) {
       EXPECT_EQ(m["rtl_cycles"], m["cycles"]) << set["set"] << " " << m["mode"];
@@ -205,6 +209,44 @@ TEST(CliSpanCycles, ReportChecksTheRtlCycles) {
       EXPECT_LE(m["cycles"].get<double>(), serial) << set["set"] << " " << m["mode"];
     }
   }
+}
+
+// A configuration file of the user's own, outside the registry: every command that needs no
+// verilated model takes it; those that do refuse it and say how to add a model.
+TEST(CliConfig, AUsersFileWorksWithoutTheRtlAndIsRefusedWithIt) {
+  const std::string spec = tmp("my_spec.json"), span = tmp("my_span.json");
+  std::ofstream(spec) << R"({"name": "mine", "rtl": {"Degree": 2, "CosFracBits": 12, "ShinBits": 10, "CoefIntBits": 10,
+    "CoefFracBits": 9, "DiffFracBits": 20, "HornerFracBits": 9, "SpecFracBits": 12, "LightBits": 8, "PipeStages": 1},
+    "prom": {"fit": "level", "level": 0.5, "n": "1:1000"}})";
+  std::ofstream(span) << R"({"name": "mylanes", "rtl": {"NumTri": 1, "LanesPerTri": 4, "AlignLanes": 1, "NumAttr": 4,
+    "AttrBits": 32, "CoordBits": 16, "RemBits": 27, "PixBits": 12, "TagBits": 32}})";
+  const std::string hex = tmp("mine.hex"), vec = tmp("mine.vec"), svec = tmp("mylanes.vec"), png = tmp("mine.png");
+  CmdResult r = run("prom --config " + spec + " --format hex -o " + hex);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("spec-error --config " + spec + " --n-list 8,32 --quiet --json");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["config"], "mine");
+  r = run("vectors --unit spec --config " + spec + " --cycles 200 -o " + vec + " --prom " + hex);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("vectors --unit span --config " + span + " --cycles 200 -o " + svec);
+  ASSERT_EQ(r.code, 0) << r.err;
+  r = run("render --quiet --scene builtin:sphere --method phong-fixed --brdf quadratic --mode " + span +
+          " --quadratic-config " + spec + " -o " + png);
+  ASSERT_EQ(r.code, 0) << r.err;
+  // The RTL needs a verilated model of the configuration.
+  for (const std::string& args : {"cosim --unit spec --config " + spec + " --vectors 10 --quiet",
+                                  "cosim --unit span --mode " + span + " --triangles 10 --quiet", "replay " + vec,
+                                  "render --quiet --rtl --scene builtin:sphere --mode " + span + " -o " + png}) {
+    r = run(args);
+    EXPECT_EQ(r.code, 2) << args;
+    const bool explained = r.err.find("add the file to the registry") != std::string::npos ||
+                           r.err.find("is not verilated into this build") != std::string::npos;
+    EXPECT_TRUE(explained) << args << "\nstderr: " << r.err;
+  }
+  // A quadratic-lobe configuration must be of degree 2.
+  r = run("render --quiet --scene builtin:sphere --method phong --brdf quadratic --quadratic-config cubic -o " + png);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("degree-2"), std::string::npos) << r.err;
 }
 
 TEST(CliRender, WritesImagesAndStats) {

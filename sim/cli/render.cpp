@@ -73,6 +73,9 @@ class RenderCmd final : public Command {
     const fs::path dir = fs::path(output_).parent_path();
     return dir.empty() ? "." : dir.string();
   }
+  SpecUnitConfig lobeConfig(Lobe l) const;
+  // Before any work: the verilated models --rtl needs exist (ArgError naming the option).
+  void requireRtl(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span) const;
   Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span, bool with_rtl,
                       const fs::path& tmp) const;
   Comparison compare(const RenderResult& res, const RenderResult& ref) const;
@@ -117,12 +120,7 @@ Engines RenderCmd::makeEngines(const Scene& sc, const RenderOptions& ro, const S
   if (with_rtl) e.span = std::make_unique<RtlSpanEngine>(span, failDir());
   else e.span = std::make_unique<ModelSpanEngine>(span.rtl);
   for (Lobe l : deviceLobesUsed(sc, ro)) {
-    SpecUnitConfig cfg;
-    try {
-      cfg = lobes_.load(l);
-    } catch (const std::invalid_argument& ex) {
-      throw ArgError(fmt::format("--{}-config: {}", toString(l), ex.what()));
-    }
+    const SpecUnitConfig cfg = lobeConfig(l);
     PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
     if (with_rtl) {
       fs::create_directories(tmp);
@@ -134,6 +132,29 @@ Engines RenderCmd::makeEngines(const Scene& sc, const RenderOptions& ro, const S
     (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.spec.back().get();
   }
   return e;
+}
+
+SpecUnitConfig RenderCmd::lobeConfig(Lobe l) const {
+  try {
+    return lobes_.load(l);
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(fmt::format("--{}-config: {}", toString(l), e.what()));
+  }
+}
+
+void RenderCmd::requireRtl(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span) const {
+  try {
+    requireVerilated(span);
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(fmt::format("--mode {}: {}", mode_, e.what()));
+  }
+  for (Lobe l : deviceLobesUsed(sc, ro)) {
+    try {
+      requireVerilated(lobeConfig(l));
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(fmt::format("--{}-config {}: {}", toString(l), lobes_.forLobe(l), e.what()));
+    }
+  }
 }
 
 Comparison RenderCmd::compare(const RenderResult& res, const RenderResult& ref) const {
@@ -225,6 +246,7 @@ int RenderCmd::run(const CLI::App&) {
   RenderOptions ro;
   ro.method = parseMethod(method_);
   ro.brdf = brdf_;
+  if (rtl_) requireRtl(sc, ro, span);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-render-{}", getpid());
   // The golden model, frame after frame into the same buffers as a renderer does.
   Engines model = makeEngines(sc, ro, span, false, tmp);
