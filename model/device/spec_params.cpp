@@ -1,18 +1,14 @@
 #include "device/spec_params.h"
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
+
+#include "config/params_json.h"
 
 namespace shd {
 
 namespace {
 
-struct Member {
-  const char* name;
-  int SpecUnitParams::*field;
-};
-
-constexpr Member kMembers[] = {
+constexpr ParamMember<SpecUnitParams> kMembers[] = {
     {"Degree", &SpecUnitParams::Degree},
     {"CosFracBits", &SpecUnitParams::CosFracBits},
     {"ShinBits", &SpecUnitParams::ShinBits},
@@ -81,32 +77,9 @@ void SpecUnitParams::validate() const {
 }
 
 SpecUnitParams SpecUnitParams::fromJson(const nlohmann::json& rtl, const std::string& where) {
-  if (!rtl.is_object())
-    throw std::invalid_argument(fmt::format("{}: \"rtl\" must be an object", where));
-  SpecUnitParams p;
-  for (const auto& [key, value] : rtl.items()) {
-    const Member* m = nullptr;
-    for (const Member& cand : kMembers)
-      if (key == cand.name) m = &cand;
-    if (m == nullptr)
-      throw std::invalid_argument(fmt::format("{}: unknown RTL parameter rtl.{}", where, key));
-    if (!value.is_number_integer())
-      throw std::invalid_argument(
-          fmt::format("{}: rtl.{} must be an integer, got {}", where, key, value.dump()));
-    p.*(m->field) = value.get<int>();
-  }
-  try {
-    p.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
-  }
-  return p;
+  return paramsFromJson(rtl, kMembers, false, where);  // missing members take the defaults
 }
 
-nlohmann::json SpecUnitParams::toJson() const {
-  nlohmann::json j = nlohmann::json::object();
-  for (const Member& m : kMembers) j[m.name] = this->*(m.field);
-  return j;
-}
+nlohmann::json SpecUnitParams::toJson() const { return paramsToJson(*this, kMembers); }
 
 }  // namespace shd

@@ -6,8 +6,8 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
-#include <fmt/ranges.h>
-#include <nlohmann/json.hpp>
+
+#include "config/params_json.h"
 
 namespace shd {
 
@@ -31,53 +31,21 @@ void SpanParams::validate() const {
 
 namespace {
 
-struct SpanMember {
-  const char* name;
-  int SpanParams::*field;
-};
-
 // In the vector files' order (sim/vectors/vector_file.h).
-constexpr SpanMember kSpanMembers[] = {
-    {"NumTri", &SpanParams::NumTri},       {"LanesPerTri", &SpanParams::LanesPerTri},
+constexpr ParamMember<SpanParams> kSpanMembers[] = {
+    {"NumTri", &SpanParams::NumTri},         {"LanesPerTri", &SpanParams::LanesPerTri},
     {"AlignLanes", &SpanParams::AlignLanes}, {"NumAttr", &SpanParams::NumAttr},
-    {"AttrBits", &SpanParams::AttrBits},   {"CoordBits", &SpanParams::CoordBits},
-    {"RemBits", &SpanParams::RemBits},     {"PixBits", &SpanParams::PixBits},
+    {"AttrBits", &SpanParams::AttrBits},     {"CoordBits", &SpanParams::CoordBits},
+    {"RemBits", &SpanParams::RemBits},       {"PixBits", &SpanParams::PixBits},
     {"TagBits", &SpanParams::TagBits}};
 
 }  // namespace
 
 SpanParams SpanParams::fromJson(const nlohmann::json& rtl, const std::string& where) {
-  if (!rtl.is_object()) throw std::invalid_argument(fmt::format("{}: 'rtl' is not an object", where));
-  SpanParams p;
-  for (const auto& [key, value] : rtl.items()) {
-    const SpanMember* m = nullptr;
-    for (const SpanMember& cand : kSpanMembers)
-      if (key == cand.name) m = &cand;
-    if (m == nullptr) {
-      std::vector<std::string> known;
-      for (const SpanMember& k : kSpanMembers) known.emplace_back(k.name);
-      throw std::invalid_argument(
-          fmt::format("{}: unknown span parameter '{}' (known: {})", where, key, fmt::join(known, " ")));
-    }
-    if (!value.is_number_integer())
-      throw std::invalid_argument(fmt::format("{}: span parameter {} is not an integer", where, key));
-    p.*(m->field) = value.get<int>();
-  }
-  for (const SpanMember& m : kSpanMembers)
-    if (!rtl.contains(m.name)) throw std::invalid_argument(fmt::format("{}: span parameter {} missing", where, m.name));
-  try {
-    p.validate();
-  } catch (const std::invalid_argument& e) {
-    throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
-  }
-  return p;
+  return paramsFromJson(rtl, kSpanMembers, true, where);
 }
 
-nlohmann::json SpanParams::toJson() const {
-  nlohmann::json j = nlohmann::json::object();
-  for (const SpanMember& m : kSpanMembers) j[m.name] = this->*(m.field);
-  return j;
-}
+nlohmann::json SpanParams::toJson() const { return paramsToJson(*this, kSpanMembers); }
 
 SpanUnitModel::SpanUnitModel(SpanParams p) : p_(p) {
   p_.validate();
