@@ -5,11 +5,10 @@
 
 namespace shd {
 
-Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, RenderResult& res)
+Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Framebuffer& fb, RenderStats& st)
     : opt(opt),
-      res(res),
-      fb(res.fb),
-      st(res.stats),
+      fb(fb),
+      st(st),
       W(scene.camera.width),
       H(scene.camera.height),
       proj(scene.camera),

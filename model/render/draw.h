@@ -156,13 +156,12 @@ struct ObjectShading {
 // the current object's lighting, and the units of the methods in use.
 class Frame {
  public:
-  Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, RenderResult& res);
+  Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Framebuffer& fb, RenderStats& st);
   Frame(const Frame&) = delete;
   Frame& operator=(const Frame&) = delete;
   ~Frame();
 
   const RenderOptions& opt;
-  RenderResult& res;
   Framebuffer& fb;
   RenderStats& st;
   const int W, H;

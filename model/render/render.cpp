@@ -38,7 +38,7 @@ DeviceCoding codingFor(SpecEngine* e, const Material& m) {
 // per-triangle work reused across the frame (no allocation per triangle once they have grown).
 class SceneDrawer {
  public:
-  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines);
+  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, std::vector<ScreenTriangleInfo>& triangles);
   void drawObject(size_t oi);
 
  private:
@@ -50,6 +50,7 @@ class SceneDrawer {
   Frame& f_;
   const Scene& scene_;
   const SpecEngines& engines_;
+  std::vector<ScreenTriangleInfo>& triangles_;  // the result's: where each screen triangle came from
   const CameraBasis basis_;
   MethodUnit& unit_;         // the frame's method's
   const bool vertex_colours_;  // the method's
@@ -61,10 +62,12 @@ class SceneDrawer {
   Parts parts_;                 // its screen triangles
 };
 
-SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines)
+SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines,
+                         std::vector<ScreenTriangleInfo>& triangles)
     : f_(f),
       scene_(scene),
       engines_(engines),
+      triangles_(triangles),
       basis_(cameraBasis(scene.camera)),
       unit_(f.unit(f.opt.method)),
       vertex_colours_(traits(f.opt.method).vertex_colours) {
@@ -149,8 +152,7 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
       sv[i].attr = {v.n.x, v.n.y, v.n.z, v.w};
     }
   }
-  RenderResult& res = f_.res;
-  const uint32_t tag = static_cast<uint32_t>(res.triangles.size());
+  const uint32_t tag = static_cast<uint32_t>(triangles_.size());
   const SetupResult s = setupTriangle(sv, tag, rc);
   if (!s.desc) {
     ++f_.st.culled;
@@ -160,7 +162,7 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   info.object = f_.obj.index;
   info.mesh_triangle = ti;
   for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
-  res.triangles.push_back(info);
+  triangles_.push_back(info);
   ++f_.st.drawn;
   part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
 }
@@ -196,8 +198,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   res.stats = RenderStats{};
   res.triangles.clear();
   clearFramebuffer(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);
-  Frame frame(scene, opt, span, res);
-  SceneDrawer drawer(frame, scene, engines);
+  Frame frame(scene, opt, span, res.fb, res.stats);
+  SceneDrawer drawer(frame, scene, engines, res.triangles);
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
