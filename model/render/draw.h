@@ -105,12 +105,6 @@ struct RunCursor {
   }
 };
 
-// The interpolated (unnormalised) normal of a fragment, from attributes 0..2.
-inline Vec3 rawNormal(const int64_t* attr) {
-  return Vec3{static_cast<double>(attr[0]) * kUnitLsb, static_cast<double>(attr[1]) * kUnitLsb,
-              static_cast<double>(attr[2]) * kUnitLsb};
-}
-
 // Barycentric coordinates of the centre of pixel (x, y) on the unsnapped screen triangle v
 // (biquadratic, reference).
 inline std::array<double, 3> barycentric(const std::array<const PVertex*, 3>& v, int32_t x, int32_t y) {

@@ -23,6 +23,12 @@ namespace shd {
 
 namespace {
 
+// The interpolated (unnormalised) normal of a fragment, from attributes 0..2.
+Vec3 rawNormal(const int64_t* attr) {
+  return Vec3{static_cast<double>(attr[0]) * kUnitLsb, static_cast<double>(attr[1]) * kUnitLsb,
+              static_cast<double>(attr[2]) * kUnitLsb};
+}
+
 // A fragment that passed the z-test, lit with normal n and written (or left pending).
 struct PixelLighting {
   Frame& f;

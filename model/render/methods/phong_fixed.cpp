@@ -29,6 +29,18 @@ namespace {
 
 // What the paths of one triangle share.
 struct FixedTriangle {
+  FixedTriangle(Frame& frame, FixedPointShader& sh, fixed_simd::Batch& b, PixelRequests& r, const SpanTriangle& tri)
+      : f(frame),
+        shader(sh),
+        batch(b),
+        req(r),
+        st(frame.st),
+        depth(frame.fb.depth.data()),
+        W(frame.W),
+        batched(frame.batchesRequests(Method::PhongFixed)),
+        write(frame.writer(tri.tag)),
+        target{depth, frame.fb.tri.data(), static_cast<int32_t>(tri.tag), static_cast<size_t>(W)},
+        squared_norm(tri.setup) {}
   Frame& f;
   FixedPointShader& shader;
   fixed_simd::Batch& batch;
@@ -176,19 +188,8 @@ class PhongFixedUnit final : public MethodUnit {
   }
 
   void draw(const SpanTriangle& tri) override {
-    Framebuffer& fb = f_.fb;
     req_.begin();
-    FixedTriangle t{f_,
-                    *fixed_,
-                    *batch_,
-                    req_,
-                    f_.st,
-                    fb.depth.data(),
-                    f_.W,
-                    f_.batchesRequests(Method::PhongFixed),
-                    f_.writer(tri.tag),
-                    {fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tri.tag), static_cast<size_t>(f_.W)},
-                    SquaredNorms(tri.setup)};
+    FixedTriangle t(f_, *fixed_, *batch_, req_, tri);
     // Runs where the shader takes them (directional lights; device lobes on the memo).
     if (f_.walker != nullptr && !t.batched && fixed_->takesRuns()) {
       fixed_->withRunKernel([&](auto& kernel) { walkRuns(t, tri, kernel); });
