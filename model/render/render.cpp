@@ -52,14 +52,14 @@ class SceneDrawer {
   const SpecEngines& engines_;
   std::vector<ScreenTriangleInfo>& triangles_;  // the result's: where each screen triangle came from
   const CameraBasis basis_;
-  MethodUnit& unit_;         // the frame's method's
-  const bool vertex_colours_;  // the method's
+  MethodUnit& unit_;                  // the frame's method's
+  const bool vertex_colours_;         // the method's
   RasterConfig rc_colour_, rc_unit_;  // setup of colour or normal attributes (and depth)
-  std::vector<PVertex> verts_;  // the object's
-  std::vector<uint8_t> lit_;    // verts_[i].colour is computed
-  Poly poly_;                   // a clipped triangle
-  Fan fan_;                     // the polygon to draw
-  Parts parts_;                 // its screen triangles
+  std::vector<PVertex> verts_;        // the object's
+  std::vector<uint8_t> lit_;          // verts_[i].colour is computed
+  Poly poly_;                         // a clipped triangle
+  Fan fan_;                           // the polygon to draw
+  Parts parts_;                       // its screen triangles
 };
 
 SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines,
