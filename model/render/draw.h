@@ -184,7 +184,8 @@ class Frame {
   bool batchesRequests(Method m) const;
 
   // The fragments of t, each to sink(x, y, attr), and with the model's walk the runs of rows to
-  // runs(const RowRun&) (see walkSpanUnit); the span cycles and fragments counted.
+  // runs(const RowRun&) (see walkSpanUnit): shaded as the walk produces them, or without it (the
+  // RTL's stream) collected first. The span cycles and fragments counted.
   template <class Sink, class... Runs>
   void walk(const SpanTriangle& t, Sink& sink, Runs&... runs) {
     if (walker != nullptr) {

@@ -158,20 +158,20 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   t.st.pixels_covered += newly;
 }
 
-// The walk with the shader's run kernel: into the batch in the vector kernel's case, else its
-// runs by fixedRun.
+// The walk with the vector kernel's batch.
 template <class Kernel>
-void walkRuns(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
-  if constexpr (Kernel::kGroups)
-    if (t.f.opt.vector_kernel && kernel.vectorised()) {
-      auto fragment = [&t, &kernel](int32_t x, int32_t y, const int64_t* attr) {
-        if (t.batch.n > 0) flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
-        fixedFragment(t, x, y, attr);
-      };
-      auto runs = [&t, &kernel](const RowRun& r) { batchRun(t, kernel, r); };
-      t.f.walk(tri, fragment, runs);
-      return;
-    }
+void walkBatched(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
+  auto fragment = [&t, &kernel](int32_t x, int32_t y, const int64_t* attr) {
+    if (t.batch.n > 0) flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
+    fixedFragment(t, x, y, attr);
+  };
+  auto runs = [&t, &kernel](const RowRun& r) { batchRun(t, kernel, r); };
+  t.f.walk(tri, fragment, runs);
+}
+
+// The walk with the run kernel's runs (fixedRun).
+template <class Kernel>
+[[gnu::noinline]] void walkRuns(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
   auto fragment = [&t](int32_t x, int32_t y, const int64_t* attr) { fixedFragment(t, x, y, attr); };
   auto runs = [&t, kernel](const RowRun& r) mutable { fixedRun(t, kernel, r); };
   t.f.walk(tri, fragment, runs);
@@ -192,7 +192,11 @@ class PhongFixedUnit final : public MethodUnit {
     FixedTriangle t(f_, *fixed_, *batch_, req_, tri);
     // Runs where the shader takes them (directional lights; device lobes on the memo).
     if (f_.walker != nullptr && !t.batched && fixed_->takesRuns()) {
-      fixed_->withRunKernel([&](auto& kernel) { walkRuns(t, tri, kernel); });
+      fixed_->withRunKernel([&](auto& kernel) {
+        if constexpr (std::decay_t<decltype(kernel)>::kGroups)
+          if (f_.opt.vector_kernel && kernel.vectorised()) return walkBatched(t, tri, kernel);
+        walkRuns(t, tri, kernel);
+      });
     } else {
       auto fragment = [&t](int32_t x, int32_t y, const int64_t* attr) { fixedFragment(t, x, y, attr); };
       f_.walk(tri, fragment);
