@@ -6,8 +6,11 @@
 #include <cmath>
 #include <filesystem>
 #include <random>
+#include <set>
 
 #include "render/fixed_simd.h"
+#include "render/methods.h"
+#include "render/pipeline.h"
 #include "render/render.h"
 #include "cosim/render_rtl.h"
 #include "cosim/replay.h"
@@ -232,6 +235,96 @@ TEST(Render, BadOptionsAreNamed) {
     EXPECT_NE(std::string(e.what()).find("specular unit"), std::string::npos) << e.what();
   }
   EXPECT_THROW(parseMethod("toon"), std::invalid_argument);
+}
+
+TEST(RenderMethods, OneTableNamesEveryMethodOnceInOrder) {
+  const std::vector<Method> all = allMethods();
+  std::set<std::string> names;
+  for (size_t i = 0; i < all.size(); ++i) {
+    EXPECT_EQ(static_cast<size_t>(all[i]), i);
+    EXPECT_EQ(traits(all[i]).method, all[i]);
+    EXPECT_EQ(parseMethod(toString(all[i])), all[i]);
+    EXPECT_NE(traits(all[i]).make, nullptr);
+    names.insert(toString(all[i]));
+  }
+  EXPECT_EQ(names.size(), all.size());
+  EXPECT_EQ(all.back(), Method::Reference);
+  try {
+    parseMethod("toon");
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    for (const Method m : all) EXPECT_NE(std::string(e.what()).find(toString(m)), std::string::npos) << e.what();
+  }
+}
+
+TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
+  const Camera cam;  // 512 x 512, z_near 0.1
+  const Projection proj(cam);
+  auto vertex = [&](Vec3 c) {
+    PVertex v;
+    v.cam = c;
+    if (c.z >= cam.z_near) proj.project(v);
+    return v;
+  };
+  std::vector<PVertex> verts;  // the triangle's (fan may point into them)
+  Poly poly;
+  Fan fan;
+  auto clip = [&](const std::array<PVertex, 3>& t, RenderStats& st) {
+    verts.assign(t.begin(), t.end());
+    const TriangleView tv = viewTriangle(verts, {0, 1, 2}, cam.z_near);
+    if (culledEarly(tv)) {
+      ++st.culled;
+      return false;
+    }
+    return clipToFan(tv, proj, cam.width, cam.height, poly, fan, st);
+  };
+  // A front face (negative screen area, y down) on the screen: drawn as it is.
+  RenderStats st;
+  const PVertex a = vertex({0, 0, 1}), b = vertex({0.1, 0, 1}), c = vertex({0, 0.1, 1});
+  EXPECT_TRUE(clip({a, b, c}, st));
+  EXPECT_EQ(st.clipped + st.culled, 0u);
+  // Its back: culled before anything is copied.
+  EXPECT_FALSE(clip({a, c, b}, st));
+  EXPECT_EQ(st.culled, 1u);
+  // One vertex behind the eye: a quadrilateral in front of the near plane, projected.
+  st = RenderStats{};
+  const PVertex behind = vertex({0, 0.1, -1});
+  ASSERT_TRUE(clip({a, b, behind}, st));
+  EXPECT_EQ(st.clipped, 1u);
+  ASSERT_EQ(fan.size(), 4u);
+  for (const PVertex* v : fan) {
+    EXPECT_GE(v->cam.z, cam.z_near * (1 - 1e-12));
+    EXPECT_NEAR(v->w, cam.z_near / v->cam.z, 1e-12);
+  }
+  // The same facing away once clipped: culled.
+  EXPECT_FALSE(clip({b, a, behind}, st));
+  EXPECT_EQ(st.culled, 1u);
+  // Far beyond the viewport (to the right and up, left and up, right and down): cut to the
+  // guard band on all four sides, the vertices' camera points from (x, y, w).
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  for (const auto& t : {std::array<Vec3, 2>{Vec3{100, 0, 2}, Vec3{0, 100, 2}},
+                        std::array<Vec3, 2>{Vec3{0, 100, 2}, Vec3{-100, 0, 2}},
+                        std::array<Vec3, 2>{Vec3{0, -100, 2}, Vec3{100, 0, 2}}}) {
+    st = RenderStats{};
+    ASSERT_TRUE(clip({a, vertex(t[0]), vertex(t[1])}, st));
+    EXPECT_EQ(st.clipped, 1u);
+    EXPECT_GE(fan.size(), 4u);
+    for (const PVertex* v : fan) {
+      x0 = std::min(x0, v->x);
+      x1 = std::max(x1, v->x);
+      y0 = std::min(y0, v->y);
+      y1 = std::max(y1, v->y);
+      PVertex p = *v;  // its camera point projects back to it
+      proj.project(p);
+      EXPECT_NEAR(p.x, v->x, 1e-9);
+      EXPECT_NEAR(p.y, v->y, 1e-9);
+      EXPECT_NEAR(p.w, v->w, 1e-12);
+    }
+  }
+  EXPECT_NEAR(x0, -kGuard, 1e-9);
+  EXPECT_NEAR(x1, cam.width + kGuard, 1e-9);
+  EXPECT_NEAR(y0, -kGuard, 1e-9);
+  EXPECT_NEAR(y1, cam.height + kGuard, 1e-9);
 }
 
 TEST(EdgeMaximum, MatchesDenseSamplingOfTheNormalisedCosine) {

@@ -13,54 +13,21 @@
 // Z-test: a fragment is written where its w is strictly greater (closer) than the stored one;
 // triangles are drawn in scene order, so the image does not depend on the lane mode.
 //
-// Methods:
-//   flat               one colour per triangle: the face normal at the centroid
-//   gouraud            vertex colours, the constant increment of the span unit (paper 4.1).
-//                      (The vertex colours of every Gouraud-type method are computed once per
-//                      vertex, and only for vertices of triangles that survive back-face culling.)
-//   gouraud-classical  vertex colours; per raster line the colour is interpolated along both
-//                      edges and divided by the span length (one division per line, float, as
-//                      the idx3d listings)
-//   phong              vertex normals interpolated by the span unit, normalised exactly per pixel
-//   phong-incremental  the same normals; |N|^2 along each span by the corrected recurrence (docs/paper-corrections.md, 4.1)
-//                      (F_{i+1} = F_i + 2B + C_{i+1}, C_{i+1} = C_i + 2C, C_1 = C: additions
-//                      only) and a fixed-point reciprocal square root (table + one Newton step)
-//   phong-fixed        the same normals and recurrence, and the whole per-pixel lighting as a
-//                      fixed-point datapath (render/fixed_shading.h): unit normal, L, H, V in
-//                      Q1.16, integer dot products, the diffuse and specular factors as codes,
-//                      the lobe from a table over its cosine (16 fraction bits) or the specular
-//                      unit; no floating point and no pow per pixel with directional lights
-//   normal-bisection   the listing NormalVector: along each span the unit normal is computed
-//                      exactly only at nodes found by recursive bisection (ends first, then the
-//                      middle of a segment while 1 - |(N_a + N_b)/2|, the listing's error
-//                      1 - sqrt(2 + 2 cos W)/2, exceeds bisection_threshold); between nodes the
-//                      normal is interpolated linearly and used unnormalised
-//   biquadratic        the listing GouraudRasterizer4's intent: a quadratic colour surface
-//                      I(x, y) through six exactly shaded points, the vertices and the edge
-//                      midpoints. The listing solves a 6x6 system by Cramer's rule (singular
-//                      when sample points coincide, and its right-hand side averaged the vertex
-//                      colours, which makes the surface linear); its exact solution is the
-//                      quadratic Lagrange basis on barycentric coordinates,
-//                      I = sum c_i l_i (2 l_i - 1) + sum 4 c_ij l_i l_j, evaluated here
-//                      directly: no solve, no conditioning problem. Per pixel (not a span-unit
-//                      increment: a quadratic has no constant step); coverage from the span unit.
-//   modified-gouraud   paper 4.4 as corrected (docs/paper-corrections.md, 4.4): on each edge the point where N(t).H peaks,
-//                      t1 = (cos chi cos psi - cos alpha) / ((cos psi - 1)(cos alpha + cos chi)),
-//                      a maximum only when cos alpha + cos chi > 0 and t1 in (0, 1) (equal or
-//                      opposite normals: no interior maximum). Where the exactly shaded colour
-//                      there exceeds the Gouraud colour by more than modified_threshold_lsb, the
-//                      point becomes a vertex: 1, 2 or 3 such points split the triangle into 2,
-//                      3 or 4 parts (Fig. 13), each drawn by Gouraud.
-//   adaptive           per triangle Gouraud or Phong by the listing's test of the vertex
-//                      normals (AdaptivGourauAndPhong.selectMetod, with its thresholds as
-//                      defaults): Gouraud where all pairs have N_i.N_j >= adaptive_m,
-//                      |N_i.H - N_j.H| <= adaptive_q and |N_i.L - N_j.L| <= adaptive_p, else
-//                      Phong. The listing returns Phong when |N_i.N_j| > 0.9, i.e. for nearly
-//                      equal normals, the opposite of its evident intent; shadesim follows the
-//                      intent.
-//   reference          per pixel in double precision: the exact barycentric normal of the pixel
-//                      centre, exact normalisation, exact pow (device lobes: the Blinn lobe they
-//                      approximate)
+// The code: render/render.cpp drives a frame (object by object, triangle by triangle);
+// render/pipeline.h holds the geometry every method shares (transform, culling, clipping);
+// render/methods.h the table of the methods (name, traits, the unit that draws each);
+// render/draw.h what the units share; render/methods/*.cpp one unit per method family, each
+// described there:
+//   flat, gouraud       methods/colour_runs.cpp
+//   gouraud-classical   methods/gouraud_classical.cpp
+//   phong, phong-incremental, normal-bisection   methods/phong.cpp
+//   phong-fixed         methods/phong_fixed.cpp (the datapath: render/fixed_shading.h)
+//   biquadratic         methods/biquadratic.cpp
+//   modified-gouraud    methods/modified_gouraud.cpp (splits, then gouraud)
+//   adaptive            methods/adaptive.cpp (gouraud or phong per triangle)
+//   reference           methods/reference.cpp
+// (The vertex colours of every Gouraud-type method are computed once per vertex, and only for
+// vertices of triangles that survive back-face culling.)
 #pragma once
 
 #include <array>

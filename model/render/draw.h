@@ -1,0 +1,235 @@
+// What the shading methods' units (render/methods/) draw with: the frame and the current
+// object's lighting (Frame), a screen triangle set up for the span unit (SpanTriangle), the
+// unit interface (MethodUnit), and the pieces of the hot paths that every unit shares: writing
+// a pixel (PixelWriter), stepping along a run (RunCursor), walking a triangle's fragments
+// (Frame::walk) and a triangle's per-pixel specular-unit requests (PixelRequests).
+//
+// The fragment paths stay static: a unit hands walkSpanUnit its fragment sink and run
+// consumers as closures or function objects (templates), so the dispatch is one virtual call
+// per screen triangle (MethodUnit::draw), none per fragment.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "raster/setup.h"
+#include "raster/span_walk.h"
+#include "render/normalize.h"
+#include "render/pipeline.h"
+#include "render/render.h"
+#include "render/shading.h"
+
+namespace shd {
+
+// A screen triangle set up for the span unit, with the method that draws it.
+struct SpanTriangle {
+  std::array<const PVertex*, 3> v;  // as set up (the fan's, or a split's)
+  Method method;
+  const SetupResult& setup;  // setup.desc: its span descriptor; setup.plane: its attribute planes
+  const RasterConfig& raster;
+  uint32_t tag;  // its id: the index in RenderResult::triangles, the framebuffer's tri
+};
+
+class MethodUnit;
+
+// A screen triangle of a polygon before setup, with the unit and the method that draw it.
+struct Part {
+  std::array<const PVertex*, 3> v;
+  MethodUnit* unit;
+  Method method;
+  const std::array<double, 3>* colour = nullptr;  // colour attributes: every vertex's (flat), or null: its own
+};
+using Parts = std::vector<Part>;
+
+// One shading method's drawing (render/methods/*.cpp, chosen by Method in the table of
+// render/methods.cpp). Per frame one unit per method in use; per object beginObject, then per
+// polygon parts(), then per screen triangle that setup keeps draw(), then endObject.
+class MethodUnit {
+ public:
+  explicit MethodUnit(Method m) : method_(m) {}
+  virtual ~MethodUnit() = default;
+  // The current object's lighting is set (Frame::obj).
+  virtual void beginObject() {}
+  // The screen triangles to draw of a polygon (a clipped triangle's fan; 3 vertices unless
+  // clipped), in order: by default each fan triangle, by this unit.
+  virtual void parts(const Fan& fan, Parts& out) {
+    for (size_t k = 1; k + 1 < fan.size(); ++k) out.push_back({{fan[0], fan[k], fan[k + 1]}, this, method_});
+  }
+  // The fragments of a screen triangle: walked, z-tested, shaded and written.
+  virtual void draw(const SpanTriangle& t) = 0;
+  // After the object's last triangle.
+  virtual void endObject() {}
+  Method method() const { return method_; }
+
+ private:
+  Method method_;
+};
+
+// A fragment's write once its z-test has passed: the colour, the depth code and the triangle's
+// tag. A written fragment has w > 0 (the z-test), so depth 0 marks a pixel not yet covered:
+// returns 1 for a pixel not covered before (for pixels_covered). The pointers are held by
+// value: a run's loop writes through a local copy (const auto put = write), whose pointers then
+// stay in registers, where an object's members would be read again after each byte store.
+struct PixelWriter {
+  uint8_t* rgb;
+  int32_t* depth;
+  int32_t* tri_of;
+  int32_t tag;
+  uint64_t operator()(size_t p, int64_t w, const std::array<uint8_t, 3>& c) const {
+    for (size_t k = 0; k < 3; ++k) rgb[p * 3 + k] = c[k];
+    const uint64_t fresh = depth[p] == 0 ? 1 : 0;
+    depth[p] = static_cast<int32_t>(w);
+    tri_of[p] = tag;
+    return fresh;
+  }
+};
+
+// A run's pixels in the framebuffer: the index and the depth code of the current one, and
+// their steps along the run.
+struct RunCursor {
+  size_t p, step;
+  uint64_t z, dz;
+  RunCursor(const RowRun& r, int width)
+      : p(static_cast<size_t>(r.y) * static_cast<size_t>(width) + static_cast<size_t>(r.x0)),
+        step(static_cast<size_t>(static_cast<ptrdiff_t>(r.dx))),  // +1 or -1 (mod 2^64)
+        z(static_cast<uint64_t>(r.a0[3])),
+        dz(static_cast<uint64_t>(r.da[3])) {}
+  int64_t depth() const { return static_cast<int64_t>(z); }
+  void next() {
+    p += step;
+    z += dz;
+  }
+};
+
+// Barycentric coordinates of the centre of pixel (x, y) on the unsnapped screen triangle v
+// (biquadratic, reference).
+inline std::array<double, 3> barycentric(const std::array<const PVertex*, 3>& v, int32_t x, int32_t y) {
+  const double px = x + 0.5, py = y + 0.5;
+  const double d = area2(*v[0], *v[1], *v[2]);
+  const double l1 = ((px - v[0]->x) * (v[2]->y - v[0]->y) - (v[2]->x - v[0]->x) * (py - v[0]->y)) / d;
+  const double l2 = ((v[1]->x - v[0]->x) * (py - v[0]->y) - (px - v[0]->x) * (v[1]->y - v[0]->y)) / d;
+  return std::array<double, 3>{1 - l1 - l2, l1, l2};
+}
+
+// phong-incremental, phong-fixed: |N|^2 of the fragments of a triangle, along each run of
+// consecutive pixels of a row by the recurrence (normalize.h), restarted (three products) where
+// the stream is not the next pixel. The recurrence is exact, so the values do not depend on
+// where it restarts.
+class SquaredNorms {
+ public:
+  explicit SquaredNorms(const SetupResult& s) : dn_{s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]} {}
+  uint64_t operator()(int32_t x, int32_t y, const int64_t* attr) {
+    const uint64_t f = y == run_y_ && x == run_next_x_ ? sqn_.next() : sqn_.start({attr[0], attr[1], attr[2]}, dn_);
+    run_y_ = y;
+    run_next_x_ = x + 1;
+    return f;
+  }
+
+ private:
+  SquaredNormRecurrence sqn_;
+  int32_t run_y_ = -1, run_next_x_ = 0;
+  std::array<int64_t, 3> dn_;
+};
+
+// The current object's lighting.
+struct ObjectShading {
+  int index = 0;
+  const Material* material = nullptr;
+  Lobe lobe = Lobe::Blinn;
+  SpecEngine* spec = nullptr;              // the lobe's specular unit, or null
+  const SpecUnitModel* direct = nullptr;   // spec's bit-exact model: per-pixel requests evaluated as made
+  DeviceCoding coding;                     // the material's requests to spec
+  std::optional<PointShader> shader;       // the material and lobe
+};
+
+// The frame being drawn: its buffers and statistics, the span engine, the camera, the lights,
+// the current object's lighting, and the units of the methods in use.
+class Frame {
+ public:
+  Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Framebuffer& fb, RenderStats& st);
+  Frame(const Frame&) = delete;
+  Frame& operator=(const Frame&) = delete;
+  ~Frame();
+
+  const RenderOptions& opt;
+  Framebuffer& fb;
+  RenderStats& st;
+  const int W, H;
+  const Projection proj;
+  const ShadeContext ctx;
+  SpanEngine& span;
+  const SpanParams* const walker;  // span.walker(): fragments shaded as the model's walk produces them
+  // Runs of a row to the vector kernels (fixed_simd.h): left to right, with depth codes that
+  // fit int32_t (AttrBits <= 32).
+  const bool vector_runs;
+  ObjectShading obj;
+
+  // The unit drawing method m, made on first use (render/methods.cpp); the units in use.
+  MethodUnit& unit(Method m);
+  const std::vector<std::pair<Method, std::unique_ptr<MethodUnit>>>& units() const { return units_; }
+
+  // A point's shade, with its device-lobe evaluations done by the specular unit right away
+  // (vertices, polygons, split points: few; pixels are batched per triangle, PixelRequests).
+  std::array<double, 3> shadeNow(Vec3 n, Vec3 p);
+  // Fragment writes of a triangle.
+  PixelWriter writer(uint32_t tag) const {
+    return PixelWriter{fb.rgb.data(), fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tag)};
+  }
+  // Whether a triangle's per-pixel device requests of method m wait for the triangle's batch
+  // (the specular unit is not the model: the RTL's stream).
+  bool batchesRequests(Method m) const;
+
+  // The fragments of t, each to sink(x, y, attr), and with the model's walk the runs of rows to
+  // runs(const RowRun&) (see walkSpanUnit): shaded as the walk produces them, or without it (the
+  // RTL's stream) collected first. The span cycles and fragments counted.
+  template <class Sink, class... Runs>
+  void walk(const SpanTriangle& t, Sink& sink, Runs&... runs) {
+    if (walker != nullptr) {
+      const SpanWalk wk = walkSpanUnit(*walker, *t.setup.desc, sink, runs...);
+      st.span_cycles += wk.cycles;
+      st.fragments += wk.fragments;
+      return;
+    }
+    collect(t);
+    for (const SpanFragment& fr : frags) sink(fr.x, fr.y, fr.attr.data());
+  }
+  // The fragments of t from the span engine, in its order, into frags (counted).
+  void collect(const SpanTriangle& t);
+  std::vector<SpanFragment> frags;
+  // The specular unit's results of its last batch.
+  std::vector<std::array<uint32_t, 3>> device_out;
+
+ private:
+  std::vector<SpecRequest> point_requests_;
+  std::vector<std::pair<Method, std::unique_ptr<MethodUnit>>> units_;
+};
+
+// A screen triangle's per-pixel device-lobe requests: on the unit's model evaluated as each
+// pixel makes them (or answered by its memo, memo_requests) and the unit's cycles counted per
+// triangle; otherwise (batched) every pixel waits, as pending, for the triangle's batch.
+class PixelRequests {
+ public:
+  struct Pending {  // a fragment waiting for its specular-unit results
+    size_t pixel;
+    int64_t w;
+    std::array<double, 3> lsb;
+    size_t dev_first, dev_count;
+  };
+  void begin() {
+    pending.clear();
+    requests.clear();
+    memo_requests = 0;
+  }
+  // The batch's cycles and evaluations counted, and the pending fragments written.
+  void finish(Frame& f, const PixelWriter& write);
+
+  std::vector<SpecRequest> requests;
+  std::vector<Pending> pending;
+  size_t memo_requests = 0;  // phong-fixed on the unit's model: requests its memo answered
+};
+
+}  // namespace shd

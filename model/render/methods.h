@@ -1,0 +1,43 @@
+// The shading methods' table: one row per Method (render/methods.cpp) with its name, the traits
+// the shared pipeline asks about, and the unit that draws it (render/methods/*.cpp, where each
+// method is described). parseMethod, toString(Method) and allMethods read the same table.
+//
+// A new method: its Method value (render.h), its unit (a MethodUnit in render/methods/, listed
+// in model/CMakeLists.txt) and its row.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include "render/render.h"
+
+namespace shd {
+
+class Frame;
+class MethodUnit;
+
+// What the span unit interpolates in attributes 0..2 (render.h): the colour (LSBs, 12 fraction
+// bits) or the normal (camera space, 28 fraction bits).
+enum class Attributes { Colour, Normal };
+
+struct MethodTraits {
+  Method method;
+  const char* name;
+  Attributes attributes;
+  // Shades the Gouraud vertex colours (each vertex once, and only vertices of triangles that
+  // survive back-face culling).
+  bool vertex_colours;
+  // Evaluates the lobe per pixel: device lobes make specular-unit requests per pixel, batched
+  // per triangle when the unit is not the model (Frame::batchesRequests).
+  bool pixel_lobe;
+  // Exact: the lobes themselves (a device lobe's Blinn lobe, no specular unit) and the
+  // framebuffer's lsb and spec_lsb.
+  bool exact;
+  std::unique_ptr<MethodUnit> (*make)(Frame&);
+};
+
+// The table, one row per Method in its order (render/methods.cpp).
+extern const MethodTraits kMethodTable[];
+inline const MethodTraits& traits(Method m) { return kMethodTable[static_cast<size_t>(m)]; }
+
+}  // namespace shd

@@ -1,0 +1,137 @@
+// flat      one colour per polygon: the face normal at the centroid, shaded once
+// gouraud   vertex colours, the constant increment of the span unit (paper 4.1)
+//
+// Both interpolate colour codes (flat's constant) and write them as they are: per fragment the
+// z-test and the codes straight to unorm8 (what combine() gives them); per run of a row the
+// same in a loop of its own, or in AVX-512 (fixed_simd::colourRun).
+#include <algorithm>
+#include <type_traits>
+
+#include "render/draw.h"
+#include "render/fixed_simd.h"
+
+namespace shd {
+
+namespace {
+
+// Flat and Gouraud: z-test, then the interpolated colour codes straight to unorm8 (what
+// combine() gives them).
+struct ColourFragment {
+  PixelWriter write;
+  int32_t* depth;
+  int W;
+  uint64_t& covered;
+  void operator()(int32_t x, int32_t y, const int64_t* attr) const {
+    const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+    __builtin_prefetch(depth + p + W);  // the row below: most likely this triangle's next
+    if (attr[3] <= depth[p]) return;
+    covered += write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
+                                  unorm8FromCode(attr[2], kColourFrac)});
+  }
+};
+
+// The same for a whole run of a row (walkSpanUnit's run consumer): the loop in registers, the
+// newly covered pixels counted once per run. When the colour codes at both ends of the run lie
+// in [0, 255 2^12] so do all between (they are affine), and unorm8FromCode is the rounding
+// shift alone.
+struct ColourRunLoop {
+  PixelWriter write;
+  int32_t* depth;
+  int W;
+  uint64_t& covered;
+  bool vector_runs;
+  const fixed_simd::Target& target;
+  uint8_t* rgb;
+
+  void operator()(const RowRun& r) const {
+    if (vector_runs && r.dx == 1) {
+      vectorRun(r);
+      return;
+    }
+    const auto put = write;
+    const int64_t count = r.count;  // a local: r may alias the pixels' byte stores
+    std::array<uint64_t, 3> a, da;
+    bool in_range = true;
+    for (size_t k = 0; k < 3; ++k) {
+      a[k] = static_cast<uint64_t>(r.a0[k]);
+      da[k] = static_cast<uint64_t>(r.da[k]);
+      const int64_t end = static_cast<int64_t>(a[k] + da[k] * static_cast<uint64_t>(count - 1));
+      in_range = in_range && std::min(r.a0[k], end) >= 0 && std::max(r.a0[k], end) <= (255 << kColourFrac);
+    }
+    uint64_t newly = 0;
+    auto loop = [&](auto clamp) {
+      auto unorm8 = [](uint64_t c) {
+        if constexpr (decltype(clamp)::value) return unorm8FromCode(static_cast<int64_t>(c), kColourFrac);
+        else return static_cast<uint8_t>((c + (1u << (kColourFrac - 1))) >> kColourFrac);
+      };
+      RunCursor c(r, W);
+      for (int64_t i = 0; i < count; ++i, c.next()) {
+        __builtin_prefetch(depth + c.p + W);  // as ColourFragment
+        if (c.depth() > depth[c.p]) newly += put(c.p, c.depth(), {unorm8(a[0]), unorm8(a[1]), unorm8(a[2])});
+        for (size_t k = 0; k < 3; ++k) a[k] += da[k];
+      }
+    };
+    if (in_range) loop(std::false_type{});
+    else loop(std::true_type{});
+    covered += newly;
+  }
+
+  // A left-to-right run in AVX-512 (fixed_simd::colourRun).
+  void vectorRun(const RowRun& r) const {
+    fixed_simd::ColourRun run;
+    run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0),
+              static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])};
+    for (size_t k = 0; k < 3; ++k) {
+      run.c[k] = static_cast<int32_t>(r.a0[k]);
+      run.dc[k] = static_cast<int32_t>(r.da[k]);
+    }
+    run.frac = kColourFrac;
+    covered += fixed_simd::colourRun(run, target, rgb);
+  }
+};
+
+// The colour units' drawing: the walk with the fragment sink and the run loop.
+void drawColourRuns(Frame& f, const SpanTriangle& t) {
+  Framebuffer& fb = f.fb;
+  const int W = f.W;
+  const PixelWriter write = f.writer(t.tag);
+  const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
+  ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered};
+  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.vector_runs, target, fb.rgb.data()};
+  f.walk(t, fragment, run);
+}
+
+class GouraudUnit final : public MethodUnit {
+ public:
+  explicit GouraudUnit(Frame& f) : MethodUnit(Method::Gouraud), f_(f) {}
+  void draw(const SpanTriangle& t) override { drawColourRuns(f_, t); }
+
+ private:
+  Frame& f_;
+};
+
+class FlatUnit final : public MethodUnit {
+ public:
+  explicit FlatUnit(Frame& f) : MethodUnit(Method::Flat), f_(f) {}
+  // The polygon's colour: its face normal (toward the viewer) at the centroid of its first
+  // three vertices, the colour attributes of all its triangles.
+  void parts(const Fan& fan, Parts& out) override {
+    Vec3 fn = normalize(cross(fan[1]->cam - fan[0]->cam, fan[2]->cam - fan[0]->cam));
+    if (dot(fn, f_.ctx.view) < 0) fn = -fn;  // toward the viewer
+    const Vec3 centroid = (1.0 / 3) * (fan[0]->cam + fan[1]->cam + fan[2]->cam);
+    colour_ = f_.shadeNow(fn, centroid);
+    for (size_t k = 1; k + 1 < fan.size(); ++k) out.push_back({{fan[0], fan[k], fan[k + 1]}, this, method(), &colour_});
+  }
+  void draw(const SpanTriangle& t) override { drawColourRuns(f_, t); }
+
+ private:
+  Frame& f_;
+  std::array<double, 3> colour_{};
+};
+
+}  // namespace
+
+std::unique_ptr<MethodUnit> makeFlatUnit(Frame& f) { return std::make_unique<FlatUnit>(f); }
+std::unique_ptr<MethodUnit> makeGouraudUnit(Frame& f) { return std::make_unique<GouraudUnit>(f); }
+
+}  // namespace shd

@@ -1,0 +1,95 @@
+#include "render/pipeline.h"
+
+#include <algorithm>
+#include <cstring>
+
+namespace shd {
+
+namespace {
+
+// Sutherland-Hodgman against one half-plane dist(v) >= 0.
+template <class Dist>
+Poly clipPolygon(const Poly& in, Dist dist) {
+  Poly out;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const PVertex& a = in[i];
+    const PVertex& b = in[(i + 1) % in.size()];
+    const double da = dist(a), db = dist(b);
+    if (da >= 0) out.push_back(a);
+    if ((da >= 0) != (db >= 0)) out.push_back(lerp(a, b, da / (da - db)));
+  }
+  return out;
+}
+
+}  // namespace
+
+void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) {
+  fb.width = W;
+  fb.height = H;
+  // Depth last: every fragment reads it, so it is the buffer to find in the cache.
+  fb.rgb.assign(static_cast<size_t>(W) * H * 3, 0);
+  fb.tri.resize(static_cast<size_t>(W) * H);  // all -1: every byte 0xFF (memset, where assign fills a loop)
+  std::memset(fb.tri.data(), 0xFF, fb.tri.size() * sizeof(int32_t));
+  fb.depth.assign(static_cast<size_t>(W) * H, 0);
+  if (exact) {
+    fb.lsb.assign(static_cast<size_t>(W) * H * 3, 0.0);
+    fb.spec_lsb.assign(static_cast<size_t>(W) * H * 3, 0.0);
+  } else {
+    fb.lsb.clear();
+    fb.spec_lsb.clear();
+  }
+}
+
+void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+                       std::vector<PVertex>& verts) {
+  verts.assign(obj.mesh.positions.size(), PVertex{});
+  const NormalTransform to_world(obj.transform);
+  for (size_t i = 0; i < verts.size(); ++i) {
+    PVertex& v = verts[i];
+    v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
+    v.n = normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
+    if (v.cam.z >= cam.z_near) proj.project(v);
+  }
+}
+
+bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly& poly, Fan& fan, RenderStats& st) {
+  auto inGuard = [&](const PVertex& v) {
+    return v.x >= -kGuard && v.x <= W + kGuard && v.y >= -kGuard && v.y <= H + kGuard;
+  };
+  fan.clear();
+  if (t.all_in && inGuard(*t.v0) && inGuard(*t.v1) && inGuard(*t.v2)) {
+    fan = {t.v0, t.v1, t.v2};  // the common case: drawn from the vertex array, nothing copied
+    return true;
+  }
+  poly = {*t.v0, *t.v1, *t.v2};
+  if (!t.all_in) {  // near plane, camera space
+    poly = clipPolygon(poly, [&](const PVertex& v) { return v.cam.z - proj.z_near; });
+    if (poly.size() < 3) {
+      ++st.culled;
+      return false;
+    }
+    ++st.clipped;
+    for (PVertex& v : poly) proj.project(v);
+    if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
+      ++st.culled;
+      return false;
+    }
+  }
+  // Guard band, screen space.
+  if (!std::all_of(poly.begin(), poly.end(), inGuard)) {
+    poly = clipPolygon(poly, [&](const PVertex& v) { return v.x + kGuard; });
+    poly = clipPolygon(poly, [&](const PVertex& v) { return W + kGuard - v.x; });
+    poly = clipPolygon(poly, [&](const PVertex& v) { return v.y + kGuard; });
+    poly = clipPolygon(poly, [&](const PVertex& v) { return H + kGuard - v.y; });
+    if (poly.size() < 3) {
+      ++st.culled;
+      return false;
+    }
+    for (PVertex& v : poly) v.cam = proj.vertexCam(v);
+    ++st.clipped;
+  }
+  for (const PVertex& v : poly) fan.push_back(&v);
+  return true;
+}
+
+}  // namespace shd

@@ -1,0 +1,100 @@
+// The renderer's cold half, shared by every shading method: the frame's buffers, an object's
+// vertices in camera space and on the screen, and a mesh triangle's way to the polygon that is
+// drawn (back-face culling, the near-plane clip, projection, the guard-band clip). The shading
+// methods (render/methods.h) take over from the polygon: render/render.cpp sets up its screen
+// triangles and hands each to the method's unit.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "render/render.h"
+
+namespace shd {
+
+constexpr int kColourFrac = 12;  // colour attributes in LSBs: 0..255 with 12 fraction bits
+constexpr int kUnitFrac = 28;    // normals and depth in [-1, 1]
+constexpr double kUnitLsb = 1.0 / (1 << kUnitFrac);  // 2^-28: code * kUnitLsb == ldexp(code, -28) exactly
+constexpr double kGuard = 2048;  // guard band (px beyond the viewport) before 2D clipping
+
+// A vertex on its way through the pipeline. cam and n are camera space; colour is the Gouraud
+// vertex colour in LSBs (device lobes included).
+struct PVertex {
+  Vec3 cam{0, 0, 0}, n{0, 0, 1};
+  double x = 0, y = 0, w = 0;
+  std::array<double, 3> colour{};
+};
+
+inline PVertex lerp(const PVertex& a, const PVertex& b, double t) {
+  PVertex r;
+  r.cam = a.cam + t * (b.cam - a.cam);
+  r.n = a.n + t * (b.n - a.n);
+  r.x = a.x + t * (b.x - a.x);
+  r.y = a.y + t * (b.y - a.y);
+  r.w = a.w + t * (b.w - a.w);
+  for (size_t k = 0; k < 3; ++k) r.colour[k] = a.colour[k] + t * (b.colour[k] - a.colour[k]);
+  return r;
+}
+
+// Twice the signed screen area; the idx3d front face has a negative one (y down), see sphere.h.
+inline double area2(const PVertex& a, const PVertex& b, const PVertex& c) {
+  return (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+}
+
+// A polygon of the clipper: a triangle cut by the near plane and the four guard-band planes
+// has at most 3 + 5 vertices.
+using Poly = InlineVec<PVertex, 8>;
+// The polygon to draw as a fan of screen triangles (fan[0], fan[k], fan[k + 1]): the mesh
+// triangle's 3 vertices in the object's vertex array, or the clipped polygon's.
+using Fan = InlineVec<const PVertex*, Poly::capacity()>;
+
+// The camera's projection: camera space -> screen (pixels, y down) and w = z_near / Z.
+struct Projection {
+  double cx = 0, cy = 0, f = 1, z_near = 1;
+  explicit Projection(const Camera& cam)
+      : cx(0.5 * cam.width), cy(0.5 * cam.height), f(cam.px_per_unit), z_near(cam.z_near) {}
+  // For Z >= z_near.
+  void project(PVertex& v) const {
+    v.x = cx + f * v.cam.x / v.cam.z;
+    v.y = cy - f * v.cam.y / v.cam.z;
+    v.w = z_near / v.cam.z;
+  }
+  // Pixel centre -> camera space point of the surface, from w = z_near / Z.
+  Vec3 pixelCam(double px, double py, double w) const {
+    const double Z = z_near / w;
+    return Vec3{(px + 0.5 - cx) * Z / f, -(py + 0.5 - cy) * Z / f, Z};
+  }
+  // The same at a vertex's screen position (the pixel whose centre it is).
+  Vec3 vertexCam(const PVertex& v) const { return pixelCam(v.x - 0.5, v.y - 0.5, v.w); }
+};
+
+// The buffers of a W x H frame, cleared; lsb and spec_lsb only for an exact method.
+void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact);
+
+// Object -> camera space and the projection of the vertices in front of the near plane (their
+// colours are left to the method, render.cpp).
+void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+                       std::vector<PVertex>& verts);
+
+// Where a mesh triangle goes before it is clipped.
+struct TriangleView {
+  const PVertex *v0, *v1, *v2;
+  bool all_in;  // all three vertices in front of the near plane (so projected)
+};
+inline TriangleView viewTriangle(const std::vector<PVertex>& verts, const std::array<uint32_t, 3>& tri, double z_near) {
+  const PVertex &v0 = verts[tri[0]], &v1 = verts[tri[1]], &v2 = verts[tri[2]];
+  return {&v0, &v1, &v2, v0.cam.z >= z_near && v1.cam.z >= z_near && v2.cam.z >= z_near};
+}
+// Back faces: a triangle wholly in front of the near plane is culled before anything is copied.
+inline bool culledEarly(const TriangleView& t) { return t.all_in && !(area2(*t.v0, *t.v1, *t.v2) < 0); }
+
+// The visible part of a triangle that is not culledEarly as a fan: its own three vertices (the
+// common case, nothing copied), or the polygon clipped by the near plane (camera space) and the
+// guard band (screen space: attributes interpolate linearly there, as in the span unit), held
+// in poly. False when nothing is left or the clipped triangle faces away (st.culled); st.clipped
+// counts each clip.
+bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly& poly, Fan& fan, RenderStats& st);
+
+}  // namespace shd
