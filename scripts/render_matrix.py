@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Renders a fixed matrix of scenes x methods x lane modes x lobes with one shadesim binary, or
+"""Renders a matrix of scenes x methods x lane modes x lobes with one shadesim binary, or
 compares two such runs byte for byte: the check that a change of the renderer keeps its images.
 
   scripts/render_matrix.py render --shadesim build/sim/shadesim -o /tmp/before [--jobs 2]
@@ -13,6 +13,7 @@ import argparse
 import concurrent.futures
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -22,23 +23,31 @@ TEAPOTS = "/usr/share/assimp/models/Collada/teapots.DAE"  # Debian assimp-testmo
 # checkouts are equal.
 SCENES = ["builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials", "vectors/scenes/still_life.json",
           TEAPOTS]
-METHODS = ["flat", "gouraud", "gouraud-classical", "phong", "phong-incremental", "phong-fixed",
-           "normal-bisection", "biquadratic", "modified-gouraud", "adaptive", "reference"]
+# Every method and lobe the binary knows (its render --help); a subset of the lane modes.
 MODES = ["serial", "evenodd", "seg4", "sierpinski"]
-LOBES = ["phong", "blinn", "normalized-blinn", "schlick", "quadratic", "cubic", "cook-torrance", "pow"]
 LOBE_METHODS = ["gouraud", "phong", "phong-incremental", "phong-fixed"]
 TIMING = {"ms", "frames"}
 
 
-def jobs():
+def choices(shadesim, option):
+    """The values render --help lists for an option ("--method TEXT:{flat,gouraud,...}")."""
+    text = subprocess.run([shadesim, "render", "--help"], capture_output=True, text=True, check=True).stdout
+    m = re.search(re.escape(option) + r" TEXT:\{([^}]*)\}", text)
+    if m is None:
+        sys.exit(f"render_matrix: {shadesim} render --help lists no choices for {option}")
+    return m.group(1).split(",")
+
+
+def jobs(shadesim):
     """(name, extra arguments) of every render of the matrix."""
+    methods, lobes = choices(shadesim, "--method"), choices(shadesim, "--brdf")
     out = []
     for si, scene in enumerate(SCENES):
-        for m in METHODS:
+        for m in methods:
             for mode in MODES:
                 out.append((f"s{si}_{m}_{mode}", ["--scene", scene, "--method", m, "--mode", mode]))
         for m in LOBE_METHODS:
-            for lobe in LOBES:
+            for lobe in lobes:
                 out.append((f"s{si}_{m}_serial_{lobe}",
                             ["--scene", scene, "--method", m, "--mode", "serial", "--brdf", lobe]))
     return out
@@ -57,7 +66,7 @@ def render(a):
     a.out = os.path.abspath(a.out)
     a.shadesim = os.path.abspath(a.shadesim)
     os.makedirs(a.out, exist_ok=True)
-    todo = jobs()
+    todo = jobs(a.shadesim)
     failed = 0
     with concurrent.futures.ThreadPoolExecutor(max_workers=a.jobs) as ex:
         futs = [ex.submit(render_one, a.shadesim, a.out, n, args) for n, args in todo]

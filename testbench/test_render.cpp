@@ -52,15 +52,17 @@ double maxError(const Framebuffer& a, const Framebuffer& ref) {
 
 }  // namespace
 
+// Every method of the table (a new one included): the lane mode changes the span unit's cycles,
+// never the image or the fragments.
 TEST(Render, ImageDoesNotDependOnTheLaneMode) {
   const Scene s = loadScene("builtin:sphere");
-  for (Method m : {Method::Gouraud, Method::Phong, Method::PhongFixed}) {
+  for (Method m : allMethods()) {
     const RenderResult serial = renderModel(s, m, "quadratic", "serial");
     for (const std::string& mode : spanModes()) {
       const RenderResult r = renderModel(s, m, "quadratic", mode);
       EXPECT_EQ(r.fb.rgb, serial.fb.rgb) << toString(m) << " " << mode;
       EXPECT_EQ(r.stats.fragments, serial.stats.fragments);
-      if (mode != "serial") {
+      if (mode != "serial" && m != Method::Reference) {  // the reference walks no span unit
         EXPECT_LT(r.stats.span_cycles, serial.stats.span_cycles) << mode;
       }
     }
