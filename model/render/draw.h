@@ -197,6 +197,19 @@ class Frame {
     collect(t);
     for (const SpanFragment& fr : frags) sink(fr.x, fr.y, fr.attr.data());
   }
+  // The fragments of t walked, z-tested and written with the colour colourAt(x, y) (LSBs, no
+  // device lobe) gives each that passes: the per-pixel colour methods (gouraud-classical,
+  // biquadratic).
+  template <class ColourAt>
+  void drawColours(const SpanTriangle& t, ColourAt&& colourAt) {
+    const PixelWriter write = writer(t.tag);
+    auto fragment = [&](int32_t x, int32_t y, const int64_t* attr) {
+      const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
+      if (attr[3] <= fb.depth[p]) return;
+      st.pixels_covered += write(p, attr[3], combine(colourAt(x, y), nullptr, 0));
+    };
+    walk(t, fragment);
+  }
   // The fragments of t from the span engine, in its order, into frags (counted).
   void collect(const SpanTriangle& t);
   std::vector<SpanFragment> frags;

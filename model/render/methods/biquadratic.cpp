@@ -25,14 +25,8 @@ class BiquadraticUnit final : public MethodUnit {
       const PVertex mv = lerp(*t.v[e], *t.v[(e + 1) % 3], 0.5);
       mid[e] = f_.shadeNow(normalize(mv.n), f_.proj.vertexCam(mv));
     }
-    Framebuffer& fb = f_.fb;
-    const int W = f_.W;
-    const PixelWriter write = f_.writer(t.tag);
-    auto fragment = [&](int32_t x, int32_t y, const int64_t* attr) {
-      const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x);
-      const int64_t wcode = attr[3];
-      if (wcode <= fb.depth[p]) return;
-      // The quadratic Lagrange basis: vertices c_i, edge midpoints c_ij.
+    // The quadratic Lagrange basis: vertices c_i, edge midpoints c_ij.
+    f_.drawColours(t, [&](int32_t x, int32_t y) {
       const std::array<double, 3> l = barycentric(t.v, x, y);
       std::array<double, 3> lsb{};
       for (size_t k = 0; k < 3; ++k) {
@@ -41,9 +35,8 @@ class BiquadraticUnit final : public MethodUnit {
         for (size_t e = 0; e < 3; ++e) v += 4 * mid[e][k] * l[e] * l[(e + 1) % 3];
         lsb[k] = v;
       }
-      f_.st.pixels_covered += write(p, wcode, combine(lsb, nullptr, 0));
-    };
-    f_.walk(t, fragment);
+      return lsb;
+    });
   }
 
  private:

@@ -66,17 +66,7 @@ std::array<double, 3> GouraudClassicalUnit::colourAt(const SpanTriangle& t, int3
 }
 
 void GouraudClassicalUnit::draw(const SpanTriangle& t) {
-  Framebuffer& fb = f_.fb;
-  RenderStats& st = f_.st;
-  const int W = f_.W;
-  const PixelWriter write = f_.writer(t.tag);
-  auto fragment = [&](int32_t x, int32_t y, const int64_t* attr) {
-    const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x);
-    const int64_t wcode = attr[3];
-    if (wcode <= fb.depth[p]) return;
-    st.pixels_covered += write(p, wcode, combine(colourAt(t, x, y), nullptr, 0));
-  };
-  f_.walk(t, fragment);
+  f_.drawColours(t, [&](int32_t x, int32_t y) { return colourAt(t, x, y); });
   for (int32_t row : divided_rows_) row_divided_[static_cast<size_t>(row)] = 0;
   divided_rows_.clear();
 }
