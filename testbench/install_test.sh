@@ -6,7 +6,7 @@
 # installed RTL. The checks:
 #   - shadesim configs, prom, spec-error, vectors and render (with the RTL in the loop), and a
 #     replay of the written vector file on the installed verilated models;
-#   - shadesim_systemc replaying that vector file;
+#   - shadesim_systemc replaying a vector file of the default configuration;
 #   - share/shadesim/testbench/icarus/run_icarus.sh replaying it under Icarus;
 #   - share/shadesim/scripts/synth.py synthesising a configuration for iCE40 with its checks.
 set -euo pipefail
@@ -29,7 +29,9 @@ checks() {  # checks PREFIX RUN_DIR
   step "$S" render --scene builtin:sphere --method phong-fixed --brdf quadratic --rtl --quiet -o sphere.png --json sphere.json
   grep -q '"pixel_mismatches": 0' sphere.json
   test -s sphere.png && test -s sphere_reference.png && test -s sphere_error.png
-  step "$prefix/bin/shadesim_systemc" --unit spec --config narrow --vector-file narrow.vec --quiet
+  # The SystemC models of every build include default (the sanitizer build has few others).
+  step "$S" vectors --unit spec --config default --cycles 400 --seed 5 -o default.vec
+  step "$prefix/bin/shadesim_systemc" --unit spec --config default --vector-file default.vec --quiet
   step "$share/testbench/icarus/run_icarus.sh" narrow.vec
   step "$share/scripts/synth.py" spec:narrow --prom "$share/vectors/prom/spec_narrow.hex" --target ice40 --out synth --check
   test -s synth/summary.json
