@@ -14,6 +14,7 @@
 #include "device/prom.h"
 #include "device/prom_io.h"
 #include "cosim/spec_cosim.h"
+#include "io/files.h"
 
 using namespace shd;
 

@@ -14,6 +14,7 @@
 #include "cosim/replay.h"
 #include "cosim/spec_cosim.h"
 #include "vectors/vector_gen.h"
+#include "io/files.h"
 
 using namespace shd;
 namespace fs = std::filesystem;

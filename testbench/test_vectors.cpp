@@ -16,6 +16,7 @@
 #include "cosim/replay.h"
 #include "vectors/vector_file.h"
 #include "vectors/vector_gen.h"
+#include "io/files.h"
 
 using namespace shd;
 namespace fs = std::filesystem;

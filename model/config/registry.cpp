@@ -1,4 +1,5 @@
 #include "config/registry.h"
+#include "io/files.h"
 
 #include <algorithm>
 #include <filesystem>
@@ -57,6 +58,7 @@ PromContent promFromJson(const nlohmann::json& value, const std::string& where) 
 std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::invalid_argument(fmt::format("cannot open configuration file {}", path));
+  noteInput(path);
   std::ostringstream s;
   s << in.rdbuf();
   return s.str();

@@ -1,11 +1,6 @@
 #include "device/prom_io.h"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -16,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "approx/fit.h"
+#include "io/files.h"
 
 #ifndef SHD_VERSION
 #error "SHD_VERSION must be defined by the build"
@@ -293,56 +289,6 @@ std::string renderProvenanceJson(const PromTable& t) {
   return j.dump(2) + "\n";
 }
 
-void writeFileAtomic(const std::string& path, const std::string& content) {
-  static std::atomic<unsigned long> counter{0};
-  auto fail = [&](const char* step, int err) -> std::runtime_error {
-    return std::runtime_error(fmt::format("cannot write '{}': {}: {}", path, step, errnoText(err)));
-  };
-
-  std::string tmp;
-  int fd = -1;
-  // O_EXCL: never reuse a stale temporary (a crashed run with a recycled pid); try a few names.
-  for (int attempt = 0; attempt < 16 && fd < 0; ++attempt) {
-    tmp = fmt::format("{}.tmp.{}.{}", path, static_cast<long>(::getpid()), counter++);
-    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd < 0 && errno != EEXIST) break;
-  }
-  if (fd < 0) throw fail("create temporary file", errno);
-
-  auto abandon = [&](const char* step, int err) {
-    if (fd >= 0) ::close(fd);
-    ::unlink(tmp.c_str());
-    throw fail(step, err);
-  };
-
-  const char* data = content.data();
-  size_t left = content.size();
-  while (left > 0) {
-    const ssize_t n = ::write(fd, data, left);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      abandon("write", errno);
-    }
-    data += n;
-    left -= static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) abandon("fsync", errno);
-  const int rc = ::close(fd);
-  fd = -1;
-  if (rc != 0) abandon("close", errno);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) abandon("rename", errno);
-
-  // Make the rename itself durable. The new file is already in place, so a failure here is not
-  // reported (the content is complete either way).
-  const size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    (void)::fsync(dfd);
-    ::close(dfd);
-  }
-}
-
 std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int depth) {
   if (word_bits < 1 || word_bits > 128)
     throw std::invalid_argument(fmt::format("readPromHex: word width {} outside 1..128", word_bits));
@@ -350,6 +296,7 @@ std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int de
 
   std::ifstream in(path);
   if (!in) throw std::runtime_error(fmt::format("cannot open PROM file {}: {}", path, errnoText(errno)));
+  noteInput(path);
 
   auto lineError = [&](long line, const std::string& what) {
     return std::runtime_error(fmt::format("PROM file {}, line {}: {}", path, line, what));

@@ -63,12 +63,6 @@ std::string renderAddressMap(const PromTable& t);
 // newline): the sidecar of a csv table, or of any PROM file.
 std::string renderProvenanceJson(const PromTable& t);
 
-// Writes content to path through a temporary file in the same directory
-// (path + ".tmp.<pid>.<counter>"): write, fsync, close, rename over path. A reader sees either
-// the old file or the whole new one. On any failure the temporary file is removed and
-// std::runtime_error names the path, the step and strerror. The new file gets mode 0666 & ~umask.
-void writeFileAtomic(const std::string& path, const std::string& content);
-
 // Strict reader of a hex ($readmemh) PROM file as renderProm writes it: `//` comments and blank
 // lines are skipped; every other whitespace-separated token must be hex digits only (no x/z,
 // no underscores, no @address directives) and fit word_bits; the file must hold exactly `depth`

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "device/prom_io.h"
+#include "io/files.h"
 
 namespace shd {
 
@@ -102,7 +103,7 @@ PixelMask thresholdMask(const ImageF& img, double threshold) {
   return out;
 }
 
-void writePng(const std::string& path, const Image& img) {
+std::string encodePng(const std::string& path, const Image& img) {
   // Degenerate images first: PNG has no 0-pixel image, and libpng's stride is a png_int_32.
   if (img.width < 1 || img.height < 1)
     throw std::invalid_argument(fmt::format("cannot write PNG '{}': empty image {}x{}", path, img.width, img.height));
@@ -130,14 +131,17 @@ void writePng(const std::string& path, const Image& img) {
   }
   png_image_free(&png);
   bytes.resize(size);
-  writeFileAtomic(path, bytes);
+  return bytes;
 }
+
+void writePng(const std::string& path, const Image& img) { writeFileAtomic(path, encodePng(path, img)); }
 
 Image readPng(const std::string& path) {
   // The whole file first (PNGs here are a few MB at most): errno names an open failure, and the
   // tail can be checked, which libpng's simplified reader does not do (it stops after IDAT).
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(fmt::format("cannot read PNG '{}': open: {}", path, std::strerror(errno)));
+  noteInput(path);
   std::ostringstream buf;
   buf << in.rdbuf();
   if (in.bad()) throw std::runtime_error(fmt::format("cannot read PNG '{}': read failed", path));

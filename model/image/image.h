@@ -11,7 +11,7 @@
 // PNG: 8-bit RGB, no alpha, with an sRGB chunk (libpng's simplified API, png_image_*, which
 // handles libpng's errors internally with its own setjmp, so no longjmp crosses C++ frames).
 // The encoded bytes are a pure function of the pixels (no time chunk), and the file is written
-// atomically through writeFileAtomic (device/prom_io.h): a reader sees the old file or the whole
+// atomically through writeFileAtomic (io/files.h): a reader sees the old file or the whole
 // new one, never a partial PNG.
 #pragma once
 
@@ -103,6 +103,8 @@ PixelMask thresholdMask(const ImageF& img, double threshold);
 // std::runtime_error naming the path if libpng fails to encode, or from writeFileAtomic (missing
 // directory, disk full, ...: the temporary file is removed, the old file left as it was).
 void writePng(const std::string& path, const Image& img);
+// The PNG bytes writePng writes (path only names the file in errors): for an OutputFiles set.
+std::string encodePng(const std::string& path, const Image& img);
 
 // The PNG at path as 8-bit RGB. libpng's simplified reader converts any PNG: grey is expanded,
 // 16-bit samples are reduced to 8-bit sRGB (16-bit data without gAMA/sRGB is taken as linear,

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "scene/scene.h"
+#include "io/files.h"
 
 namespace shd {
 
@@ -76,6 +77,7 @@ Mesh loadMeshFile(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  noteInput(path);
   checkPlyHeader(path);
 
   // Two stages: the plain import, a check of its faces, then the post-processing. Merging

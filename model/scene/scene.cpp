@@ -1,6 +1,7 @@
 // Scenes: transforms, the torus and plane generators, the builtin scenes and the JSON scene
 // files (scene/scene.h documents all of it; loadMeshFile is in mesh_io.cpp).
 #include "scene/scene.h"
+#include "io/files.h"
 
 #include <cctype>
 #include <algorithm>
@@ -642,6 +643,7 @@ Scene loadSceneFile(const std::string& file) {
     throw SceneError(fmt::format("{}: no such scene file", file));
   std::ifstream in(file);
   if (!in) throw SceneError(fmt::format("{}: cannot open", file));
+  noteInput(file);
   json root;
   try {
     root = json::parse(in);

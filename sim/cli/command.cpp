@@ -6,6 +6,7 @@
 #include <fmt/ranges.h>
 
 #include "device/prom_io.h"
+#include "io/files.h"
 
 namespace shd::cli {
 

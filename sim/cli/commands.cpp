@@ -9,6 +9,7 @@
 
 #include "cli/command.h"
 #include "cli/run.h"
+#include "io/files.h"
 
 namespace shd::cli {
 
@@ -53,6 +54,7 @@ int run(int argc, char** argv) {
   for (auto& [sub, cmd] : subs) {
     if (!sub->parsed()) continue;
     try {
+      const RunInputs inputs;  // the files this run reads may not be its outputs (io/files.h)
       return cmd->run(*sub);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "shadesim %s: error: %s\n", sub->get_name().c_str(), e.what());

@@ -15,6 +15,7 @@
 #include "cosim/spec_cosim.h"
 #include "device/prom_io.h"
 #include "raster/desc_stream.h"
+#include "io/files.h"
 
 namespace fs = std::filesystem;
 
@@ -128,6 +129,7 @@ int CosimCmd::runSpec() {
     throw ArgError(fmt::format("--config {} (after --degree/--coef-format): {}", table_.config, e.what()));
   }
   std::string prom_path = prom_;
+  if (!prom_path.empty()) noteInput(prom_path);
   fs::path tmp_dir;
   if (prom_path.empty()) {
     tmp_dir = fs::temp_directory_path() / fmt::format("shadesim-{}", getpid());

@@ -5,6 +5,7 @@
 #include "cli/command.h"
 #include "cli/table_options.h"
 #include "device/prom_io.h"
+#include "io/files.h"
 
 namespace shd::cli {
 
@@ -29,10 +30,14 @@ class PromCmd final : public Command {
     const std::string body = renderProm(t, f);
     const std::string map = t.request.n.is_list ? renderAddressMap(t) : "";
     const std::string side = f == PromFormat::Csv ? renderProvenanceJson(t) : "";
-    writeOut(output_, body);
-    if (!output_.empty() && output_ != "-") {
-      if (!map.empty()) writeFileAtomic(output_ + ".map.csv", map);
-      if (!side.empty()) writeFileAtomic(output_ + ".json", side);
+    if (output_.empty() || output_ == "-") {
+      writeOut(output_, body);
+    } else {
+      OutputFiles files;  // the table and its sidecars together, or none of them
+      files.add(output_, body);
+      if (!map.empty()) files.add(output_ + ".map.csv", map);
+      if (!side.empty()) files.add(output_ + ".json", side);
+      files.commit();
       std::fprintf(stderr, "wrote %s: %zu codes, %d words of %d bits (%s)\n", output_.c_str(), t.entries.size(),
                    t.unit.promDepth(), t.unit.promWordBits(), t.request.describe().c_str());
     }

@@ -20,6 +20,7 @@
 #include "render/lobe_units.h"
 #include "render/render.h"
 #include "scene/scene.h"
+#include "io/files.h"
 
 namespace fs = std::filesystem;
 
@@ -274,13 +275,15 @@ int RenderCmd::run(const CLI::App&) {
     j["rtl"] = hw->json;
     if (!hw->first_mismatch.empty()) j["first_mismatch"] = hw->first_mismatch;
   }
-  // Every output is written only now, each atomically: a failure above leaves nothing.
+  // Every output is written only now, as one set (io/files.h): a failure leaves none of them.
   const fs::path out(output_);
   const std::string stem = (out.parent_path() / out.stem()).string();
-  writePng(output_, toImage(res.fb));
-  writePng(stem + "_reference.png", c.reference);
-  writePng(stem + "_error.png", c.heat);
-  if (!json_path_.empty()) writeFileAtomic(json_path_, j.dump(2) + "\n");
+  OutputFiles files;
+  files.add(output_, encodePng(output_, toImage(res.fb)));
+  files.add(stem + "_reference.png", encodePng(stem + "_reference.png", c.reference));
+  files.add(stem + "_error.png", encodePng(stem + "_error.png", c.heat));
+  if (!json_path_.empty()) files.add(json_path_, j.dump(2) + "\n");
+  files.commit();
   const RenderStats& st = res.stats;
   std::printf("%s %s %s: %llu triangles (%llu culled), %llu fragments, %llu pixels, %llu span cycles, %.2f ms; "
               "vs reference: max %.2f LSB, PSNR %s dB, %.2f%% of pixels over 1 LSB; highlight (%llu px): max %.2f LSB\n",

@@ -16,6 +16,7 @@
 #include "report/span_cycles.h"
 #include "scene/scene.h"
 #include "scene/sphere.h"
+#include "io/files.h"
 
 namespace shd::cli {
 

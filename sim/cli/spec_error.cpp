@@ -11,6 +11,7 @@
 #include "cli/table_options.h"
 #include "device/prom_io.h"
 #include "report/spec_error.h"
+#include "io/files.h"
 
 namespace shd::cli {
 

@@ -9,6 +9,7 @@
 #include "device/prom_io.h"
 #include "vectors/vector_file.h"
 #include "vectors/vector_gen.h"
+#include "io/files.h"
 
 namespace fs = std::filesystem;
 
@@ -43,6 +44,7 @@ class VectorsCmd final : public Command {
       const SpecUnitConfig cfg = specConfigArg("--config", config_);
       name = cfg.name;
       std::string prom_file = prom_;
+      if (!prom_file.empty()) noteInput(prom_file);  // the vectors refer to it: never their output
       if (prom_file.empty()) {
         prom_file = output_ + ".hex";
         writeFileAtomic(prom_file, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl),

@@ -11,6 +11,7 @@
 #include "cosim/span_cosim.h"
 #include "cosim/spec_cosim.h"
 #include "vectors/vector_file.h"
+#include "io/files.h"
 
 namespace shd {
 

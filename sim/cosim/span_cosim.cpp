@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "device/prom_io.h"
+#include "io/files.h"
 
 namespace shd {
 

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "device/prom_io.h"
+#include "io/files.h"
 
 namespace fs = std::filesystem;
 

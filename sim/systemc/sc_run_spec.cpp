@@ -23,6 +23,7 @@
 #include "spec_rtl.h"
 #include "spec_tb.h"
 #include "vectors/vector_file.h"
+#include "io/files.h"
 
 namespace fs = std::filesystem;
 

@@ -10,6 +10,7 @@
 
 #include "device/prom_io.h"
 #include "device/spec_params.h"
+#include "io/files.h"
 
 namespace shd {
 
@@ -68,6 +69,7 @@ class VectorReader {
   explicit VectorReader(const std::string& path) : path_(path) {
     std::ifstream in(path);
     if (!in) throw std::runtime_error(fmt::format("cannot open vector file {}", path));
+    noteInput(path);
     std::string s;
     long no = 0;
     while (std::getline(in, s)) {
