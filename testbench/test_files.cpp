@@ -1,32 +1,26 @@
 // The output policy (model/io/files.h): atomic writes, sets of files written together, regular
 // files only, symbolic links followed, never over an input, no write into a missing directory.
 #include <sys/stat.h>
-#include <sys/types.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <functional>
 #include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
 #include "io/files.h"
+#include "test_util.h"
 
 using namespace shd;
+using shd::testutil::errorOf;
 namespace fs = std::filesystem;
 
 namespace {
 
 class Files : public testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::path(testing::TempDir()) / ("shd_files_" + std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  void SetUp() override { dir_ = testutil::freshTestDir("test_files"); }
   std::string path(const std::string& name) const { return (dir_ / name).string(); }
   static std::string read(const std::string& p) {
     std::ifstream in(p, std::ios::binary);
@@ -35,18 +29,9 @@ class Files : public testing::Test {
     return s.str();
   }
   // The directory's entries: no temporary may be left behind.
-  size_t entries() const { return static_cast<size_t>(std::distance(fs::directory_iterator(dir_), {})); }
+  size_t entries() const { return testutil::dirEntries(dir_).size(); }
   fs::path dir_;
 };
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST_F(Files, WritesAndReplacesAtomically) {
   writeFileAtomic(path("a.txt"), "one");

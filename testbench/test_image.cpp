@@ -26,6 +26,7 @@ using shd::ImageF;
 using shd::ImageMetrics;
 using shd::PixelMask;
 using shd::Rgb8;
+using shd::testutil::errorOf;
 
 namespace {
 
@@ -40,17 +41,6 @@ std::string readAll(const fs::path& p) {
 
 void writeAll(const fs::path& p, const std::string& bytes) {
   std::ofstream(p, std::ios::binary) << bytes;
-}
-
-// The error message of f(), or "" if it does not throw E.
-template <typename E, typename F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const E& e) {
-    return e.what();
-  }
-  return "";
 }
 
 Image randomImage(int w, int h, std::mt19937& rng) {

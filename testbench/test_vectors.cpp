@@ -19,6 +19,7 @@
 #include "io/files.h"
 
 using namespace shd;
+using shd::testutil::errorOf;
 namespace fs = std::filesystem;
 
 namespace {
@@ -53,17 +54,6 @@ fs::path spanFile(const fs::path& dir, const std::string& config, uint64_t cycle
   const fs::path vec = dir / ("span_" + config + ".vec");
   writeSpanVectors(vec.string(), generateSpanVectors(spanConfig(config), cycles, seed, summary));
   return vec;
-}
-
-// The message of the exception `f` throws ("" if none).
-template <class F>
-std::string errorOf(F f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "";
 }
 
 }  // namespace

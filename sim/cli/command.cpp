@@ -1,12 +1,7 @@
 #include "cli/command.h"
 
-#include <cstdio>
-
 #include <fmt/format.h>
 #include <fmt/ranges.h>
-
-#include "device/prom_io.h"
-#include "io/files.h"
 
 namespace shd::cli {
 
@@ -28,14 +23,6 @@ SpanUnitConfig spanConfigArg(const std::string& option, const std::string& arg) 
 
 std::string configChoices(const std::string& unit) {
   return fmt::format("{} or a JSON file", fmt::join(builtinConfigNames(unit), " | "));
-}
-
-void writeOut(const std::string& path, const std::string& text) {
-  if (path.empty() || path == "-") {
-    std::fwrite(text.data(), 1, text.size(), stdout);
-    return;
-  }
-  writeFileAtomic(path, text);
 }
 
 }  // namespace shd::cli

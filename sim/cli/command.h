@@ -42,7 +42,4 @@ SpanUnitConfig spanConfigArg(const std::string& option, const std::string& arg);
 // "name | name | ... or a JSON file": the registry's names of a unit, for help texts.
 std::string configChoices(const std::string& unit);
 
-// The text to `path`, atomically; "" or "-": stdout.
-void writeOut(const std::string& path, const std::string& text);
-
 }  // namespace shd::cli

@@ -31,7 +31,7 @@ class PromCmd final : public Command {
     const std::string map = t.request.n.is_list ? renderAddressMap(t) : "";
     const std::string side = f == PromFormat::Csv ? renderProvenanceJson(t) : "";
     if (output_.empty() || output_ == "-") {
-      writeOut(output_, body);
+      std::fwrite(body.data(), 1, body.size(), stdout);
     } else {
       OutputFiles files;  // the table and its sidecars together, or none of them
       files.add(output_, body);
