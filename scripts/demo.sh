@@ -17,6 +17,7 @@ for fmt in hex mem coe mif csv; do
 done
 
 echo "== 2. exhaustive co-simulation: verilated shd_spec_unit vs golden model"
+mkdir -p "$out/fail"
 "$S" cosim --unit spec --config default --exhaustive --prom "$out/prom/spec_default.hex" \
   --fail-dir "$out/fail" --json > "$out/cosim_spec_default.json.tmp"
 mv "$out/cosim_spec_default.json.tmp" "$out/cosim_spec_default.json"

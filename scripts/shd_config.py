@@ -85,6 +85,9 @@ def parse(text, where, unit=None, name=None):
             raise ConfigError(f"{where}: rtl.{k}: a parameter name is UpperCamelCase letters and digits")
         if type(v) is not int:
             raise ConfigError(f"{where}: rtl.{k} = {json.dumps(v)} is not an integer")
+        # Verilog parameters are 32-bit integers: a larger value would wrap (4294967304 to 8).
+        if not -2**31 <= v < 2**31:
+            raise ConfigError(f"{where}: rtl.{k} = {v} does not fit a 32-bit Verilog parameter")
     if RAW_END in text:
         raise ConfigError(f"{where}: contains {RAW_END!r}, which cannot be embedded")
     return Config(unit, jname, rtl, where, text)

@@ -327,6 +327,34 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
   EXPECT_NEAR(x1, cam.width + kGuard, 1e-9);
   EXPECT_NEAR(y0, -kGuard, 1e-9);
   EXPECT_NEAR(y1, cam.height + kGuard, 1e-9);
+  // A vertex that projects beyond the range the clipper resolves exactly (kMaxClipCoord) is an
+  // error, not a silently wrong polygon: the limit itself is still taken.
+  st = RenderStats{};
+  const double edge = kMaxClipCoord * cam.z_near / cam.px_per_unit;  // x = cx + 2^40 px at Z = z_near
+  EXPECT_TRUE(clip({a, vertex({-a.cam.x + edge * 0.999, 0, cam.z_near}), vertex({0, 0.1, cam.z_near})}, st));
+  try {
+    clip({a, vertex({edge * 2, 0, cam.z_near}), vertex({0, 0.1, cam.z_near})}, st);
+    ADD_FAILURE() << "a vertex at 2^41 px was clipped";
+  } catch (const std::range_error& e) {
+    EXPECT_NE(std::string(e.what()).find("beyond the +-2^40 px"), std::string::npos) << e.what();
+  }
+}
+
+// The renderer names the object and the triangle whose projection leaves the clipper's range.
+TEST(RenderPipeline, ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle) {
+  // The eye just above the 8 x 8 plane, looking along it: the near plane (1e-6 ahead) cuts
+  // the triangles under the eye up to 4 units to the side, which project to 4e12 px.
+  Scene s = loadScene("builtin:plane");
+  s.camera.px_per_unit = 1e6;
+  s.camera.z_near = 1e-6;
+  s.camera.eye = {0.01, 0.1, 0.01};
+  s.camera.target = {0.01, 0.1, 1};
+  try {
+    renderModel(s, Method::Gouraud, "", "serial");
+    FAIL() << "rendered";
+  } catch (const std::range_error& e) {
+    EXPECT_NE(std::string(e.what()).find("object 'plane' triangle "), std::string::npos) << e.what();
+  }
 }
 
 TEST(EdgeMaximum, MatchesDenseSamplingOfTheNormalisedCosine) {

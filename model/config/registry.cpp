@@ -1,4 +1,5 @@
 #include "config/registry.h"
+#include "device/prom.h"
 #include "io/files.h"
 
 #include <algorithm>
@@ -42,8 +43,11 @@ PromContent promFromJson(const nlohmann::json& value, const std::string& where) 
   PromContent c;
   for (const auto& [pk, pv] : value.items()) {
     if (pk == "fit" && pv.is_string()) c.fit = pv.get<std::string>();
-    else if (pk == "level" && pv.is_number()) c.level = pv.get<double>();
-    else if (pk == "n" && pv.is_string()) c.n = pv.get<std::string>();
+    else if (pk == "level" && pv.is_number()) {
+      c.level = pv.get<double>();
+      if (!(c.level > 0 && c.level < 1))
+        throw std::invalid_argument(fmt::format("{}: prom.level = {} must lie in (0, 1)", where, pv.dump()));
+    } else if (pk == "n" && pv.is_string()) c.n = pv.get<std::string>();
     else if (pk == "n_list" && pv.is_string()) {
       c.n = pv.get<std::string>();
       c.is_list = true;
@@ -52,12 +56,15 @@ PromContent promFromJson(const nlohmann::json& value, const std::string& where) 
           "{}: prom.{} is unknown or has the wrong type (fit: string, level: number, n or n_list: string)", where, pk));
     }
   }
+  if (!value.contains("fit")) throw std::invalid_argument(fmt::format("{}: prom.fit missing", where));
+  if (value.contains("n") == value.contains("n_list"))
+    throw std::invalid_argument(fmt::format("{}: prom needs exactly one of n (a range) and n_list", where));
   return c;
 }
 
 std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(fmt::format("cannot open configuration file {}", path));
+  if (!in) throw std::invalid_argument(fmt::format("{}: cannot open it", path));
   noteInput(path);
   std::ostringstream s;
   s << in.rdbuf();
@@ -97,14 +104,23 @@ SpecUnitConfig SpecUnitConfig::parse(const std::string& text, const std::string&
   const nlohmann::json j = parseObject(text, where);
   SpecUnitConfig c;
   c.path = where;
+  bool has_rtl = false, has_prom = false;
   for (const auto& [key, value] : j.items()) {
     if (key == "name") c.name = stringMember(value, where, "name");
     else if (key == "description") c.description = stringMember(value, where, "description");
-    else if (key == "rtl") c.rtl = SpecUnitParams::fromJson(value, where);
-    else if (key == "prom") c.prom = promFromJson(value, where);
+    else if (key == "rtl") c.rtl = SpecUnitParams::fromJson(value, where), has_rtl = true;
+    else if (key == "prom") c.prom = promFromJson(value, where), has_prom = true;
     else throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", where, key));
   }
+  // A file states the whole unit: nothing falls back to a default the user did not see.
   if (c.name.empty()) throw std::invalid_argument(fmt::format("{}: missing \"name\"", where));
+  if (!has_rtl) throw std::invalid_argument(fmt::format("{}: missing \"rtl\" (the Verilog parameters)", where));
+  if (!has_prom) throw std::invalid_argument(fmt::format("{}: missing \"prom\" (fit and shininess list)", where));
+  try {
+    PromRequest::fromContent(c.prom);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(fmt::format("{}: prom: {}", where, e.what()));
+  }
   return c;
 }
 

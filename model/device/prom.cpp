@@ -1,5 +1,6 @@
 #include "device/prom.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -56,6 +57,12 @@ NSpec NSpec::parse(std::string_view text, bool is_list) {
     if (!(n >= kMinShininess && n <= kMaxShininess))
       throw std::invalid_argument(
           fmt::format("n '{}': shininess {} outside [{}, {}]", text, n, kMinShininess, kMaxShininess));
+  // Each n has one address: a repeated value would make the address map ambiguous.
+  std::vector<double> sorted = spec.values;
+  std::sort(sorted.begin(), sorted.end());
+  const auto twice = std::adjacent_find(sorted.begin(), sorted.end());
+  if (twice != sorted.end())
+    throw std::invalid_argument(fmt::format("n '{}': shininess {} appears more than once", text, *twice));
   return spec;
 }
 

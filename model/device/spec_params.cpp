@@ -77,7 +77,7 @@ void SpecUnitParams::validate() const {
 }
 
 SpecUnitParams SpecUnitParams::fromJson(const nlohmann::json& rtl, const std::string& where) {
-  return paramsFromJson(rtl, kMembers, false, where);  // missing members take the defaults
+  return paramsFromJson(rtl, kMembers, true, where);
 }
 
 nlohmann::json SpecUnitParams::toJson() const { return paramsToJson(*this, kMembers); }

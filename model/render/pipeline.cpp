@@ -1,7 +1,11 @@
 #include "render/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 namespace shd {
 
@@ -77,6 +81,12 @@ bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly
   }
   // Guard band, screen space.
   if (!std::all_of(poly.begin(), poly.end(), inGuard)) {
+    for (const PVertex& v : poly)
+      if (!(std::abs(v.x) <= kMaxClipCoord && std::abs(v.y) <= kMaxClipCoord))
+        throw std::range_error(fmt::format(
+            "a vertex projects to ({:.3g}, {:.3g}) px, beyond the +-2^40 px within which the clipper is exact to "
+            "1/4096 px (lower camera.px_per_unit, raise camera.z_near or move the camera)",
+            v.x, v.y));
     poly = clipPolygon(poly, [&](const PVertex& v) { return v.x + kGuard; });
     poly = clipPolygon(poly, [&](const PVertex& v) { return W + kGuard - v.x; });
     poly = clipPolygon(poly, [&](const PVertex& v) { return v.y + kGuard; });

@@ -18,6 +18,11 @@ constexpr int kColourFrac = 12;  // colour attributes in LSBs: 0..255 with 12 fr
 constexpr int kUnitFrac = 28;    // normals and depth in [-1, 1]
 constexpr double kUnitLsb = 1.0 / (1 << kUnitFrac);  // 2^-28: code * kUnitLsb == ldexp(code, -28) exactly
 constexpr double kGuard = 2048;  // guard band (px beyond the viewport) before 2D clipping
+// The largest projected coordinate the guard-band clipper takes: an intersection it computes
+// is off by at most a few ulp of the coordinates, 2^40 * 2^-52 = 1/4096 px, well inside the
+// setup's subpixel grid (1/16 px). A vertex beyond it is an error (std::range_error), not a
+// silently wrong image.
+constexpr double kMaxClipCoord = 1099511627776.0;  // 2^40
 
 // A vertex on its way through the pipeline. cam and n are camera space; colour is the Gouraud
 // vertex colour in LSBs (device lobes included).

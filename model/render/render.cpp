@@ -105,8 +105,12 @@ void SceneDrawer::drawObject(size_t oi) {
   for (const auto& u : f_.units()) u.second->beginObject();
   transformVertices(obj, basis_, scene_.camera, f_.proj, verts_);
   lit_.assign(verts_.size(), 0);
-  for (size_t ti = 0; ti < obj.mesh.triangles.size(); ++ti)
-    drawMeshTriangle(obj.mesh.triangles[ti], static_cast<uint32_t>(ti));
+  size_t ti = 0;
+  try {
+    for (; ti < obj.mesh.triangles.size(); ++ti) drawMeshTriangle(obj.mesh.triangles[ti], static_cast<uint32_t>(ti));
+  } catch (const std::range_error& e) {
+    throw std::range_error(fmt::format("object '{}' triangle {}: {}", obj.name, ti, e.what()));
+  }
   for (const auto& u : f_.units()) u.second->endObject();
 }
 
@@ -133,7 +137,9 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
   unit_.parts(fan_, parts_);
+  const uint64_t drawn_before = st.drawn;
   for (const Part& part : parts_) drawPart(part, ti);
+  if (st.drawn == drawn_before) ++st.culled;  // every part dropped by setup: nothing on screen
 }
 
 // A part through the span unit's setup (dropped: culled), recorded, and drawn by its unit.
@@ -154,10 +160,7 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   }
   const uint32_t tag = static_cast<uint32_t>(triangles_.size());
   const SetupResult s = setupTriangle(sv, tag, rc);
-  if (!s.desc) {
-    ++f_.st.culled;
-    return;
-  }
+  if (!s.desc) return;  // no pixel centre inside (drawMeshTriangle counts the triangle culled)
   ScreenTriangleInfo info;
   info.object = f_.obj.index;
   info.mesh_triangle = ti;

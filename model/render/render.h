@@ -134,7 +134,8 @@ struct RenderOptions {
 
 struct RenderStats {
   uint64_t triangles = 0;       // input triangles of every object
-  uint64_t culled = 0;          // back faces, behind the camera, zero area on screen
+  uint64_t culled = 0;          // input triangles of which nothing is drawn: back faces, behind
+                                // the camera, outside the view, no pixel centre inside
   uint64_t clipped = 0;         // triangles cut by the near plane or the guard band
   uint64_t drawn = 0;           // screen triangles sent to the span unit
   uint64_t fragments = 0;

@@ -1,4 +1,5 @@
-// loadMeshFile: mesh files through assimp 5.2 (the policy is documented in scene/scene.h).
+// importMeshInProcess: mesh files through assimp 5.2 (the policy is documented in
+// scene/scene.h; loadMeshFile runs it in a child process, mesh_child.cpp).
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -15,7 +16,6 @@
 #include <fmt/format.h>
 
 #include "scene/scene.h"
-#include "io/files.h"
 
 namespace shd {
 
@@ -73,11 +73,10 @@ void checkFaces(const std::string& path, const aiScene* scene) {
 
 }  // namespace
 
-Mesh loadMeshFile(const std::string& path) {
+Mesh importMeshInProcess(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
   if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
-  noteInput(path);
   checkPlyHeader(path);
 
   // Two stages: the plain import, a check of its faces, then the post-processing. Merging

@@ -405,6 +405,8 @@ class SceneReader {
     Vec3 v{number(j[0], index(path, 0)), number(j[1], index(path, 1)), number(j[2], index(path, 2))};
     return v;
   }
+  // A point in world space (camera, light, translation): each coordinate within kMaxSceneCoord.
+  Vec3 position(const json& j, const std::string& path) const { return vec3Range(j, path, -kMaxSceneCoord, kMaxSceneCoord); }
   Vec3 vec3Range(const json& j, const std::string& path, double lo, double hi) const {
     const Vec3 v = vec3(j, path);
     const double c[3] = {v.x, v.y, v.z};
@@ -459,12 +461,13 @@ class SceneReader {
     object(j, path);
     onlyKeys(j, path, {"eye", "target", "px_per_unit", "width", "height", "z_near"});
     Camera c;
-    if (j.contains("eye")) c.eye = vec3(j["eye"], key(path, "eye"));
-    if (j.contains("target")) c.target = vec3(j["target"], key(path, "target"));
-    if (j.contains("px_per_unit")) c.px_per_unit = positive(j["px_per_unit"], key(path, "px_per_unit"));
+    if (j.contains("eye")) c.eye = position(j["eye"], key(path, "eye"));
+    if (j.contains("target")) c.target = position(j["target"], key(path, "target"));
+    if (j.contains("px_per_unit"))
+      c.px_per_unit = numberIn(j["px_per_unit"], key(path, "px_per_unit"), kMinSceneScale, kMaxSceneScale);
     if (j.contains("width")) c.width = integerIn(j["width"], key(path, "width"), 1, 4096);
     if (j.contains("height")) c.height = integerIn(j["height"], key(path, "height"), 1, 4096);
-    if (j.contains("z_near")) c.z_near = positive(j["z_near"], key(path, "z_near"));
+    if (j.contains("z_near")) c.z_near = numberIn(j["z_near"], key(path, "z_near"), kMinSceneScale, kMaxSceneScale);
     if (!(length(c.target - c.eye) > 0))
       fail(key(path, "target"), "equals the eye (no view direction)");
     return c;
@@ -483,7 +486,7 @@ class SceneReader {
     } else if (type == "point") {
       onlyKeys(j, path, {"type", "position", "colour"});
       l.kind = Light::Kind::Point;
-      l.position = vec3(required(j, path, "position"), key(path, "position"));
+      l.position = position(required(j, path, "position"), key(path, "position"));
     } else {
       fail(key(path, "type"), fmt::format("'{}' is not a light type (directional, point)", type));
     }
@@ -519,8 +522,8 @@ class SceneReader {
     object(j, path);
     onlyKeys(j, path, {"translate", "rotate_deg", "scale"});
     Vec3 t{0, 0, 0}, r{0, 0, 0}, sc{1, 1, 1};
-    if (j.contains("translate")) t = vec3(j["translate"], key(path, "translate"));
-    if (j.contains("rotate_deg")) r = vec3(j["rotate_deg"], key(path, "rotate_deg"));
+    if (j.contains("translate")) t = position(j["translate"], key(path, "translate"));
+    if (j.contains("rotate_deg")) r = vec3Range(j["rotate_deg"], key(path, "rotate_deg"), -360, 360);
     if (j.contains("scale")) {
       const json& s = j["scale"];
       const std::string sp = key(path, "scale");
@@ -532,7 +535,9 @@ class SceneReader {
       } else {
         fail(sp, "expected a number or an array of 3 numbers");
       }
-      if (sc.x == 0 || sc.y == 0 || sc.z == 0) fail(sp, "scale factors must be non-zero");
+      for (double f : {sc.x, sc.y, sc.z})
+        if (!(std::abs(f) >= kMinSceneScale && std::abs(f) <= kMaxSceneScale))
+          fail(sp, fmt::format("scale factor {} must have a magnitude in [{}, {}]", f, kMinSceneScale, kMaxSceneScale));
     }
     return Mat4::translate(t) * Mat4::rotateDeg(r) * Mat4::scale(sc);
   }

@@ -25,7 +25,12 @@
 // e.g. "scenes/x.json: objects[2].transform.scale: expected a number or an array of 3 numbers"):
 //   - "objects" is required and non-empty; every other top-level key is optional.
 //   - camera: each field optional (the defaults are Camera's, i.e. the default scene's);
-//     width, height integers in 1..4096; px_per_unit > 0; z_near > 0; eye != target.
+//     width, height integers in 1..4096; px_per_unit and z_near in [1e-6, 1e6]; eye != target.
+//   - positions (camera eye and target, point lights, translations): each coordinate within
+//     +-1e6 (kMaxSceneCoord); rotate_deg within +-360; scale factors of magnitude [1e-6, 1e6].
+//     Inside these limits double precision resolves a position to 1e-10 units, far below a
+//     pixel; a projection that still leaves the clipper's exact range is refused by the
+//     renderer (render/pipeline.h, kMaxClipCoord).
 //   - ambient and light colours: 3 numbers >= 0 (above 1 is a brighter light); material colours
 //     in 0..1, or "#RRGGBB" (the hex digits / 255, taken as linear like Material's default).
 //   - lights: "type" is required; a directional light needs a non-zero "direction", a point
@@ -35,8 +40,8 @@
 //     Material's defaults.
 //   - objects: "mesh" required; "name" defaults to "object<i>"; "material" names a material of
 //     the file; without it the object uses the material named "default" (the file's, or else
-//     Material{} appended to Scene::materials). transform: every field optional; scale factors
-//     must be non-zero (a negative one mirrors: worldMesh keeps front faces front).
+//     Material{} appended to Scene::materials). transform: every field optional; a negative
+//     scale factor mirrors (worldMesh keeps front faces front).
 //   - builtin mesh sources: "builtin:sphere(radius,segments)" = idx3dSphere, "builtin:torus(
 //     major,minor,major_segments,minor_segments)" = torusMesh, "builtin:plane(size_x,size_z,
 //     divisions)" = planeMesh; without the parenthesis the defaults sphere(1,64),
@@ -158,6 +163,10 @@ struct Scene {
   std::vector<SceneObject> objects;
 };
 
+// The limits of a scene file's values (above).
+constexpr double kMaxSceneCoord = 1e6;
+constexpr double kMinSceneScale = 1e-6, kMaxSceneScale = 1e6;
+
 // A clear error naming the file (or builtin) and the field.
 struct SceneError : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -197,11 +206,17 @@ Mesh worldMesh(const SceneObject& obj);
 //     truncated ASCII PLY leaves faces without indices, on which Debian's assimp 5.2 aborts
 //     in an assertion instead of failing), and a PLY header without end_header is refused up
 //     front (assimp 5.2 loops forever on it). A text file cut at a line boundary is a valid
-//     smaller file and loads. Not guarded: assimp 5.2 terminates the process on some
-//     truncated COB files (an exception thrown where it cannot be caught), and a file that
-//     declares billions of elements (invalid/OutOfMemory.off) makes it allocate them: under a
-//     memory limit that is a SceneError (std::bad_alloc), without one it takes the memory.
+//     smaller file and loads;
+//   - resource limits: the import runs in a child process (mesh_child.cpp) with 4 GB of
+//     memory (address space beyond the parent's, and resident memory) and 120 s of wall time.
+//     assimp 5.2 terminates on some truncated COB files (an exception thrown where it cannot be
+//     caught) and allocates what a header declares (invalid/OutOfMemory.off: 353535235358
+//     vertices in 309 bytes): each is a SceneError naming the file and the limit or the
+//     signal, and shadesim goes on.
 Mesh loadMeshFile(const std::string& path);
+// The same import in the calling process, without the limits (the fuzz target's entry; a
+// program reads meshes through loadMeshFile). It does not record the file as an input.
+Mesh importMeshInProcess(const std::string& path);
 
 // A torus about the y axis: centre circle of radius major_radius in the x-z plane, tube radius
 // minor_radius (0 < minor < major). major_segments x minor_segments vertices (shared, no seam

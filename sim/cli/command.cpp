@@ -5,20 +5,28 @@
 
 namespace shd::cli {
 
-SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg) {
+namespace {
+
+// An error in a configuration file names the file, the member and the value (config/registry.h)
+// and is the file's, not the option's; an unknown registry name is the option's.
+template <class Load>
+auto configArg(const std::string& option, const std::string& arg, Load load) {
   try {
-    return specConfig(arg);
+    return load(arg);
   } catch (const std::invalid_argument& e) {
+    if (isConfigFile(arg)) throw ArgError(fmt::format("configuration file {}", e.what()));
     throw ArgError(fmt::format("{} {}: {}", option, arg, e.what()));
   }
 }
 
+}  // namespace
+
+SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg) {
+  return configArg(option, arg, specConfig);
+}
+
 SpanUnitConfig spanConfigArg(const std::string& option, const std::string& arg) {
-  try {
-    return spanConfig(arg);
-  } catch (const std::invalid_argument& e) {
-    throw ArgError(fmt::format("{} {}: {}", option, arg, e.what()));
-  }
+  return configArg(option, arg, spanConfig);
 }
 
 std::string configChoices(const std::string& unit) {

@@ -1,7 +1,7 @@
 // The shadesim program's subcommands. Each is a Command in its own file of sim/cli/, listed
 // once in commands.cpp; main.cpp only wires them to CLI11 and reports their errors.
-// Exit status of run(): 0 success, 1 a check failed (a mismatch), 2 bad input (main.cpp prints
-// "shadesim <command>: error: ..." for an exception and returns 2).
+// Exit status of run(): kExitOk, kExitFailed (a check failed) or kExitBadInput (cli/options.h;
+// cli::run prints "shadesim <command>: error: ..." for an exception and returns kExitBadInput).
 #pragma once
 
 #include <memory>
@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/options.h"
 #include "config/registry.h"
 
 namespace shd::cli {
@@ -31,12 +32,8 @@ struct CommandInfo {
 // Every subcommand, in the order `shadesim --help` lists them.
 const std::vector<CommandInfo>& commands();
 
-// A usage error: the message names the argument.
-struct ArgError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
-
-// A configuration option (registry name or JSON file), errors as ArgError naming the option.
+// A configuration option (registry name or JSON file). Errors are ArgError: an unknown name
+// names the option, an error in a file "configuration file <path>: <member>: ...".
 SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg);
 SpanUnitConfig spanConfigArg(const std::string& option, const std::string& arg);
 // "name | name | ... or a JSON file": the registry's names of a unit, for help texts.

@@ -1,9 +1,10 @@
 // The list of shadesim's subcommands (one row each, in the order of `shadesim --help`) and the
 // program wired to CLI11: every failure prints "shadesim <command>: error: ..." naming the
-// argument and exits non-zero; files are written atomically, so a failed run leaves no partial
-// output.
+// argument and exits with kExitBadInput (cli/options.h); files are written as one set, so a
+// failed run leaves no partial output (io/files.h).
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include <fmt/format.h>
 
@@ -49,19 +50,24 @@ int run(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    std::string who = "shadesim";
+    for (const auto& s : subs)
+      if (s.first->parsed()) who += " " + s.first->get_name();
+    return parseErrorExit(app, e, who);
   }
   for (auto& [sub, cmd] : subs) {
     if (!sub->parsed()) continue;
     try {
       const RunInputs inputs;  // the files this run reads may not be its outputs (io/files.h)
       return cmd->run(*sub);
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "shadesim %s: error: out of memory\n", sub->get_name().c_str());
     } catch (const std::exception& e) {
       std::fprintf(stderr, "shadesim %s: error: %s\n", sub->get_name().c_str(), e.what());
-      return 2;
     }
+    return kExitBadInput;
   }
-  return 2;
+  return kExitBadInput;
 }
 
 }  // namespace shd::cli

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "cli/command.h"
+#include "cli/options.h"
 #include "cli/progress.h"
 #include "cli/table_options.h"
 #include "cosim/span_cosim.h"
@@ -31,23 +32,34 @@ class CosimCmd final : public Command {
         ->default_val("spec");
     app.add_option("--mode", mode_, "span unit: its configuration (lane mode), " + configChoices("span"));
     app.add_option("--triangles", triangles_, "span unit: seeded random triangles (raster/trigen.h classes)")
-        ->check(CLI::PositiveNumber);
+        ->check(countIn(1, kMaxStreamTriangles));
     app.add_option("--ready", ready_prob_, "span unit: probability that the consumer is ready on a cycle")
-        ->check(CLI::Range(0.05, 1.0));
+        ->check(realIn(kMinReady, 1.0));
     table_.add(app);
     app.add_option("--prom", prom_, "PROM hex file the RTL loads (default: the table written to a temporary file); "
                                     "it must hold the table the options describe");
     app.add_flag("--exhaustive", exhaustive_, "every (shininess code, cos code) pair, valid on every cycle");
-    app.add_option("--vectors", vectors_, "random vectors (without --exhaustive)")->check(CLI::PositiveNumber);
-    app.add_option("--seed", seed_, "random seed");
+    app.add_option("--vectors", vectors_, "random vectors (without --exhaustive)")->check(countIn(1, kMaxVectors));
+    app.add_option("--seed", seed_, "random seed")->check(countIn(0, UINT64_MAX));
     app.add_option("--gap", gap_, "probability of dropping valid_i for 1..3 cycles (random mode)")
-        ->check(CLI::Range(0.0, 0.9));
+        ->check(realIn(0.0, kMaxGap));
     app.add_option("--fail-dir", fail_dir_, "where a failing case's FST waveform and vector file go");
     app.add_flag("--json", json_, "print the result as one JSON object on stdout");
     app.add_flag("--quiet", quiet_, "no progress on stderr");
   }
 
-  int run(const CLI::App&) override { return unit_ == "span" ? runSpan() : runSpec(); }
+  int run(const CLI::App& app) override {
+    requireDirectoryArg("--fail-dir", fail_dir_);
+    if (unit_ == "span") {
+      requireAbsent(app, {"--config", "--fit", "--level", "--degree", "--n", "--n-list", "--coef-format", "--prom",
+                          "--exhaustive", "--vectors", "--gap"},
+                    "applies to --unit spec only");
+      return runSpan();
+    }
+    requireAbsent(app, {"--mode", "--triangles", "--ready"}, "applies to --unit span only");
+    if (exhaustive_) requireAbsent(app, {"--vectors", "--gap"}, "and --exhaustive exclude each other");
+    return runSpec();
+  }
 
  private:
   TableOptions table_;

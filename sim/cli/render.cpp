@@ -2,6 +2,7 @@
 // the double-precision reference (image, heat map, metrics), and optionally the same frame with
 // the verilated span and specular units in the loop, which must give the same image.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -106,11 +107,12 @@ void RenderCmd::add(CLI::App& app) {
   app.add_option("-o,--output", output_, "the image (PNG); beside it <name>_reference.png and <name>_error.png")
       ->required();
   app.add_option("--json", json_path_, "write the statistics as JSON to this file");
-  app.add_option("--heat-scale", heat_scale_, "error (LSB) shown white in the heat map")->check(CLI::PositiveNumber);
+  app.add_option("--heat-scale", heat_scale_, "error (LSB) shown white in the heat map")
+      ->check(realIn(0, 255, Ends::OpenLow));
   app.add_option("--highlight", highlight_lsb_,
                  "the highlight: pixels whose reference specular part exceeds this many LSBs")
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--bench", bench_, "render this many frames and report the median time")->check(CLI::Range(0, 10000));
+      ->check(realIn(0, 255));
+  app.add_option("--bench", bench_, "render this many frames and report the median time")->check(countIn(0, 10000));
   app.add_flag("--quiet", quiet_, "no progress lines");
 }
 
@@ -242,6 +244,10 @@ nlohmann::json RenderCmd::statistics(const Scene& sc, const RenderOptions& ro, c
 }
 
 int RenderCmd::run(const CLI::App&) {
+  std::string ext = fs::path(output_).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  if (ext != ".png")
+    throw ArgError(fmt::format("-o {}: the images are PNG files; name the output <name>.png", output_));
   const Scene sc = loadScene(scene_);
   const SpanUnitConfig span = spanConfigArg("--mode", mode_);
   RenderOptions ro;
@@ -268,6 +274,13 @@ int RenderCmd::run(const CLI::App&) {
   say("reference (double precision, exact pow)");
   const Comparison c = compare(res, render(sc, rref, serial, SpecEngines{}));
   nlohmann::json j = statistics(sc, ro, res, ms, frame_ms.size(), c);
+  if (res.stats.pixels_covered == 0) {  // a blank image is not a result: say so (and in the JSON)
+    const std::string w = fmt::format("nothing drawn: all {} triangles are culled or outside the view (check the "
+                                      "camera and the transforms)",
+                                      res.stats.triangles);
+    j["warnings"].push_back(w);
+    std::fprintf(stderr, "render: warning: %s\n", w.c_str());
+  }
   std::optional<RtlCheck> hw;
   if (rtl_) {
     hw = renderRtl(sc, ro, span, res, tmp);

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/command.h"
+#include "cli/options.h"
 #include "cosim/span_cosim.h"
 #include "device/prom_io.h"
 #include "raster/desc_stream.h"
@@ -29,14 +30,14 @@ class SpanCyclesCmd final : public Command {
   void add(CLI::App& app) override {
     app.add_option("--triangles", triangles_,
                    "triangles per size class and for the mixed stream; large: 1/20 of it, screen-filling: 1/2000 "
-                   "(at least 5), so that every set costs about the same")
-        ->check(CLI::PositiveNumber);
-    app.add_option("--seed", seed_, "generator seed");
+                   "(at least 5), so that every set costs about the same; the sets are held in memory")
+        ->check(countIn(1, kMaxTriangles));
+    app.add_option("--seed", seed_, "generator seed")->check(countIn(0, UINT64_MAX));
     app.add_option("--divider-latency", divider_latency_, "divider latencies (cycles) of the classical unit")
         ->delimiter(',')
-        ->check(CLI::NonNegativeNumber);
+        ->check(countIn(0, 1000));
     app.add_option("--soft-repeats", soft_repeats_, "repeats of the software timing (median)")
-        ->check(CLI::Range(1, 1000));
+        ->check(countIn(1, 1000));
     app.add_flag("--json", json_, "print one JSON object instead of the tables");
     app.add_option("--json-out", json_out_, "also write the JSON object to this file");
     app.add_flag("--rtl", rtl_, "also run every set through the verilated unit of every mode and check its cycles");
@@ -65,6 +66,8 @@ class SpanCyclesCmd final : public Command {
   }
 
  private:
+  // The sets are held in memory: at the limit about 1 GB (4 sets of this many triangles).
+  static constexpr uint64_t kMaxTriangles = 1'000'000;
   uint64_t triangles_ = 20000, seed_ = 1;
   std::vector<int> divider_latency_{1, 4, 8, 16, 32};
   int soft_repeats_ = 5;

@@ -10,7 +10,8 @@ void TableOptions::add(CLI::App& app) {
   app.add_option("--config", config, "configuration: " + configChoices("spec"))->default_val("default");
   app.add_option("--fit", fit, "inflection | level | shortcut | minimax (default: the configuration's)")
       ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax"}));
-  app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)");
+  app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)")
+      ->check(realIn(0, 1, Ends::Open));
   app.add_option("--degree", degree, "2 (quadratic) or 3 (cubic)")->check(CLI::IsMember({2, 3}));
   auto* n_opt = app.add_option("--n", n, "shininess range lo:hi[:step], each in [1, 1000]");
   auto* list_opt = app.add_option("--n-list", n_list, "explicit shininess list, e.g. 8,32,200");
@@ -22,17 +23,14 @@ PromTable TableOptions::build(SpecUnitConfig& cfg_out, bool size_to_n) const {
   SpecUnitConfig cfg = specConfigArg("--config", config);
   PromContent content = cfg.prom;
   if (!fit.empty()) content.fit = fit;
-  if (level) {
-    if (!(*level > 0 && *level < 1)) throw ArgError(fmt::format("--level {}: must lie in (0, 1)", *level));
-    content.level = *level;
-  }
-  if (!n.empty()) content = PromContent{content.fit, content.level, n, false};
-  if (!n_list.empty()) content = PromContent{content.fit, content.level, n_list, true};
+  if (level) content.level = *level;
+  if (n) content = PromContent{content.fit, content.level, *n, false};
+  if (n_list) content = PromContent{content.fit, content.level, *n_list, true};
   PromRequest req;
   try {
     req = PromRequest::fromContent(content);
   } catch (const std::invalid_argument& e) {
-    throw ArgError(fmt::format("{}: {}", !n_list.empty() ? "--n-list" : (!n.empty() ? "--n" : "--fit"), e.what()));
+    throw ArgError(fmt::format("{}: {}", n_list ? "--n-list" : (n ? "--n" : "--fit"), e.what()));
   }
   SpecUnitParams& p = cfg.rtl;
   if (degree != 0) p.Degree = degree;

@@ -14,7 +14,8 @@ namespace shd::cli {
 
 struct TableOptions {
   std::string config = "default";
-  std::string fit, n, n_list, coef_format;
+  std::string fit, coef_format;
+  std::optional<std::string> n, n_list;  // given (even empty: an error) or not
   std::optional<double> level;
   int degree = 0;  // 0: the configuration's
 

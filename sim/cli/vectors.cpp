@@ -28,8 +28,8 @@ class VectorsCmd final : public Command {
         ->required();
     app.add_option("--cycles", cycles_, "clock cycles after reset (the file holds exactly this many)")
         ->required()
-        ->check(CLI::Range(uint64_t{1}, uint64_t{100'000'000}));
-    app.add_option("--seed", seed_, "stimulus seed");
+        ->check(countIn(1, 100'000'000));
+    app.add_option("--seed", seed_, "stimulus seed")->check(countIn(0, UINT64_MAX));
     app.add_option("-o,--output", output_, "the vector file to write")->required();
     app.add_option("--prom", prom_,
                    "spec: the PROM file the vectors refer to, which must hold the configuration's table (default: "

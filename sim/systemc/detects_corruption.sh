@@ -13,6 +13,7 @@ cycle=${where%% *}
 port=${where#* }
 port=${port%%[*}
 rm -rf "$work/fail"
+mkdir -p "$work/fail"  # --fail-dir names an existing directory
 "$sc" --unit "$unit" --config "$config" --vector-file "$work/bad.vec" --quiet --fail-dir "$work/fail" 2>"$work/stderr"
 rc=$?
 cat "$work/stderr" >&2

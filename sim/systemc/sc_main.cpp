@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <new>
 #include <string>
 
 #include <systemc>
@@ -29,6 +30,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "io/files.h"
 #include "sc_fail_case.h"
 #include "sc_run.h"
 
@@ -57,7 +59,7 @@ void addOptions(CLI::App& app, CommandLine& c) {
   app.add_option("--config", o.config,
                  "configuration (vectors/config/<unit>_<name>.json); default: default (spec), serial (span)");
   given.vectors = app.add_option("--vectors", o.vectors, "spec: seeded random vectors (default 20000)")
-                      ->check(CLI::PositiveNumber);
+                      ->check(cli::countIn(1, cli::kMaxVectors));
   app.add_option("--vector-file", o.vector_file,
                  "replay a vector file (sim/vectors/vector_file.h, e.g. vectors/cycles/<unit>_<config>.vec): its "
                  "inputs, and its expected outputs checked as well")
@@ -65,29 +67,29 @@ void addOptions(CLI::App& app, CommandLine& c) {
   app.add_option("--save-vectors", o.save_vectors,
                  "write the run as a vector file: the inputs on the ports every cycle and the golden model's outputs");
   given.gap = app.add_option("--gap", o.gap, "spec: probability of dropping valid_i for 1..3 cycles (default 0.2)")
-                  ->check(CLI::Range(0.0, 0.9));
+                  ->check(cli::realIn(0.0, cli::kMaxGap));
   app.add_option("--prom", o.prom,
                  "spec: PROM hex file (default: the vector file's, else vectors/prom/spec_<config>.hex); it must hold "
                  "the configuration's table");
   given.triangles = app.add_option("--triangles", o.triangles,
                                    "span: seeded generator triangles (default 1000); with --scene: at most this many of "
                                    "the scene's descriptors")
-                        ->check(CLI::PositiveNumber);
+                        ->check(cli::countIn(1, cli::kMaxStreamTriangles));
   app.add_option("--scene", o.scene, "span: the descriptors of a scene's frame, e.g. builtin:sphere");
   given.ready = app.add_option("--ready", o.ready, "span: probability that out_ready is high on a cycle (default 0.8)")
-                    ->check(CLI::Range(0.05, 1.0));
+                    ->check(cli::realIn(cli::kMinReady, 1.0));
   given.desc_gap = app.add_option("--desc-gap", o.desc_gap,
                                   "span: probability that a descriptor waits 1..3 cycles before it is offered "
                                   "(default 0.1)")
-                       ->check(CLI::Range(0.0, 0.9));
-  app.add_option("--seed", o.seed, "random seed (stimulus and back-pressure)");
+                       ->check(cli::realIn(0.0, cli::kMaxGap));
+  app.add_option("--seed", o.seed, "random seed (stimulus and back-pressure)")->check(cli::countIn(0, UINT64_MAX));
   app.add_option("--fst", o.fst, "write an FST waveform of the unit (every signal) to this file");
   app.add_option("--fault", o.fault,
                  "fault injection in the golden-model module, to see the scoreboard fail: latency (predictions one "
                  "cycle late) or value (spec: one bit less of c^2 - c; span: attribute 0 one code off)")
       ->check(CLI::IsMember({"none", "latency", "value"}));
   app.add_option("--max-mismatches", o.max_mismatches, "stop after this many mismatches (default 16)")
-      ->check(CLI::PositiveNumber);
+      ->check(cli::countIn(1, 1'000'000));
   app.add_option("--fail-dir", o.fail_dir,
                  "on a mismatch, save the failing case alone here: <unit>_<config>_fail.vec (from reset, the failing "
                  "cycle last; spec: and the PROM copy .hex) and the FST waveform of its replay, "
@@ -245,7 +247,7 @@ int sc_main(int argc, char* argv[]) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    return cli::parseErrorExit(app, e, "shadesim_systemc");
   }
   if (o.config.empty()) o.config = o.unit == "spec" ? "default" : "serial";
   o.argv0 = argv[0];
@@ -254,11 +256,16 @@ int sc_main(int argc, char* argv[]) {
 
   ScReport r;
   try {
+    const RunInputs inputs;  // the files the run reads may not be its outputs (io/files.h)
     checkOptions(o, c.given);
+    cli::requireDirectoryArg("--fail-dir", o.fail_dir);
     r = runUnit(o);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "shadesim_systemc: error: out of memory\n");
+    return cli::kExitBadInput;
   } catch (const std::exception& e) {  // ArgError, files, configurations, SystemC elaboration errors
     std::fprintf(stderr, "shadesim_systemc: error: %s\n", e.what());
-    return 2;
+    return cli::kExitBadInput;
   }
 
   const ScFailCase& fc = r.fail;
@@ -269,10 +276,10 @@ int sc_main(int argc, char* argv[]) {
   }
   if (c.json) std::cout << reportJson(o, r, fr).dump(2) << std::endl;
   else std::cout << r.summary << std::endl;
-  if (r.score.passed() && r.complete) return 0;
+  if (r.score.passed() && r.complete) return cli::kExitOk;
   printFailure(o, r);
   printFailCase(o, fc, fr);
-  return 1;
+  return cli::kExitFailed;
 }
 
 // Our own main (IEEE 1666 lets an application call sc_elab_and_sim itself), only to keep the

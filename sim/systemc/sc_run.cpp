@@ -11,6 +11,7 @@
 #include <verilated_fst_sc.h>
 
 #include "cli/progress.h"
+#include "io/files.h"
 
 namespace fs = std::filesystem;
 
@@ -18,14 +19,14 @@ namespace shd {
 
 namespace {
 
-// An output file named by `option`: its directory is created and the file opened for writing.
+// An output file named by `option`, checked by the output policy (io/files.h) before the run:
+// a regular file or a new one in an existing directory, not one of the run's inputs.
 void prepareOutput(const std::string& path, const char* option) {
-  const fs::path dir = fs::absolute(path).parent_path();
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec) throw ArgError(fmt::format("{} {}: cannot create {}: {}", option, path, dir.string(), ec.message()));
-  std::ofstream probe(path, std::ios::app);
-  if (!probe) throw ArgError(fmt::format("{} {}: cannot write it", option, path));
+  try {
+    outputTarget(path);
+  } catch (const std::exception& e) {
+    throw ArgError(fmt::format("{}: {}", option, e.what()));
+  }
 }
 
 }  // namespace

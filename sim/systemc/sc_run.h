@@ -14,6 +14,7 @@
 
 #include <systemc>
 
+#include "cli/options.h"
 #include "sc_common.h"
 
 class VerilatedFstC;
@@ -22,9 +23,7 @@ class VerilatedFstSc;
 namespace shd {
 
 // Bad input (an argument, a file, a configuration): a message naming it, exit status 2.
-struct ArgError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+using cli::ArgError;
 
 struct ScOptions {
   std::string unit, config, vector_file, save_vectors, scene, prom, fst, fault = "none";
@@ -78,9 +77,9 @@ void requireBuilt(const ScOptions& o, const std::vector<std::string>& built, con
 void requireFileParams(const ScOptions& o, const std::string& file_config, const std::string& file_params,
                        const std::string& unit_params);
 
-// The output files named by --save-vectors and --fst: their directories are created and the
-// files opened for writing now, so that a path that cannot be written fails before the run
-// (ArgError), not after it.
+// The output files named by --save-vectors and --fst, checked by the output policy (io/files.h)
+// after the inputs are read and before the run, so that a path that cannot be written fails
+// before the run (ArgError), not after it; the program's directories are never created.
 void prepareOutputs(const ScOptions& o);
 
 // The stimulus as the command line gave it: "--vector-file F", "--scene S", "--seed N --vectors M"

@@ -340,8 +340,8 @@ ScReport runSpanSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
   requireBuilt(o, scSpanRtlConfigs(), "span unit");
   ScWaveform wave(o.fst);  // before the model
   const std::unique_ptr<SpanRtl> rtl = makeRtl(o);
-  prepareOutputs(o);
   SpanStimulus stim(o, rtl->params());
+  prepareOutputs(o);  // after the inputs are read: an output may not be one of them
   SpanBench tb(o, *rtl, stim, clk, rst_n);
 
   sc_core::sc_start(sc_core::SC_ZERO_TIME);  // elaborate: the waveform opens after it

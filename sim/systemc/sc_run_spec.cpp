@@ -219,15 +219,17 @@ void saveSpecVectors(const ScOptions& o, const SpecUnitParams& p, const PromTabl
   v.config = o.config;
   v.params = p;  // the unit's: the file replays on it (a fault shows in the source line)
   v.prom = prom;
+  OutputFiles out;  // the file and the PROM kept beside it: both or neither
   if (temp_prom) {
     const std::string kept = o.save_vectors + ".hex";
-    writeFileAtomic(kept, renderProm(table, PromFormat::Hex));
+    out.add(kept, renderProm(table, PromFormat::Hex));
     v.prom = fs::path(kept).filename().string();
   }
   v.source = savedVectorsSource(o);
   v.in = golden.recordedInputs();
   v.expected = golden.recordedOutputs();
-  writeSpecVectors(o.save_vectors, v);
+  out.add(o.save_vectors, renderSpecVectors(v));
+  out.commit();
 }
 
 // The failing case (sc_run.h, ScFailCase): the captured window of inputs, from reset, with the
