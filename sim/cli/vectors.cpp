@@ -44,13 +44,14 @@ class VectorsCmd final : public Command {
       const SpecUnitConfig cfg = specConfigArg("--config", config_);
       name = cfg.name;
       std::string prom_file = prom_;
-      if (!prom_file.empty()) noteInput(prom_file);  // the vectors refer to it: never their output
+      if (!prom_file.empty()) requirePromFileHoldsTable(cfg, prom_file);  // an input: never an output
+      OutputFiles files;  // the vector file and the PROM written beside it: both or neither
       if (prom_file.empty()) {
         prom_file = output_ + ".hex";
-        writeFileAtomic(prom_file, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl),
-                                              PromFormat::Hex));
+        files.add(prom_file, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl), PromFormat::Hex));
       }
-      writeSpecVectors(output_, generateSpecVectors(cfg, cycles_, seed_, prom_file, out_dir, &s));
+      files.add(output_, renderSpecVectors(generateSpecVectors(cfg, cycles_, seed_, prom_file, out_dir, &s)));
+      files.commit();
     } else {
       if (!prom_.empty()) throw ArgError("--prom: the span unit has no PROM");
       const SpanUnitConfig cfg = spanConfigArg("--config", config_);

@@ -44,11 +44,14 @@ struct VectorGenSummary {
   std::string text() const;
 };
 
-// The configuration's PROM table is built from its JSON; `prom_file` must hold exactly its words
-// (std::runtime_error naming the first differing address otherwise) and is referred to in the
-// header relative to `out_dir` (the directory the vector file goes to).
+// The configuration's PROM table is built from its JSON; `prom_file` is the file that holds it
+// (the caller writes it, or checks a given one with requirePromFileHoldsTable), referred to in
+// the header relative to `out_dir` (the directory the vector file goes to).
 SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& prom_file,
                                 const std::string& out_dir, VectorGenSummary* summary = nullptr);
+// `prom_file` must hold exactly the configuration's table: the expected outputs depend on it
+// (std::runtime_error naming the first differing address otherwise).
+void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& prom_file);
 
 SpanVectors generateSpanVectors(const SpanUnitConfig& cfg, uint64_t cycles, uint64_t seed,
                                 VectorGenSummary* summary = nullptr);
