@@ -19,6 +19,7 @@
 #include "image/metrics.h"
 #include "render/fixed_simd.h"
 #include "render/lobe_units.h"
+#include "render/methods.h"
 #include "render/render.h"
 #include "scene/scene.h"
 #include "io/files.h"
@@ -243,7 +244,7 @@ nlohmann::json RenderCmd::statistics(const Scene& sc, const RenderOptions& ro, c
   return j;
 }
 
-int RenderCmd::run(const CLI::App&) {
+int RenderCmd::run(const CLI::App& app) {
   std::string ext = fs::path(output_).extension().string();
   for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
   if (ext != ".png")
@@ -253,6 +254,16 @@ int RenderCmd::run(const CLI::App&) {
   RenderOptions ro;
   ro.method = parseMethod(method_);
   ro.brdf = brdf_;
+  // A lobe configuration no object evaluates with the specular unit would be silently unused.
+  const std::vector<Lobe> lobes = deviceLobesUsed(sc, ro);
+  for (const auto& [option, lobe] : {std::pair{"--quadratic-config", Lobe::Quadratic}, {"--cubic-config", Lobe::Cubic}})
+    if (app.count(option) > 0 && std::find(lobes.begin(), lobes.end(), lobe) == lobes.end())
+      throw ArgError(traits(ro.method).exact
+                         ? fmt::format("{} does not apply: --method {} evaluates every lobe exactly, without the "
+                                       "specular unit",
+                                       option, method_)
+                         : fmt::format("{} does not apply: no object of {} has the {} lobe (choose it with --brdf {})",
+                                       option, sc.name, toString(lobe), toString(lobe)));
   if (rtl_) requireRtl(sc, ro, span);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-render-{}", getpid());
   // The golden model, frame after frame into the same buffers as a renderer does.
