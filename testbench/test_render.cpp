@@ -353,7 +353,7 @@ TEST(RenderPipeline, ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle)
     renderModel(s, Method::Gouraud, "", "serial");
     FAIL() << "rendered";
   } catch (const std::range_error& e) {
-    EXPECT_NE(std::string(e.what()).find("object 'plane' triangle "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("builtin:plane: object 'plane' triangle "), std::string::npos) << e.what();
   }
 }
 

@@ -586,7 +586,7 @@ TEST(LoadMeshFile, AnImportThatAbortsIsAnError) {
 
 TEST(LoadMeshFile, MissingFileAndDirectory) {
   EXPECT_EQ(meshErrorOf("/nonexistent/dir/mesh.obj"), "/nonexistent/dir/mesh.obj: no such file");
-  EXPECT_EQ(meshErrorOf(kModels), kModels + ": not a regular file");
+  EXPECT_EQ(meshErrorOf(kModels), kModels + ": it is a directory; inputs are read only from regular files");
 }
 
 TEST(LoadMeshFile, TruncatedFilesAreErrors) {
@@ -855,7 +855,13 @@ TEST(SceneFile, NotJsonOrMissing) {
   const std::string f = tmp.write("trunc.json", R"j({"objects": [{"mesh": "builtin:sph)j");
   const std::string e = sceneErrorOf(f);
   EXPECT_EQ(e.rfind(f + ": not valid JSON", 0), 0u) << e;
-  EXPECT_EQ(sceneErrorOf("/nonexistent/scene.json"), "/nonexistent/scene.json: no such scene file");
+  EXPECT_EQ(sceneErrorOf("/nonexistent/scene.json"), "/nonexistent/scene.json: no such file");
+  // A repeated key would silently keep the last value: an error naming the key.
+  const std::string twice = tmp.write("twice.json", R"j({"objects": [{"mesh": "builtin:sphere", "mesh": "x.obj"}]})j");
+  EXPECT_EQ(sceneErrorOf(twice), twice + ": key \"mesh\" appears twice in one object");
+  // An OFF face naming a vertex past the last, which assimp clamps and only logs.
+  const std::string off = tmp.write("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  EXPECT_EQ(sceneErrorOf(off), off + ": assimp reported an error: OFF: Vertex index is out of range");
 }
 
 }  // namespace

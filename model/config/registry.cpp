@@ -1,8 +1,10 @@
 #include "config/registry.h"
 #include "device/prom.h"
 #include "io/files.h"
+#include "io/json_strict.h"
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -25,9 +27,11 @@ namespace {
 nlohmann::json parseObject(const std::string& text, const std::string& where) {
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+    j = parseJsonStrict(text);
+  } catch (const nlohmann::json::exception& e) {  // parse_error; out_of_range for 1e999
     throw std::invalid_argument(fmt::format("{}: not valid JSON: {}", where, e.what()));
+  } catch (const std::invalid_argument& e) {  // a repeated key
+    throw std::invalid_argument(fmt::format("{}: {}", where, e.what()));
   }
   if (!j.is_object()) throw std::invalid_argument(fmt::format("{}: must hold a JSON object", where));
   return j;
@@ -63,8 +67,11 @@ PromContent promFromJson(const nlohmann::json& value, const std::string& where) 
 }
 
 std::string readFile(const std::string& path) {
+  // A configuration is a few hundred bytes.
+  if (const std::string why = inputFileProblem(path, uint64_t{1} << 20); !why.empty())
+    throw std::invalid_argument(fmt::format("{}: {}", path, why));
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(fmt::format("{}: cannot open it", path));
+  if (!in) throw std::invalid_argument(fmt::format("{}: cannot open it: {}", path, std::strerror(errno)));
   noteInput(path);
   std::ostringstream s;
   s << in.rdbuf();

@@ -294,6 +294,10 @@ std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int de
     throw std::invalid_argument(fmt::format("readPromHex: word width {} outside 1..128", word_bits));
   if (depth < 1) throw std::invalid_argument(fmt::format("readPromHex: depth {} below 1", depth));
 
+  // A hex file of the widest table: 2^16 words of 32 digits and a newline, with room for comments.
+  constexpr uint64_t kMaxPromFileBytes = uint64_t{16} << 20;
+  if (const std::string why = inputFileProblem(path, kMaxPromFileBytes); !why.empty())
+    throw std::runtime_error(fmt::format("cannot read PROM file {}: {}", path, why));
   std::ifstream in(path);
   if (!in) throw std::runtime_error(fmt::format("cannot open PROM file {}: {}", path, errnoText(errno)));
   noteInput(path);

@@ -139,6 +139,8 @@ void writePng(const std::string& path, const Image& img) { writeFileAtomic(path,
 Image readPng(const std::string& path) {
   // The whole file first (PNGs here are a few MB at most): errno names an open failure, and the
   // tail can be checked, which libpng's simplified reader does not do (it stops after IDAT).
+  if (const std::string why = inputFileProblem(path, uint64_t{256} << 20); !why.empty())
+    throw std::runtime_error(fmt::format("cannot read PNG '{}': {}", path, why));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(fmt::format("cannot read PNG '{}': open: {}", path, std::strerror(errno)));
   noteInput(path);

@@ -115,6 +115,17 @@ void noteInput(const std::string& path) {
   g_inputs.push_back({st.st_dev, st.st_ino, path});
 }
 
+std::string inputFileProblem(const std::string& path, uint64_t max_bytes) {
+  struct stat st {};
+  if (path.empty()) return "an empty file name";
+  if (::stat(path.c_str(), &st) != 0) return errno == ENOENT ? "no such file" : std::strerror(errno);
+  if (!S_ISREG(st.st_mode)) return fmt::format("it is {}; inputs are read only from regular files", kindOf(st.st_mode));
+  if (static_cast<uint64_t>(st.st_size) > max_bytes)
+    return fmt::format("{} bytes, more than the {} bytes a file of this kind may have", st.st_size, max_bytes);
+  if (::access(path.c_str(), R_OK) != 0) return std::strerror(errno);
+  return {};
+}
+
 std::string outputTarget(const std::string& path) {
   if (path.empty()) throw std::runtime_error("cannot write '': an empty file name");
   std::string target = path;

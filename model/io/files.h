@@ -13,6 +13,7 @@
 // Errors are std::runtime_error naming the path and what is wrong.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,6 +34,12 @@ class RunInputs {
 // Records that the run reads `path` (a file that exists); every reader of an input file calls
 // it. Thread-safe.
 void noteInput(const std::string& path);
+
+// Why `path` cannot be an input file: "" if it is a readable regular file of at most max_bytes,
+// else the reason ("no such file", "it is a FIFO; ...", "<n> bytes, more than ..."). Every
+// reader calls it before opening a file, so that a FIFO does not block and /dev/zero does not
+// fill the memory.
+std::string inputFileProblem(const std::string& path, uint64_t max_bytes);
 
 // The path an output to `path` replaces: `path` itself, or the file a symbolic link names
 // (relative links resolved against the link's directory, chains followed). Throws when the

@@ -109,7 +109,7 @@ void SceneDrawer::drawObject(size_t oi) {
   try {
     for (; ti < obj.mesh.triangles.size(); ++ti) drawMeshTriangle(obj.mesh.triangles[ti], static_cast<uint32_t>(ti));
   } catch (const std::range_error& e) {
-    throw std::range_error(fmt::format("object '{}' triangle {}: {}", obj.name, ti, e.what()));
+    throw std::range_error(fmt::format("{}: object '{}' triangle {}: {}", scene_.name, obj.name, ti, e.what()));
   }
   for (const auto& u : f_.units()) u.second->endObject();
 }

@@ -186,9 +186,7 @@ std::string describeSignal(int sig) {
 }  // namespace
 
 Mesh loadMeshFile(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  if (const std::string why = inputFileProblem(path, kMaxMeshFileBytes); !why.empty()) fail(path, why);
   noteInput(path);
   int fds[2];
   if (pipe(fds) != 0) throw std::system_error(errno, std::generic_category(), "pipe");

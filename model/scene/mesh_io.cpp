@@ -1,6 +1,8 @@
 // importMeshInProcess: mesh files through assimp 5.2 (the policy is documented in
 // scene/scene.h; loadMeshFile runs it in a child process, mesh_child.cpp).
+#include <assimp/DefaultLogger.hpp>
 #include <assimp/Importer.hpp>
+#include <assimp/LogStream.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
@@ -15,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "io/files.h"
 #include "scene/scene.h"
 
 namespace shd {
@@ -71,12 +74,40 @@ void checkFaces(const std::string& path, const aiScene* scene) {
   }
 }
 
+// assimp reports some malformed input only in its log and goes on with a repaired guess (an OFF
+// face naming a vertex past the last is clamped to the last vertex, "OFF: Vertex index is out of
+// range"). Its error messages are collected while a file is imported; one about an index out of
+// range fails the import, since the geometry is no longer the file's. (Its other errors are
+// about what shadesim does not read, such as unsupported chunks or missing materials.)
+class ErrorLog final : public Assimp::LogStream {
+ public:
+  explicit ErrorLog(std::vector<std::string>& out) : out_(out) {}
+  void write(const char* message) override {
+    std::string m(message);
+    while (!m.empty() && (m.back() == '\n' || m.back() == '\r')) m.pop_back();
+    const size_t colon = m.find(": ");  // "Error, T0: <text>"
+    out_.push_back(colon == std::string::npos ? m : m.substr(colon + 2));
+  }
+
+ private:
+  std::vector<std::string>& out_;
+};
+
+struct AssimpErrors {
+  std::vector<std::string> messages;
+  AssimpErrors() {
+    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+    Assimp::DefaultLogger::get()->attachStream(new ErrorLog(messages), Assimp::Logger::Err);  // the logger owns it
+  }
+  ~AssimpErrors() { Assimp::DefaultLogger::kill(); }
+  AssimpErrors(const AssimpErrors&) = delete;
+  AssimpErrors& operator=(const AssimpErrors&) = delete;
+};
+
 }  // namespace
 
 Mesh importMeshInProcess(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) fail(path, "no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) fail(path, "not a regular file");
+  if (const std::string why = inputFileProblem(path, kMaxMeshFileBytes); !why.empty()) fail(path, why);
   checkPlyHeader(path);
 
   // Two stages: the plain import, a check of its faces, then the post-processing. Merging
@@ -86,10 +117,14 @@ Mesh importMeshInProcess(const std::string& path) {
   // indices), instead of reporting an error.
   constexpr unsigned kPostFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                   aiProcess_GenSmoothNormals | aiProcess_PreTransformVertices;
+  const AssimpErrors log;
   Assimp::Importer importer;
   const aiScene* scene = nullptr;
   try {
     scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+    for (const std::string& m : log.messages)
+      if (scene != nullptr && m.find("out of range") != std::string::npos)
+        fail(path, fmt::format("assimp reported an error: {}", m));
     if (scene != nullptr) {
       checkFaces(path, scene);
       scene = importer.ApplyPostProcessing(kPostFlags);

@@ -2,11 +2,14 @@
 // files (scene/scene.h documents all of it; loadMeshFile is in mesh_io.cpp).
 #include "scene/scene.h"
 #include "io/files.h"
+#include "io/json_strict.h"
 
 #include <cctype>
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
@@ -577,6 +580,9 @@ class SceneReader {
         while (e != nullptr && *e == ' ') ++e;
         if (e == b || *e != '\0' || !std::isfinite(v))
           fail(path, fmt::format("'{}': '{}' is not a number", src, item));
+        // Sizes are in the range of a scale factor (the counts are checked below).
+        if (!(v >= kMinSceneScale && v <= kMaxSceneScale))
+          fail(path, fmt::format("'{}': {} is out of range [{}, {}]", src, v, kMinSceneScale, kMaxSceneScale));
         args.push_back(v);
       }
     }
@@ -643,17 +649,20 @@ class SceneReader {
 };
 
 Scene loadSceneFile(const std::string& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec))
-    throw SceneError(fmt::format("{}: no such scene file", file));
-  std::ifstream in(file);
-  if (!in) throw SceneError(fmt::format("{}: cannot open", file));
+  if (const std::string why = inputFileProblem(file, kMaxSceneFileBytes); !why.empty())
+    throw SceneError(fmt::format("{}: {}", file, why));
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw SceneError(fmt::format("{}: cannot open it: {}", file, std::strerror(errno)));
   noteInput(file);
+  std::ostringstream text;
+  text << in.rdbuf();
   json root;
   try {
-    root = json::parse(in);
+    root = parseJsonStrict(text.str());
   } catch (const json::exception& e) {  // parse_error; out_of_range for 1e999
     throw SceneError(fmt::format("{}: not valid JSON: {}", file, e.what()));
+  } catch (const std::invalid_argument& e) {  // a repeated key
+    throw SceneError(fmt::format("{}: {}", file, e.what()));
   }
   return SceneReader(file).read(root);
 }

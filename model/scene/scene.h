@@ -27,7 +27,8 @@
 //   - camera: each field optional (the defaults are Camera's, i.e. the default scene's);
 //     width, height integers in 1..4096; px_per_unit and z_near in [1e-6, 1e6]; eye != target.
 //   - positions (camera eye and target, point lights, translations): each coordinate within
-//     +-1e6 (kMaxSceneCoord); rotate_deg within +-360; scale factors of magnitude [1e-6, 1e6].
+//     +-1e6 (kMaxSceneCoord); rotate_deg within +-360; scale factors of magnitude [1e-6, 1e6],
+//     and the sizes of builtin meshes in [1e-6, 1e6].
 //     Inside these limits double precision resolves a position to 1e-10 units, far below a
 //     pixel; a projection that still leaves the clipper's exact range is refused by the
 //     renderer (render/pipeline.h, kMaxClipCoord).
@@ -166,6 +167,10 @@ struct Scene {
 // The limits of a scene file's values (above).
 constexpr double kMaxSceneCoord = 1e6;
 constexpr double kMinSceneScale = 1e-6, kMaxSceneScale = 1e6;
+// The largest scene file and mesh file read (a scene file is a few kB; meshes are imported in a
+// child process with a memory limit of their own, loadMeshFile).
+constexpr uint64_t kMaxSceneFileBytes = uint64_t{16} << 20;
+constexpr uint64_t kMaxMeshFileBytes = uint64_t{1} << 30;
 
 // A clear error naming the file (or builtin) and the field.
 struct SceneError : std::runtime_error {

@@ -47,6 +47,19 @@ int run(int argc, char** argv) {
     subs.emplace_back(sub, c.make());
     subs.back().second->add(*sub);
   }
+  // A first word that is no command is named (CLI11 would only say that a command is missing).
+  if (argc > 1 && argv[1][0] != '-') {
+    bool known = false;
+    std::string names;
+    for (const CommandInfo& c : commands()) {
+      known = known || c.name == std::string(argv[1]);
+      names += (names.empty() ? "" : ", ") + std::string(c.name);
+    }
+    if (!known) {
+      std::fprintf(stderr, "shadesim: error: unknown command '%s' (commands: %s)\n", argv[1], names.c_str());
+      return kExitBadInput;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -64,6 +64,7 @@ inline CLI::Validator countIn(uint64_t lo, uint64_t hi) {
   const std::string range = fmt::format("a whole number in [{}, {}]", lo, hi);
   return CLI::Validator(
       [lo, hi, range](std::string& s) -> std::string {
+        // 20 digits hold every 64-bit value; longer is out of range anyway.
         bool digits = !s.empty() && s.size() <= 20;
         for (char ch : s) digits = digits && ch >= '0' && ch <= '9';
         if (!digits) return fmt::format("'{}' is not {}", s, range);

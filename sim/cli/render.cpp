@@ -265,6 +265,13 @@ int RenderCmd::run(const CLI::App& app) {
                          : fmt::format("{} does not apply: no object of {} has the {} lobe (choose it with --brdf {})",
                                        option, sc.name, toString(lobe), toString(lobe)));
   if (rtl_) requireRtl(sc, ro, span);
+  // The outputs are checked now, after the inputs are read and before any work (io/files.h),
+  // and written at the end as one set.
+  const fs::path out(output_);
+  const std::string stem = (out.parent_path() / out.stem()).string();
+  const std::vector<std::string> outputs = {output_, stem + "_reference.png", stem + "_error.png"};
+  for (const std::string& o : outputs) outputTarget(o);
+  if (!json_path_.empty()) outputTarget(json_path_);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-render-{}", getpid());
   // The golden model, frame after frame into the same buffers as a renderer does.
   Engines model = makeEngines(sc, ro, span, false, tmp);
@@ -300,12 +307,10 @@ int RenderCmd::run(const CLI::App& app) {
     if (!hw->first_mismatch.empty()) j["first_mismatch"] = hw->first_mismatch;
   }
   // Every output is written only now, as one set (io/files.h): a failure leaves none of them.
-  const fs::path out(output_);
-  const std::string stem = (out.parent_path() / out.stem()).string();
   OutputFiles files;
-  files.add(output_, encodePng(output_, toImage(res.fb)));
-  files.add(stem + "_reference.png", encodePng(stem + "_reference.png", c.reference));
-  files.add(stem + "_error.png", encodePng(stem + "_error.png", c.heat));
+  files.add(outputs[0], encodePng(outputs[0], toImage(res.fb)));
+  files.add(outputs[1], encodePng(outputs[1], c.reference));
+  files.add(outputs[2], encodePng(outputs[2], c.heat));
   if (!json_path_.empty()) files.add(json_path_, j.dump(2) + "\n");
   files.commit();
   const RenderStats& st = res.stats;

@@ -7,7 +7,6 @@
 
 #include "cli/command.h"
 #include "cosim/replay.h"
-#include "io/files.h"
 
 namespace shd::cli {
 
@@ -24,11 +23,8 @@ class ReplayCmd final : public Command {
   }
 
   int run(const CLI::App&) override {
-    // The inputs first, then the waveform's target checked by the output policy (io/files.h):
-    // the FST writer is not atomic, and must not replace an input or a device.
-    noteInput(file_);
-    if (!prom_.empty()) noteInput(prom_);
-    if (!fst_.empty()) outputTarget(fst_);
+    // replayVectorFile checks the waveform's target by the output policy (io/files.h) once it
+    // has read the file and its PROM: the FST writer is not atomic.
     ReplayOptions o;
     o.fst_path = fst_;
     o.prom_path = prom_;

@@ -44,6 +44,7 @@ class SpanCyclesCmd final : public Command {
   }
 
   int run(const CLI::App&) override {
+    if (!json_out_.empty()) outputTarget(json_out_);  // refused before the work, not after it
     const std::vector<SpanUnitConfig> modes = spanCyclesConfigs();
     if (rtl_)
       for (const SpanUnitConfig& m : modes) requireVerilated(m);

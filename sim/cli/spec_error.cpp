@@ -32,6 +32,7 @@ class SpecErrorCmd final : public Command {
   int run(const CLI::App&) override {
     SpecUnitConfig cfg;
     const PromTable t = table_.build(cfg, false);
+    if (!json_out_.empty()) outputTarget(json_out_);  // refused before the work, not after it
     Progress progress(fmt::format("spec-error {}", toString(t.request.fit)), !quiet_);
     auto prog = [&](size_t done, size_t total) {
       progress.update(static_cast<double>(done), static_cast<double>(total), "n");

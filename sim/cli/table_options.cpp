@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "cli/command.h"
+#include "cli/options.h"
 
 namespace shd::cli {
 
@@ -12,7 +13,7 @@ void TableOptions::add(CLI::App& app) {
       ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax"}));
   app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)")
       ->check(realIn(0, 1, Ends::Open));
-  app.add_option("--degree", degree, "2 (quadratic) or 3 (cubic)")->check(CLI::IsMember({2, 3}));
+  app.add_option("--degree", degree, "2 (quadratic) or 3 (cubic)")->check(countIn(2, 3));
   auto* n_opt = app.add_option("--n", n, "shininess range lo:hi[:step], each in [1, 1000]");
   auto* list_opt = app.add_option("--n-list", n_list, "explicit shininess list, e.g. 8,32,200");
   n_opt->excludes(list_opt);

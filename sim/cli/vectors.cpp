@@ -28,7 +28,7 @@ class VectorsCmd final : public Command {
         ->required();
     app.add_option("--cycles", cycles_, "clock cycles after reset (the file holds exactly this many)")
         ->required()
-        ->check(countIn(1, 100'000'000));
+        ->check(countIn(1, 10'000'000));
     app.add_option("--seed", seed_, "stimulus seed")->check(countIn(0, UINT64_MAX));
     app.add_option("-o,--output", output_, "the vector file to write")->required();
     app.add_option("--prom", prom_,
@@ -45,6 +45,7 @@ class VectorsCmd final : public Command {
       name = cfg.name;
       std::string prom_file = prom_;
       if (!prom_file.empty()) requirePromFileHoldsTable(cfg, prom_file);  // an input: never an output
+      outputTarget(output_);  // refused before the work, not after it
       OutputFiles files;  // the vector file and the PROM written beside it: both or neither
       if (prom_file.empty()) {
         prom_file = output_ + ".hex";
@@ -55,6 +56,7 @@ class VectorsCmd final : public Command {
     } else {
       if (!prom_.empty()) throw ArgError("--prom: the span unit has no PROM");
       const SpanUnitConfig cfg = spanConfigArg("--config", config_);
+      outputTarget(output_);
       name = cfg.name;
       writeSpanVectors(output_, generateSpanVectors(cfg, cycles_, seed_, &s));
     }

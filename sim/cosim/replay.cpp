@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "device/prom_io.h"
+#include "io/files.h"
 #include "harness/span_dut.h"
 #include "cosim/spec_cosim.h"
 #include "harness/spec_dut.h"
@@ -73,6 +74,8 @@ ReplayResult replaySpec(const std::string& path, const ReplayOptions& opts) {
   if (opts.prom_path.empty() && fs::path(prom).is_relative()) prom = (fs::absolute(path).parent_path() / prom).string();
   prom = fs::absolute(prom).lexically_normal().string();
   const std::vector<PromWord> words = readPromHex(prom, p.promWordBits(), p.promDepth());
+  // Every input is read: the waveform (written as it runs, not atomically) may replace none.
+  if (!opts.fst_path.empty()) outputTarget(opts.fst_path);
   auto dut = makeSpecDut(v.config, SpecDutOptions{prom, opts.fst_path});
   verifyLoadedProm(*dut, words, prom, p);
   dut->reset();
@@ -99,6 +102,7 @@ ReplayResult replaySpan(const std::string& path, const ReplayOptions& opts) {
   ReplayResult r;
   r.unit = "span";
   r.config = v.config;
+  if (!opts.fst_path.empty()) outputTarget(opts.fst_path);  // after the input (see replaySpec)
   auto dut = makeSpanDut(v.config, opts.fst_path);  // names the built configurations if unknown
   const SpanParams& p = v.params;
   if (dut->params().toJson() != p.toJson())

@@ -1,5 +1,6 @@
 #include "vectors/vector_file.h"
 
+#include <cstring>
 #include <fstream>
 #include <map>
 #include <sstream>
@@ -64,12 +65,21 @@ struct Line {
   std::string text;
 };
 
+// A vector file opened for reading after the input checks (io/files.h): a regular file of at
+// most 1 GB (the largest file `shadesim vectors` writes, 10^7 cycles, is well under it).
+std::ifstream openVectorFile(const std::string& path) {
+  if (const std::string why = inputFileProblem(path, uint64_t{1} << 30); !why.empty())
+    throw std::runtime_error(fmt::format("cannot read vector file {}: {}", path, why));
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(fmt::format("cannot open vector file {}: {}", path, std::strerror(errno)));
+  noteInput(path);
+  return in;
+}
+
 class VectorReader {
  public:
   explicit VectorReader(const std::string& path) : path_(path) {
-    std::ifstream in(path);
-    if (!in) throw std::runtime_error(fmt::format("cannot open vector file {}", path));
-    noteInput(path);
+    std::ifstream in = openVectorFile(path);
     std::string s;
     long no = 0;
     while (std::getline(in, s)) {
@@ -77,6 +87,13 @@ class VectorReader {
       if (!s.empty() && s.back() == '\r') s.pop_back();
       if (s.find_first_not_of(" \t") == std::string::npos) continue;
       if (s[0] == '#') {
+        // The first line names the format; a file of another format is not read as this one.
+        static const std::string kFormatLine = "# shadesim vector file, format ";
+        if (no == 1 && s.compare(0, kFormatLine.size(), kFormatLine) == 0) {
+          const std::string version = s.substr(kFormatLine.size(), s.find(' ', kFormatLine.size()) - kFormatLine.size());
+          if (version != std::to_string(kVectorFormat))
+            throw error(no, fmt::format("format {}; this shadesim reads format {}", version, kVectorFormat));
+        }
         // "# <key> <value>" header lines; every other '#' line is a comment.
         const size_t k0 = s.find_first_not_of(' ', 1);
         if (k0 != std::string::npos) {
@@ -158,8 +175,11 @@ std::vector<std::string> tokens(const std::string& s) {
 // A hex token of a `bits`-bit port; signed: sign-extended from `bits`.
 int64_t parseField(const VectorReader& r, const Line& line, const std::string& tok, int bits, bool is_signed,
                    const std::string& name) {
-  if (tok.empty() || tok.size() > 16 || tok.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
+  if (tok.empty() || tok.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos)
     throw r.error(line.no, fmt::format("{}: '{}' is not a hex value", name, tok));
+  if (tok.size() > 16)
+    throw r.error(line.no, fmt::format("{}: 0x{} has {} hex digits: wider than its {}-bit port", name, tok,
+                                       tok.size(), bits));
   const uint64_t v = std::stoull(tok, nullptr, 16);
   if (bits < 64 && (v >> bits) != 0)
     throw r.error(line.no, fmt::format("{}: 0x{} does not fit its {}-bit port", name, tok, bits));
@@ -429,8 +449,7 @@ SpanVectors loadSpanVectors(const std::string& path) {
 }
 
 std::string vectorFileUnit(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(fmt::format("cannot open vector file {}", path));
+  std::ifstream in = openVectorFile(path);
   for (std::string s; std::getline(in, s);) {
     if (s.rfind("# unit ", 0) == 0) {
       const size_t v = s.find_first_not_of(' ', 7);
