@@ -264,7 +264,8 @@ TEST(TriangleSetup, DegenerateAndOutsideAreDroppedWithAReason) {
   const RasterConfig c = configFor("serial");
   EXPECT_EQ(setupTriangle({vtx(1, 1), vtx(1, 1), vtx(5, 9)}, 1, c).dropped, "zero area");
   EXPECT_EQ(setupTriangle({vtx(1, 1), vtx(3, 3), vtx(7, 7)}, 1, c).dropped, "zero area");
-  EXPECT_EQ(setupTriangle({vtx(-20, -20), vtx(-10, -20), vtx(-20, -5)}, 1, c).dropped, "outside the viewport");
+  EXPECT_EQ(setupTriangle({vtx(-20, -20), vtx(-10, -20), vtx(-20, -5)}, 1, c).dropped,
+            "no pixel centre of its bounding box in the viewport");
   EXPECT_THROW(setupTriangle({vtx(NAN, 1), vtx(3, 3), vtx(7, 1)}, 1, c), std::invalid_argument);
   EXPECT_THROW(setupTriangle({vtx(1e6, 1), vtx(3, 3), vtx(7, 1)}, 1, c), std::invalid_argument);
   EXPECT_THROW(setupTriangle({vtx(1, 1, {1e30, 0, 0, 0}), vtx(3, 3), vtx(7, 1)}, 1, c), std::invalid_argument);

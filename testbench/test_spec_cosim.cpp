@@ -176,7 +176,7 @@ TEST(SpecCosim, CorruptShortOrMissingPromFailsLoudly) {
   writeFileAtomic(s.prom_path + ".flip.hex", renderProm(bad, PromFormat::Hex));
   expectFailure(s.prom_path + ".flip.hex", "word 500");
   // Missing.
-  expectFailure(s.prom_path + ".missing.hex", "cannot open");
+  expectFailure(s.prom_path + ".missing.hex", "missing.hex: no such file");
   // Short: the last 24 lines cut off.
   std::ifstream full(s.prom_path);
   std::vector<std::string> lines;

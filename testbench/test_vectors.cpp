@@ -230,7 +230,8 @@ TEST(VectorFile, ReadersRejectMalformedFilesNamingTheLine) {
     EXPECT_NE(err.find(c.needle), std::string::npos) << c.name << ": " << err;
     EXPECT_NE(err.find(p.string() + ":"), std::string::npos) << c.name << ": " << err;  // path:line
   }
-  EXPECT_NE(errorOf([&] { vectorFileUnit((dir / "missing.vec").string()); }).find("cannot open"), std::string::npos);
+  EXPECT_NE(errorOf([&] { vectorFileUnit((dir / "missing.vec").string()); }).find("missing.vec: no such file"),
+            std::string::npos);
   spit(dir / "plain.txt", "1 0 0\n");
   EXPECT_NE(errorOf([&] { vectorFileUnit((dir / "plain.txt").string()); }).find("not a shadesim vector file"),
             std::string::npos);
@@ -303,7 +304,7 @@ TEST(Replay, RefusesFilesItCannotReplayFaithfully) {
   EXPECT_NE(errorOf([&] { replayVectorFile((dir / "unknown.vec").string()); }).find("not verilated"), std::string::npos);
   // A PROM that is missing, or holds another configuration's table.
   fs::remove(dir / "default.hex");
-  EXPECT_NE(errorOf([&] { replayVectorFile(spec.string()); }).find("cannot open PROM file"), std::string::npos);
+  EXPECT_NE(errorOf([&] { replayVectorFile(spec.string()); }).find("cannot read PROM file"), std::string::npos);
   const SpecUnitConfig narrow = specConfig("narrow");
   writeFileAtomic((dir / "default.hex").string(),
                   renderProm(buildPromTable(PromRequest::fromContent(narrow.prom), narrow.rtl), PromFormat::Hex));

@@ -16,7 +16,7 @@ class DescriptorStream {
  public:
   DescriptorStream(uint64_t seed, uint64_t count, RasterConfig cfg, TriGenOptions gen = {});
   // The next descriptor; false after `count` generator triangles. Triangles setup drops
-  // (zero area, outside the viewport) are counted and skipped.
+  // (zero area, no pixel centre in the viewport) are counted and skipped.
   bool next(SpanDesc& d);
   uint64_t generated() const { return generated_; }
   uint64_t dropped() const { return dropped_; }

@@ -187,7 +187,9 @@ void buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
     t.clip_x0 = static_cast<int32_t>(-ox);
     t.clip_x1 = static_cast<int32_t>(W - 1 - ox);
   }
-  if (r0 > r1) return;  // no rows: row_first > row_last
+  // Columns the same way: a triangle wholly left or right of the viewport has no pixel in it.
+  const auto [c0, c1] = centreRows(*std::min_element(g.xu.begin(), g.xu.end()), *std::max_element(g.xu.begin(), g.xu.end()), S);
+  if (r0 > r1 || c1 < t.clip_x0 || c0 > t.clip_x1) return;  // no rows: row_first > row_last
   requireCoord(r0, p, "lane-triangle first row");
   requireCoord(r1, p, "lane-triangle last row");
   t.row_first = static_cast<int32_t>(r0);
@@ -251,6 +253,11 @@ void RasterConfig::validate() const {
                                             height, unit.CoordBits));
   if (subpixel_bits < 1 || subpixel_bits > 8)
     throw std::invalid_argument(fmt::format("subpixel_bits {} must be in 1..8", subpixel_bits));
+  // An edge divisor D = |dY| 2^(S+1) (u units) reaches 2^(CoordBits + 2S) across the guard band.
+  if (unit.CoordBits + 2 * subpixel_bits + 1 > unit.RemBits)
+    throw std::invalid_argument(fmt::format("subpixel_bits {} needs RemBits >= CoordBits + 2 S + 1 = {} (the edge divisor "
+                                            "across the guard band); RemBits is {}",
+                                            subpixel_bits, unit.CoordBits + 2 * subpixel_bits + 1, unit.RemBits));
   if (!attr_frac_bits.empty() && static_cast<int>(attr_frac_bits.size()) != unit.NumAttr)
     throw std::invalid_argument(fmt::format("attr_frac_bits has {} entries, NumAttr is {}", attr_frac_bits.size(), unit.NumAttr));
   for (int k = 0; k < unit.NumAttr; ++k)
@@ -370,7 +377,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   }
   if (!any) {
     res.desc.reset();
-    res.dropped = "outside the viewport";
+    res.dropped = "no pixel centre of its bounding box in the viewport";
     return res;
   }
   d.tag = tag;

@@ -19,8 +19,11 @@
 //   direction, so exactly one of the two is top/left) is drawn exactly once.
 //
 // Degenerate triangles (the stated rule): det == 0 (zero area: repeated or collinear vertices)
-//   covers no pixel and is dropped at setup without a division; so is a triangle with no pixel
-//   centre inside the viewport. setupTriangle() then returns no descriptor and says why.
+//   covers no pixel and is dropped at setup without a division; so is a triangle whose bounding
+//   box holds no pixel centre of the viewport (wholly above, below, left or right of it, or too
+//   small to reach a centre row or column). setupTriangle() then returns no descriptor and says
+//   why. A triangle whose box holds centres but that covers none (a sliver passing between them)
+//   is walked and yields no fragment: knowing that takes the walk.
 //
 // Attribute planes (the corrected 4.1 of docs/paper-corrections.md: the plane gradient with det as denominator)
 //   Vertex attribute k is quantised to a code a_i = round(value * 2^F_k) (F_k = attr_frac_bits).
@@ -101,7 +104,7 @@ struct AttributePlane {
 
 struct SetupResult {
   std::optional<SpanDesc> desc;  // empty: nothing to draw, see `dropped`
-  std::string dropped;           // "zero area", "outside the viewport"
+  std::string dropped;           // "zero area", "no pixel centre of its bounding box in the viewport"
   SnappedTriangle tri;
   std::array<EdgeFunction, 3> edges;  // of the whole triangle, screen pixel coordinates
   AttributePlane plane;               // screen pixel coordinates

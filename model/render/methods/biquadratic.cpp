@@ -5,7 +5,8 @@
 // quadratic Lagrange basis on barycentric coordinates,
 // I = sum c_i l_i (2 l_i - 1) + sum 4 c_ij l_i l_j, evaluated here directly: no solve, no
 // conditioning problem. Per pixel (not a span-unit increment: a quadratic has no constant
-// step); coverage and depth from the span unit, fragment by fragment.
+// step); coverage and depth from the span unit, fragment by fragment, and the barycentric
+// coordinates on the triangle it draws (the snapped one: a sliver's stay in [0, 1]).
 #include <algorithm>
 
 #include "render/draw.h"
@@ -27,7 +28,7 @@ class BiquadraticUnit final : public MethodUnit {
     }
     // The quadratic Lagrange basis: vertices c_i, edge midpoints c_ij.
     f_.drawColours(t, [&](int32_t x, int32_t y) {
-      const std::array<double, 3> l = barycentric(t.v, x, y);
+      const std::array<double, 3> l = barycentricSnapped(t, x, y);
       std::array<double, 3> lsb{};
       for (size_t k = 0; k < 3; ++k) {
         double v = 0;
