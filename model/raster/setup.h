@@ -96,9 +96,13 @@ struct EdgeFunction {
 struct AttributePlane {
   int64_t xref = 0, yref = 0;
   AttrVec iref, didx, didy;  // codes (not wrapped)
+  // In 128 bits: with wide attributes (AttrBits up to 62) a product can leave int64 at a covered
+  // pixel of a sliver although the sum fits (setup checks that the values it hands on fit).
   int64_t at(int k, int64_t px, int64_t py) const {
     const size_t i = static_cast<size_t>(k);
-    return iref[i] + didx[i] * (px - xref) + didy[i] * (py - yref);
+    using i128 = __int128;
+    return static_cast<int64_t>(static_cast<i128>(iref[i]) + static_cast<i128>(didx[i]) * (px - xref) +
+                                static_cast<i128>(didy[i]) * (py - yref));
   }
 };
 

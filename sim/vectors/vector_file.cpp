@@ -370,6 +370,7 @@ SpanVectors loadSpanVectors(const std::string& path) {
   const SpanParams& p = v.params;
   const int CB = p.CoordBits, AB = p.AttrBits, RB = p.RemBits, PB = p.PixBits, K = p.NumAttr, L = p.lanes();
   bool pending = false;  // the last cycle offered a descriptor that was not accepted
+  long unused_d = 0;     // the line of a D record no C record has followed yet (0: none)
   for (const Line& line : r.data()) {
     std::vector<std::string> toks = tokens(line.text);
     const std::string kind = toks[0];
@@ -377,6 +378,10 @@ SpanVectors loadSpanVectors(const std::string& path) {
     if (kind == "D") {
       if (pending)
         throw r.error(line.no, "a D record while the previous descriptor is offered and not accepted (valid/ready rule)");
+      // A descriptor is on the ports from its D record on: one that no cycle saw is no stimulus.
+      if (unused_d != 0)
+        throw r.error(line.no, fmt::format("a D record replaces the descriptor of line {} before any C record", unused_d));
+      unused_d = line.no;
       SpanDesc d;
       d.tag = static_cast<uint32_t>(f.next(p.TagBits, false, "tag"));
       d.row_first = static_cast<int32_t>(f.next(CB, true, "row_first"));
@@ -439,11 +444,13 @@ SpanVectors loadSpanVectors(const std::string& path) {
       }
       f.end();
       pending = c.desc_valid && !o.desc_ready;
+      unused_d = 0;
       v.cycles.push_back(std::move(c));
     } else {
       throw r.error(line.no, fmt::format("unknown record '{}' (D or C expected)", kind));
     }
   }
+  if (unused_d != 0) throw r.error(unused_d, "a D record after the last C record (no cycle puts it on the ports)");
   if (v.cycles.empty()) throw r.error("no C records (cycles)");
   return v;
 }
