@@ -85,7 +85,8 @@ class VectorReader {
     while (std::getline(in, s)) {
       ++no;
       if (!s.empty() && s.back() == '\r') s.pop_back();
-      if (s.find_first_not_of(" \t") == std::string::npos) continue;
+      // Blank: whitespace only, as the record tokenizer (operator>>) sees it, \v and \f included.
+      if (s.find_first_not_of(" \t\n\v\f\r") == std::string::npos) continue;
       if (s[0] == '#') {
         // The first line names the format; a file of another format is not read as this one.
         static const std::string kFormatLine = "# shadesim vector file, format ";
