@@ -3,13 +3,9 @@
 // "# unit" line says. Clean rejection: std::runtime_error (documented for all three).
 // Property of an accepted file: written back (render*Vectors) it is read again, and writing
 // that gives the same text (the writer's output is a fixed point of read-then-write). The
-// writer refusing what the reader accepted (std::invalid_argument) is a finding too. Known
-// finding: vectors-blank-record (below).
-#include <algorithm>
-#include <cctype>
+// writer refusing what the reader accepted (std::invalid_argument) is a finding too.
 #include <stdexcept>
 #include <string>
-#include <string_view>
 
 #include "fuzz_util.h"
 #include "vectors/vector_file.h"
