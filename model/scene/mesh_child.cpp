@@ -214,18 +214,19 @@ Mesh loadMeshFile(const std::string& path) {
   if (end == Wait::Deadline)
     fail(path, fmt::format("the import took longer than {} s (the time limit of a mesh import)", kImportSeconds));
   if (end == Wait::Memory) msg = std::string(1, kMeshOutOfMemory);
-  if (WIFSIGNALED(status) && end == Wait::Closed) {
+  const bool no_result = msg.empty() || (msg[0] != kMeshOk && msg[0] != kMeshError && msg[0] != kMeshOutOfMemory);
+  if (end == Wait::Closed && (WIFSIGNALED(status) || no_result)) {
     const std::string said = childStderr(err_fd);
-    fail(path, fmt::format("assimp crashed on it ({}{}; a malformed file)", describeSignal(WTERMSIG(status)),
-                           said.empty() ? std::string() : ": " + said));
-  }
-  if (msg.empty() || (msg[0] != kMeshOk && msg[0] != kMeshError && msg[0] != kMeshOutOfMemory)) {
-    const std::string said = childStderr(err_fd);
-    // A sanitizer's allocator reports an allocation over the limit itself and exits.
-    if (said.find("out-of-memory") == std::string::npos && said.find("allocation-size-too-big") == std::string::npos)
+    // A sanitizer's allocator reports an allocation over the limit itself, then exits or, with
+    // ASAN_OPTIONS=abort_on_error=1, aborts.
+    if (said.find("out-of-memory") != std::string::npos || said.find("allocation-size-too-big") != std::string::npos)
+      msg = std::string(1, kMeshOutOfMemory);
+    else if (WIFSIGNALED(status))
+      fail(path, fmt::format("assimp crashed on it ({}{}; a malformed file)", describeSignal(WTERMSIG(status)),
+                             said.empty() ? std::string() : ": " + said));
+    else if (no_result)
       fail(path, fmt::format("the import process ended without a result (exit status {}{})", WEXITSTATUS(status),
                              said.empty() ? std::string() : ": " + said));
-    msg = std::string(1, kMeshOutOfMemory);
   }
   if (msg[0] == kMeshOutOfMemory)
     fail(path, fmt::format("the import needs more than {} MB (the memory limit of a mesh import; a file that "
