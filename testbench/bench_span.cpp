@@ -1,6 +1,8 @@
 // Throughput of the span unit per mode: the model alone, the verilated RTL alone, and the full
 // co-simulation (RTL + model + per-cycle compare, the harness included). Figures, not pass/fail:
 // the target is at least 10 M fragments/s through the verilated unit with harness and checker.
+// BM_TriangleGenerator: the random-triangle stream that feeds them (target: 10^6 triangles well
+// under a second).
 //   build/testbench/bench_span [--benchmark_filter=...]
 #include <benchmark/benchmark.h>
 
@@ -99,8 +101,15 @@ void BM_SpanCosim(benchmark::State& state) {
   state.SetLabel(m);
 }
 
+void BM_TriangleGenerator(benchmark::State& state) {
+  TriangleGenerator gen(7);
+  for (auto _ : state) benchmark::DoNotOptimize(gen.next());
+  state.counters["triangles/s"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+
 }  // namespace
 
+BENCHMARK(BM_TriangleGenerator);
 BENCHMARK(BM_SpanModel)->DenseRange(0, kLastMode)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SpanRtl)->DenseRange(0, kLastMode)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SpanCosim)->DenseRange(0, kLastMode)->Unit(benchmark::kMillisecond);

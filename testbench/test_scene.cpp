@@ -4,7 +4,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -565,12 +564,10 @@ TEST(LoadMeshFile, InvalidTestModelsGiveErrorsNamingTheFile) {
 TEST(LoadMeshFile, OutOfMemoryModelIsRefusedByTheImportLimit) {
   const std::string path = kModels + "/invalid/OutOfMemory.off";
   ASSERT_TRUE(fs::exists(path));
-  const auto t0 = std::chrono::steady_clock::now();
+  // Without the limit assimp takes 36 s and 15.8 GB on it.
   const std::string e = meshErrorOf(path);
-  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   EXPECT_EQ(e.rfind(path + ": ", 0), 0u) << e;
   EXPECT_NE(e.find("4096 MB"), std::string::npos) << e;
-  EXPECT_LT(s, 60.0) << "the limit is 4 GB; without it assimp takes 36 s and 15.8 GB";
 }
 
 // A truncated COB file makes assimp 5.2 throw where nothing can catch it: std::terminate. In
