@@ -139,7 +139,8 @@ wait
 
 # An artifact is a finding if it fails again when replayed alone; one that does not (a heap
 # corrupted by an earlier input, in uninstrumented code) is only counted. Out-of-memory
-# artifacts of a target run with -ignore_ooms=1 are counted too (see mode_of).
+# artifacts of a target run with -ignore_ooms=1 are counted too (see mode_of), and so are
+# crashes that are AddressSanitizer refusing an allocation larger than the memory there is.
 triage() {
   local t=$1 bin=$build/testbench/fuzz/fuzz_$1 f kind
   find "$build/fuzz-work/$t/findings" -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) |
@@ -148,8 +149,11 @@ triage() {
       # shellcheck disable=SC2046  # flags_of's words are separate options
       if [ "$kind" = oom ] && [[ "$(mode_of "$t")" == *-ignore_ooms=1* ]]; then
         echo "ignored $f"
-      elif SHD_FUZZ_SKIP_KNOWN=1 nice "$bin" $(flags_of "$t") -timeout=10 "$f" >/dev/null 2>&1; then
+      elif out=$(SHD_FUZZ_SKIP_KNOWN=1 nice "$bin" $(flags_of "$t") -timeout=10 "$f" 2>&1 >/dev/null); then
         echo "flaky $f"
+      elif [[ "$(mode_of "$t")" == *-ignore_ooms=1* ]] &&
+        grep -qE 'AddressSanitizer: (out-of-memory|allocation-size-too-big|requested allocation size)' <<<"$out"; then
+        echo "ignored $f"  # AddressSanitizer's allocator refused a size read from the file: out of memory
       else
         echo "finding $f"
       fi
