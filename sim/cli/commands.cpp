@@ -22,6 +22,8 @@ std::unique_ptr<Command> makeRenderCmd();
 std::unique_ptr<Command> makeVectorsCmd();
 std::unique_ptr<Command> makeReplayCmd();
 std::unique_ptr<Command> makeConfigsCmd();
+std::unique_ptr<Command> makeSweepCmd();
+std::unique_ptr<Command> makeSweepMergeCmd();
 
 const std::vector<CommandInfo>& commands() {
   static const std::vector<CommandInfo> all = {
@@ -33,6 +35,8 @@ const std::vector<CommandInfo>& commands() {
       {"vectors", "write a vector file (inputs and the golden model's outputs, cycle by cycle)", makeVectorsCmd},
       {"replay", "replay a vector file on the verilated RTL, comparing every cycle", makeReplayCmd},
       {"configs", "list the unit configurations built in, and which have a verilated model", makeConfigsCmd},
+      {"sweep", "evaluate the specular unit over a grid of its parameters (error, latency, PROM size)", makeSweepCmd},
+      {"sweep-merge", "join the shard directories of one sweep", makeSweepMergeCmd},
   };
   return all;
 }

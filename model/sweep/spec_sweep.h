@@ -1,0 +1,34 @@
+// One point of a specular-unit sweep, evaluated by the model: the base configuration's
+// parameters with the grid's values, its PROM built by the sweep's fit, and its error found
+// exhaustively (report/spec_error.h: every cosine code 0..2^CosFracBits at every shininess of
+// the PROM, at full light; a lower light only scales the error down, the final rounding aside),
+// its latency and its PROM size.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "device/prom.h"
+#include "device/spec_params.h"
+
+namespace shd {
+
+// The base parameters with `values` set (names as in SpecUnitParams::toJson). std::invalid_argument
+// naming the point and the derivation a width breaks (SpecUnitParams::validate).
+SpecUnitParams specPointParams(const SpecUnitParams& base, const std::vector<std::pair<std::string, int>>& values);
+
+// The parameter names a specular sweep may vary.
+std::vector<std::string> specParamNames();
+
+// The point's record: {"index", "hash", "rtl", "error": {...}, "latency", "prom_bits",
+// "inputs"}. Deterministic: the same parameters and request give the same record, byte for
+// byte, on any machine (no timings in it).
+nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req);
+
+// The hash naming a point's parameters (textHash of its "rtl" object).
+std::string specPointHash(const SpecUnitParams& p);
+
+}  // namespace shd
