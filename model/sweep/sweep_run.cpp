@@ -258,6 +258,7 @@ void writeSweepResults(const std::string& dir, const SweepPlan& plan, const Swee
 
 void mergeSweeps(const std::vector<std::string>& dirs, const std::string& out) {
   if (dirs.empty()) throw std::runtime_error("no shard directories given");
+  requireDir(out);  // before the work
   const SweepPlan plan = readSweepPlan(dirs.at(0));
   SweepRecords all;
   for (const std::string& d : dirs) {
