@@ -172,6 +172,9 @@ for t in "${targets[@]}"; do
   eps=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   last=$(grep -E '^#[0-9]+: cov:' "$log" | tail -1 || true)
   [ -n "$last" ] || last=$(grep -E '^#[0-9]+' "$log" | tail -1 || true)
+  # Fork mode prints no final stats: the runs and the rate of its last status line.
+  [ -n "$runs" ] || runs=$(sed -n 's/^#\([0-9]*\):.*/\1/p' <<<"$last")
+  [ -n "$eps" ] || eps=$(sed -n 's/.* exec\/s \([0-9]*\).*/\1/p' <<<"$last")
   cov=$(sed -n 's/.* cov: \([0-9]*\).*/\1/p' <<<"$last")
   ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$last")
   after=$(find "$root/testbench/fuzz/corpus/$t" -maxdepth 1 -type f | wc -l)
