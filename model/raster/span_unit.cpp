@@ -177,8 +177,15 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
 }
 
 SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d) {
-  if (!m.idle()) throw std::logic_error("runSpanUnit: the unit is busy");
   SpanRun run;
+  runSpanUnit(m, d, run);
+  return run;
+}
+
+void runSpanUnit(SpanUnitModel& m, const SpanDesc& d, SpanRun& run) {
+  if (!m.idle()) throw std::logic_error("runSpanUnit: the unit is busy");
+  run.fragments.clear();  // its capacity kept
+  run.cycles = 0;
   const uint64_t rows0 = m.rowCycles(), spans0 = m.spanCycles();
   SpanIn in;
   in.desc_valid = true;
@@ -201,7 +208,6 @@ SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d) {
   run.valid_lanes = run.fragments.size();
   run.row_cycles = m.rowCycles() - rows0;
   run.span_cycles = m.spanCycles() - spans0;
-  return run;
 }
 
 SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out) {

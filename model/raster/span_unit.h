@@ -228,6 +228,8 @@ struct SpanRun {
   uint64_t row_cycles = 0;   // ROW cycles
 };
 SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d);
+// The same into `run`, reusing its fragments' memory (a long stream of triangles allocates once).
+void runSpanUnit(SpanUnitModel& m, const SpanDesc& d, SpanRun& run);
 
 // A row's fragments as one run (walkSpanUnit's run consumer): count fragments, fragment i at
 // pixel (x0 + i dx, y) with attribute a equal to a0[a] + i da[a] exactly (nothing wraps in
