@@ -7,6 +7,8 @@
 
 #include <fmt/format.h>
 
+#include "io/text.h"
+
 namespace shd {
 
 namespace {
@@ -21,17 +23,6 @@ double parseNumber(std::string_view tok, std::string_view whole) {
   return v;
 }
 
-std::vector<std::string_view> split(std::string_view s, char sep) {
-  std::vector<std::string_view> out;
-  size_t start = 0;
-  for (;;) {
-    const size_t pos = s.find(sep, start);
-    out.push_back(s.substr(start, pos == std::string_view::npos ? std::string_view::npos : pos - start));
-    if (pos == std::string_view::npos) return out;
-    start = pos + 1;
-  }
-}
-
 }  // namespace
 
 NSpec NSpec::parse(std::string_view text, bool is_list) {
@@ -39,9 +30,9 @@ NSpec NSpec::parse(std::string_view text, bool is_list) {
   spec.text = std::string(text);
   spec.is_list = is_list;
   if (is_list) {
-    for (std::string_view tok : split(text, ',')) spec.values.push_back(parseNumber(tok, text));
+    for (std::string_view tok : splitFields(text, ',')) spec.values.push_back(parseNumber(tok, text));
   } else {
-    const auto parts = split(text, ':');
+    const auto parts = splitFields(text, ':');
     if (parts.size() < 2 || parts.size() > 3)
       throw std::invalid_argument(fmt::format("n range '{}': expected lo:hi or lo:hi:step", text));
     const double lo = parseNumber(parts[0], text), hi = parseNumber(parts[1], text);

@@ -6,30 +6,21 @@
 
 #include <fmt/format.h>
 
+#include "io/text.h"
+
 namespace shd {
 
 namespace {
 
 constexpr int kMaxValue = 1 << 20;
 
-int parseValue(const std::string& s, const std::string& whole) {
+int parseValue(std::string_view s, const std::string& whole) {
   bool digits = !s.empty() && s.size() <= 8;
   for (char ch : s) digits = digits && ch >= '0' && ch <= '9';
-  const long v = digits ? std::stol(s) : -1;
+  const long v = digits ? std::stol(std::string(s)) : -1;
   if (!digits || v > kMaxValue)
     throw std::invalid_argument(fmt::format("--param {}: '{}' is not a whole number in [0, {}]", whole, s, kMaxValue));
   return static_cast<int>(v);
-}
-
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  size_t at = 0;
-  for (;;) {
-    const size_t next = s.find(sep, at);
-    out.push_back(s.substr(at, next == std::string::npos ? std::string::npos : next - at));
-    if (next == std::string::npos) return out;
-    at = next + 1;
-  }
 }
 
 }  // namespace
@@ -47,7 +38,7 @@ GridAxis parseGridAxis(const std::string& text, const std::vector<std::string>& 
     throw std::invalid_argument(fmt::format("--param {}: the unit has no parameter {} (it has {})", text, a.name, names));
   }
   if (a.text.find(':') != std::string::npos) {
-    const std::vector<std::string> parts = split(a.text, ':');
+    const auto parts = splitFields(a.text, ':');
     if (parts.size() > 3) throw std::invalid_argument(fmt::format("--param {}: a range is lo:hi or lo:hi:step", text));
     const int lo = parseValue(parts[0], text), hi = parseValue(parts[1], text);
     const int step = parts.size() == 3 ? parseValue(parts[2], text) : 1;
@@ -56,7 +47,7 @@ GridAxis parseGridAxis(const std::string& text, const std::vector<std::string>& 
     for (int v = lo; v <= hi; v += step) a.values.push_back(v);
   } else {
     std::set<int> seen;
-    for (const std::string& s : split(a.text, ',')) {
+    for (const std::string_view s : splitFields(a.text, ',')) {
       const int v = parseValue(s, text);
       if (!seen.insert(v).second) throw std::invalid_argument(fmt::format("--param {}: {} is given twice", text, v));
       a.values.push_back(v);
