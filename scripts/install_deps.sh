@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config python3
   verilator iverilog yosys
-  sollya gappa clang
+  sollya gappa clang parallel
   libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
   libassimp-dev assimp-testmodels
