@@ -26,7 +26,8 @@ SpecUnitParams specPointParams(const SpecUnitParams& base, const std::vector<std
 
 std::string specPointHash(const SpecUnitParams& p) { return textHash(p.toJson().dump()); }
 
-nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req) {
+nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req,
+                                 const SynthTool* synth) {
   const PromTable table = buildPromTable(req, p);
   const SpecErrorReport r = computeSpecError("sweep", table);
   const SpecErrorSummary& s = r.summary;
@@ -55,6 +56,7 @@ nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const 
   j["latency"] = p.latency();
   j["prom_bits"] = static_cast<int64_t>(p.promDepth()) * p.promWordBits();
   j["inputs"] = static_cast<int64_t>(table.entries.size()) * (p.cosOne() + 1);
+  if (synth != nullptr) j["area"] = specPointArea(table, *synth);
   return j;
 }
 

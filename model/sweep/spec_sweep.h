@@ -13,6 +13,7 @@
 
 #include "device/prom.h"
 #include "device/spec_params.h"
+#include "sweep/spec_area.h"
 
 namespace shd {
 
@@ -24,9 +25,10 @@ SpecUnitParams specPointParams(const SpecUnitParams& base, const std::vector<std
 std::vector<std::string> specParamNames();
 
 // The point's record: {"index", "hash", "rtl", "error": {...}, "latency", "prom_bits",
-// "inputs"}. Deterministic: the same parameters and request give the same record, byte for
-// byte, on any machine (no timings in it).
-nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req);
+// "inputs"}, and with `synth` its "area" (spec_area.h). Deterministic: the same parameters and
+// request give the same record, byte for byte, on any machine (no timings in it).
+nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req,
+                                 const SynthTool* synth = nullptr);
 
 // The hash naming a point's parameters (textHash of its "rtl" object).
 std::string specPointHash(const SpecUnitParams& p);

@@ -59,30 +59,43 @@ std::string csvField(const nlohmann::json& v) {
   return v.dump();
 }
 
-// The columns of sweep.csv: index, hash, every "rtl" parameter, every "error" figure, then the
-// record's other numbers; taken from the first record (every record has the same members).
-std::vector<std::vector<std::string>> csvColumns(const nlohmann::json& first) {
-  std::vector<std::vector<std::string>> cols = {{"index"}, {"hash"}};
-  for (const auto& item : first.at("rtl").items()) cols.push_back({"rtl", item.key()});
-  for (const auto& item : first.at("error").items()) cols.push_back({"error", item.key()});
+// A column: where its value is in a record, and its header.
+struct Column {
+  std::vector<std::string> path;
+  std::string header;
+};
+
+// The columns of sweep.csv: index, hash, every "rtl" parameter, every "error" figure, the
+// record's other numbers, then "area" per target (<target>_<figure>); taken from the first
+// record (every record of a sweep has the same members).
+std::vector<Column> csvColumns(const nlohmann::json& first) {
+  std::vector<Column> cols = {{{"index"}, "index"}, {{"hash"}, "hash"}};
+  for (const auto& item : first.at("rtl").items()) cols.push_back({{"rtl", item.key()}, item.key()});
+  for (const auto& item : first.at("error").items()) cols.push_back({{"error", item.key()}, item.key()});
   for (const auto& item : first.items())
-    if (item.value().is_number() && item.key() != "index") cols.push_back({item.key()});
+    if (item.value().is_number() && item.key() != "index") cols.push_back({{item.key()}, item.key()});
+  if (first.contains("area"))
+    for (const auto& target : first.at("area").items())
+      for (const auto& fig : target.value().items())
+        cols.push_back({{"area", target.key(), fig.key()}, target.key() + "_" + fig.key()});
   return cols;
 }
 
-std::string csvTable(const std::vector<const nlohmann::json*>& rows, const std::vector<std::vector<std::string>>& cols,
+const nlohmann::json& at(const nlohmann::json& record, const std::vector<std::string>& path) {
+  const nlohmann::json* v = &record;
+  for (const std::string& key : path) v = &v->at(key);
+  return *v;
+}
+
+std::string csvTable(const std::vector<const nlohmann::json*>& rows, const std::vector<Column>& cols,
                      const std::string& first_col, const std::vector<std::string>& first_vals) {
   std::string out;
   if (!first_col.empty()) out += first_col + ",";
-  for (size_t c = 0; c < cols.size(); ++c) out += (c ? "," : "") + cols[c].back();
+  for (size_t c = 0; c < cols.size(); ++c) out += (c ? "," : "") + cols[c].header;
   out += "\n";
   for (size_t r = 0; r < rows.size(); ++r) {
     if (!first_col.empty()) out += first_vals[r] + ",";
-    for (size_t c = 0; c < cols.size(); ++c) {
-      const nlohmann::json* v = rows[r];
-      for (const std::string& key : cols[c]) v = &v->at(key);
-      out += (c ? "," : "") + csvField(*v);
-    }
+    for (size_t c = 0; c < cols.size(); ++c) out += (c ? "," : "") + csvField(at(*rows[r], cols[c].path));
     out += "\n";
   }
   return out;
@@ -91,11 +104,11 @@ std::string csvTable(const std::vector<const nlohmann::json*>& rows, const std::
 // The points not dominated in (datapath error, cost): no other point has both at most as large
 // and one smaller. In index order. The datapath error is what the widths control; the
 // approximation error is the fit's, the same at every point of a sweep.
-std::vector<const nlohmann::json*> paretoFront(const SweepRecords& records, const std::string& cost) {
+std::vector<const nlohmann::json*> paretoFront(const SweepRecords& records, const std::vector<std::string>& cost) {
   std::vector<const nlohmann::json*> all;
   for (const auto& kv : records) all.push_back(&kv.second);
   auto err = [](const nlohmann::json* r) { return r->at("error").at("datapath_max_lsb").get<double>(); };
-  auto cst = [&](const nlohmann::json* r) { return r->at(cost).get<double>(); };
+  auto cst = [&](const nlohmann::json* r) { return at(*r, cost).get<double>(); };
   std::vector<const nlohmann::json*> front;
   for (const nlohmann::json* a : all) {
     bool dominated = false;
@@ -242,10 +255,13 @@ void writeSweepResults(const std::string& dir, const SweepPlan& plan, const Swee
   const auto cols = csvColumns(points.at(0));
   std::vector<const nlohmann::json*> front_rows;
   std::vector<std::string> front_names;
-  for (const std::string cost : {"latency", "prom_bits"}) {
-    for (const nlohmann::json* r : paretoFront(records, cost)) {
+  std::vector<Column> costs = {{{"latency"}, "latency"}, {{"prom_bits"}, "prom_bits"}};
+  for (const Column& c : cols)
+    if (c.path.size() == 3 && c.path[0] == "area" && c.path[2] == "luts") costs.push_back(c);
+  for (const Column& cost : costs) {
+    for (const nlohmann::json* r : paretoFront(records, cost.path)) {
       front_rows.push_back(r);
-      front_names.push_back("error-" + cost);
+      front_names.push_back("error-" + cost.header);
     }
   }
   OutputFiles out;

@@ -39,6 +39,11 @@ class SweepCmd final : public Command {
         ->required();
     app.add_option("--shard", shard_, "run the i-th of N deterministic parts (i/N); join with sweep-merge");
     app.add_option("--jobs", jobs_, "threads (default: the machine's cores)")->check(countIn(1, 256));
+    app.add_option("--area", area_, "also the area by yosys (scripts/synth.py): ice40, xc7 or both")
+        ->check(CLI::IsMember({"ice40", "xc7", "both"}));
+    app.add_option("--synth-cache", synth_cache_,
+                   "an existing directory where synthesised areas are kept by the point's parameters and PROM "
+                   "(required with --area; shared by sweeps)");
     app.add_option("-o,--output", dir_, "the sweep's directory (must exist; a killed sweep resumes in it)")->required();
     app.add_flag("--quiet", quiet_, "no progress on stderr");
   }
@@ -51,6 +56,16 @@ class SweepCmd final : public Command {
     const Grid grid = argOr([](std::vector<GridAxis> a) { return Grid(std::move(a)); }, axes);
     const Shard shard = shard_.empty() ? Shard{} : argOr(Shard::parse, shard_);
     validatePoints(grid, cfg.rtl, base_table.request);
+    SynthTool synth;
+    if (!area_.empty()) {
+      if (synth_cache_.empty()) throw ArgError("--area needs --synth-cache DIR (an existing directory)");
+      requireDirectoryArg("--synth-cache", synth_cache_);
+      synth = {findSynthScript(), synth_cache_, area_};
+      if (synth.script.empty())
+        throw ArgError("--area: scripts/synth.py is neither in this installation nor in the source tree it was built from");
+    } else if (!synth_cache_.empty()) {
+      throw ArgError("--synth-cache applies only with --area");
+    }
 
     const SweepPlan plan = SweepPlan::make(planJson(cfg, base_table.request, grid));
     claimSweepDir(dir_, plan);
@@ -63,7 +78,10 @@ class SweepCmd final : public Command {
       const PromRequest req = base_table.request;
       runSweepPoints(
           dir_, plan, shard, jobs,
-          [&](uint64_t k) { return evaluateSpecPoint(k, specPointParams(cfg.rtl, grid.point(k)), req); }, done,
+          [&](uint64_t k) {
+            return evaluateSpecPoint(k, specPointParams(cfg.rtl, grid.point(k)), req, area_.empty() ? nullptr : &synth);
+          },
+          done,
           [&](uint64_t d, uint64_t n) { progress.update(static_cast<double>(d), static_cast<double>(n), "points"); });
     }
     if (!missingPoints(plan, done).empty()) {
@@ -101,9 +119,9 @@ class SweepCmd final : public Command {
 
   nlohmann::json planJson(const SpecUnitConfig& cfg, const PromRequest& req, const Grid& grid) const {
     nlohmann::json axes = nlohmann::json::array();
-    std::string command = fmt::format("shadesim sweep --unit {} --config {} --fit {} --level {} --{} {}", unit_,
+    std::string command = fmt::format("shadesim sweep --unit {} --config {} --fit {} --level {} --{} {}{}", unit_,
                                       cfg.ref(), toString(req.fit), req.level, req.n.is_list ? "n-list" : "n",
-                                      req.n.text);
+                                      req.n.text, area_.empty() ? "" : " --area " + area_);
     for (const GridAxis& a : grid.axes()) {
       axes.push_back({{"name", a.name}, {"text", a.text}, {"values", a.values}});
       command += fmt::format(" --param {}={}", a.name, a.text);
@@ -114,12 +132,13 @@ class SweepCmd final : public Command {
             {"unit", unit_},
             {"base", {{"config", cfg.ref()}, {"rtl", cfg.rtl.toJson()}}},
             {"prom", req.describe()},
+            {"area", area_.empty() ? "none" : area_},
             {"axes", axes},
             {"points", grid.size()}};
   }
 
   TableOptions table_;
-  std::string unit_ = "spec", shard_, dir_;
+  std::string unit_ = "spec", shard_, dir_, area_, synth_cache_;
   std::vector<std::string> params_;
   unsigned jobs_ = 0;
   bool quiet_ = false;
