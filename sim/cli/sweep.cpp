@@ -3,6 +3,7 @@
 // The directory layout and the resume rule: model/sweep/sweep_run.h.
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <thread>
 #include <tuple>
 
@@ -70,6 +71,9 @@ class SweepCmd final : public Command {
     const SweepPlan plan = SweepPlan::make(planJson(cfg, base_table.request, grid));
     claimSweepDir(dir_, plan);
     SweepRecords done = readSweepRecords(dir_, plan);
+    if (!done.empty() && !quiet_)
+      std::fprintf(stderr, "sweep %s: resuming, %zu of %llu points already recorded in %s\n", plan.hash.c_str(),
+                   done.size(), static_cast<unsigned long long>(grid.size()), dir_.c_str());
     const unsigned jobs = jobs_ > 0 ? jobs_ : std::max(1u, std::thread::hardware_concurrency());
     {
       Progress progress(fmt::format("sweep {} ({} points{})", plan.hash, grid.size(),
@@ -82,7 +86,10 @@ class SweepCmd final : public Command {
             return evaluateSpecPoint(k, specPointParams(cfg.rtl, grid.point(k)), req, area_.empty() ? nullptr : &synth);
           },
           done,
-          [&](uint64_t d, uint64_t n) { progress.update(static_cast<double>(d), static_cast<double>(n), "points"); });
+          [&, base = std::optional<uint64_t>()](uint64_t d, uint64_t n) mutable {
+            if (!base) base = d;  // the points recorded before this run: not counted in its rate
+            progress.update(static_cast<double>(d - *base), static_cast<double>(n - *base), "points");
+          });
     }
     if (!missingPoints(plan, done).empty()) {
       std::printf("sweep %s: shard %llu/%llu recorded in %s; join the shards with shadesim sweep-merge\n",
