@@ -35,7 +35,7 @@ const std::vector<CommandInfo>& commands() {
       {"vectors", "write a vector file (inputs and the golden model's outputs, cycle by cycle)", makeVectorsCmd},
       {"replay", "replay a vector file on the verilated RTL, comparing every cycle", makeReplayCmd},
       {"configs", "list the unit configurations built in, and which have a verilated model", makeConfigsCmd},
-      {"sweep", "evaluate the specular unit over a grid of its parameters (error, latency, PROM size)", makeSweepCmd},
+      {"sweep", "evaluate the specular unit over a grid of its parameters (error, latency, PROM size, area)", makeSweepCmd},
       {"sweep-merge", "join the shard directories of one sweep", makeSweepMergeCmd},
   };
   return all;
