@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <cstdlib>
+#include <algorithm>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -64,6 +65,28 @@ nlohmann::json targetFigures(const nlohmann::json& t) {
 
 }  // namespace
 
+std::string synthToolVersion(const std::string& script) {
+  char tmpl[] = "/tmp/shadesim-yosys-XXXXXX";
+  const int fd = mkstemp(tmpl);
+  if (fd < 0) throw std::runtime_error(fmt::format("cannot make a temporary file: {}", std::strerror(errno)));
+  close(fd);
+  const int rc = runLogged({"yosys", "-V"}, tmpl);
+  std::string v = readText(tmpl);
+  unlink(tmpl);
+  if (rc != 0) throw std::runtime_error(fmt::format("--area: yosys -V failed (exit {}): {}", rc, v));
+  while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
+  // The flow and the RTL it synthesises (rtl/ beside scripts/).
+  std::string sources = readText(script);
+  const fs::path rtl = fs::path(script).parent_path().parent_path() / "rtl";
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(rtl, ec))
+    if (e.path().extension() == ".v") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const fs::path& f : files) sources += f.filename().string() + "\n" + readText(f);
+  return v + " flow " + textHash(sources);
+}
+
 std::string findSynthScript() {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
@@ -81,7 +104,7 @@ std::string findSynthScript() {
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
   const std::string hex = renderProm(table, PromFormat::Hex);
   const nlohmann::json rtl = table.unit.toJson();
-  const std::string key = textHash(fmt::format("spec {} {} {}", rtl.dump(), tool.targets, hex));
+  const std::string key = textHash(fmt::format("spec {} {} {} {}", rtl.dump(), tool.targets, tool.version, hex));
   const fs::path cached = fs::path(tool.cache_dir) / fmt::format("spec-{}.json", key);
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
@@ -126,7 +149,8 @@ nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
   const nlohmann::json summary = parseJsonStrict(readText(tmp / "out" / "summary.json"));
   nlohmann::json area = nlohmann::json::object();
   for (const auto& item : summary.at("targets").items()) area[item.key()] = targetFigures(item.value());
-  writeFileAtomic(cached.string(), nlohmann::json{{"key", key}, {"rtl", rtl}, {"area", area}}.dump(1) + "\n");
+  writeFileAtomic(cached.string(),
+                  nlohmann::json{{"key", key}, {"tools", tool.version}, {"rtl", rtl}, {"area", area}}.dump(1) + "\n");
   return area;
 }
 

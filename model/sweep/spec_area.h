@@ -15,7 +15,13 @@ struct SynthTool {
   std::string script;     // scripts/synth.py
   std::string cache_dir;  // an existing directory: <key>.json per point and targets
   std::string targets = "both";  // ice40 | xc7 | both
+  std::string version;    // what else decides the netlist: synthToolVersion()
 };
+
+// The yosys version (`yosys -V`) and a hash of `script` and the RTL it reads, part of every cache
+// key: another yosys or an edited flow or RTL synthesises again. std::runtime_error if yosys
+// does not run.
+std::string synthToolVersion(const std::string& script);
 
 // scripts/synth.py beside this program: <exe dir>/../share/shadesim/scripts (an installation), or
 // the source tree this program was built from. "" if neither exists.

@@ -61,14 +61,15 @@ class SweepCmd final : public Command {
     if (!area_.empty()) {
       if (synth_cache_.empty()) throw ArgError("--area needs --synth-cache DIR (an existing directory)");
       requireDirectoryArg("--synth-cache", synth_cache_);
-      synth = {findSynthScript(), synth_cache_, area_};
+      synth = {findSynthScript(), synth_cache_, area_, ""};
       if (synth.script.empty())
         throw ArgError("--area: scripts/synth.py is neither in this installation nor in the source tree it was built from");
+      synth.version = synthToolVersion(synth.script);
     } else if (!synth_cache_.empty()) {
       throw ArgError("--synth-cache applies only with --area");
     }
 
-    const SweepPlan plan = SweepPlan::make(planJson(cfg, base_table.request, grid));
+    const SweepPlan plan = SweepPlan::make(planJson(cfg, base_table.request, grid, synth.version));
     claimSweepDir(dir_, plan);
     SweepRecords done = readSweepRecords(dir_, plan);
     if (!done.empty() && !quiet_)
@@ -124,7 +125,10 @@ class SweepCmd final : public Command {
     }
   }
 
-  nlohmann::json planJson(const SpecUnitConfig& cfg, const PromRequest& req, const Grid& grid) const {
+  // The plan; with --area it names the synthesis tools (synthToolVersion), so that a sweep does
+  // not resume with another yosys or flow.
+  nlohmann::json planJson(const SpecUnitConfig& cfg, const PromRequest& req, const Grid& grid,
+                          const std::string& synth_tools) const {
     nlohmann::json axes = nlohmann::json::array();
     std::string command = fmt::format("shadesim sweep --unit {} --config {} --fit {} --level {} --{} {}{}", unit_,
                                       cfg.ref(), toString(req.fit), req.level, req.n.is_list ? "n-list" : "n",
@@ -139,7 +143,7 @@ class SweepCmd final : public Command {
             {"unit", unit_},
             {"base", {{"config", cfg.ref()}, {"rtl", cfg.rtl.toJson()}}},
             {"prom", req.describe()},
-            {"area", area_.empty() ? "none" : area_},
+            {"area", area_.empty() ? "none" : area_ + " (" + synth_tools + ")"},
             {"axes", axes},
             {"points", grid.size()}};
   }
