@@ -252,3 +252,39 @@ TEST(SweepDir, RefusesAnotherSweepAndForeignOrCorruptedPoints) {
             }).find("hold different sweeps"),
             std::string::npos);
 }
+
+// Beyond 2^28 inputs a point is evaluated on a seeded sample of cosine codes with the corners.
+TEST(SpecSweep, SampleCodesAboveTheExhaustiveLimit) {
+  SpecUnitParams p = specConfig("default").rtl;
+  EXPECT_TRUE(specSampleCodes(p, 1000, kSpecSampleSeed).empty());  // 1000 x 32769 inputs: all
+  p.CosFracBits = 20;
+  p.DiffFracBits = 28;
+  const std::vector<int64_t> codes = specSampleCodes(p, 1000, kSpecSampleSeed);
+  ASSERT_EQ(codes.size(), kSpecExhaustiveInputs / 1000);
+  EXPECT_TRUE(std::is_sorted(codes.begin(), codes.end()));
+  EXPECT_EQ(std::adjacent_find(codes.begin(), codes.end()), codes.end());
+  EXPECT_EQ(codes.front(), 0);
+  EXPECT_EQ(codes.back(), p.cosOne());
+  for (int64_t corner : {int64_t{1}, int64_t{2}, p.cosOne() / 2, p.cosOne() - 1})
+    EXPECT_TRUE(std::binary_search(codes.begin(), codes.end(), corner)) << corner;
+  EXPECT_EQ(codes, specSampleCodes(p, 1000, kSpecSampleSeed));
+  EXPECT_NE(codes, specSampleCodes(p, 1000, kSpecSampleSeed + 1));
+  EXPECT_EQ(specSampleCodes(p, 10000000, 1).size(), 64u);  // at least 64 per shininess
+}
+
+// The report over an explicit list of every code equals the exhaustive one.
+TEST(SpecSweep, ErrorOverListedCodesEqualsTheExhaustiveReport) {
+  SpecUnitConfig cfg = specConfig("narrow");
+  PromRequest req = PromRequest::fromContent(cfg.prom);
+  req.n = NSpec::parse("1,8,64,500", true);
+  const PromTable t = buildPromTable(req, cfg.rtl);
+  std::vector<int64_t> all(static_cast<size_t>(cfg.rtl.cosOne() + 1));
+  for (size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int64_t>(k);
+  const SpecErrorReport a = computeSpecError("x", t), b = computeSpecError("x", t, {}, all);
+  nlohmann::json ja = toJson(a).at("summary"), jb = toJson(b).at("summary");
+  ja.erase("seconds");
+  jb.erase("seconds");
+  EXPECT_EQ(ja, jb);
+  const SpecErrorReport c = computeSpecError("x", t, {}, {0, 512, 1024});
+  EXPECT_LE(c.summary.datapath_max_lsb.value, a.summary.datapath_max_lsb.value);
+}

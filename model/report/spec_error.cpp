@@ -19,7 +19,8 @@ void keepWorst(SpecErrorWorst& w, double value, double n) {
 }  // namespace
 
 SpecErrorReport computeSpecError(const std::string& config, const PromTable& table,
-                                 const std::function<void(size_t, size_t)>& progress) {
+                                 const std::function<void(size_t, size_t)>& progress,
+                                 const std::vector<int64_t>& codes) {
   const auto t0 = std::chrono::steady_clock::now();
   SpecErrorReport r;
   r.config = config;
@@ -38,7 +39,9 @@ SpecErrorReport computeSpecError(const std::string& config, const PromTable& tab
     row.peak50 = s.at("peak50");
     row.inflection = s.at("inflection");
     const double c_peak = levelCos(e.n, 0.5);
-    for (int64_t code = 0; code <= p.cosOne(); ++code) {
+    const size_t count = codes.empty() ? static_cast<size_t>(p.cosOne() + 1) : codes.size();
+    for (size_t k = 0; k < count; ++k) {
+      const int64_t code = codes.empty() ? static_cast<int64_t>(k) : codes[k];
       const double c = std::ldexp(static_cast<double>(code), -p.CosFracBits);
       const SpecOut o = model.evaluate(e.address, static_cast<uint32_t>(code), {lmax, lmax, lmax});
       const double ideal = e.approx.eval(c);

@@ -50,9 +50,11 @@ struct SpecErrorReport {
   double seconds = 0;
 };
 
-// One row per PROM entry; `progress(done, total)` is called after each row when given.
+// One row per PROM entry; `progress(done, total)` is called after each row when given. `codes`:
+// the cosine codes evaluated (ascending, each in 0..2^CosFracBits); empty: every one.
 SpecErrorReport computeSpecError(const std::string& config, const PromTable& table,
-                                 const std::function<void(size_t, size_t)>& progress = {});
+                                 const std::function<void(size_t, size_t)>& progress = {},
+                                 const std::vector<int64_t>& codes = {});
 
 nlohmann::json toJson(const SpecErrorReport& r);
 

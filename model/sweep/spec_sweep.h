@@ -1,8 +1,9 @@
 // One point of a specular-unit sweep, evaluated by the model: the base configuration's
-// parameters with the grid's values, its PROM built by the sweep's fit, and its error found
-// exhaustively (report/spec_error.h: every cosine code 0..2^CosFracBits at every shininess of
-// the PROM, at full light; a lower light only scales the error down, the final rounding aside),
-// its latency and its PROM size.
+// parameters with the grid's values, its PROM built by the sweep's fit, and its error
+// (report/spec_error.h: at full light; a lower light only scales the error down, the final
+// rounding aside) found exhaustively, every cosine code 0..2^CosFracBits at every shininess of
+// the PROM, when those are at most kSpecExhaustiveInputs, else on a seeded sample of codes plus
+// the corners (specSampleCodes); its latency and its PROM size.
 #pragma once
 
 #include <string>
@@ -21,11 +22,20 @@ namespace shd {
 // naming the point and the derivation a width breaks (SpecUnitParams::validate).
 SpecUnitParams specPointParams(const SpecUnitParams& base, const std::vector<std::pair<std::string, int>>& values);
 
+constexpr uint64_t kSpecExhaustiveInputs = uint64_t{1} << 28;
+constexpr uint64_t kSpecSampleSeed = 20261125;
+
+// The cosine codes a point evaluates: empty (all of them) when (2^CosFracBits + 1) * entries is
+// at most kSpecExhaustiveInputs; otherwise, ascending, 0, 1, 2, the middle, the three highest
+// codes and codes drawn by SplitMix64 from `seed`, kSpecExhaustiveInputs / entries (at least 64)
+// in all. The same on every machine.
+std::vector<int64_t> specSampleCodes(const SpecUnitParams& p, size_t entries, uint64_t seed);
+
 // The parameter names a specular sweep may vary.
 std::vector<std::string> specParamNames();
 
 // The point's record: {"index", "hash", "rtl", "error": {...}, "latency", "prom_bits",
-// "inputs"}, and with `synth` its "area" (spec_area.h). Deterministic: the same parameters and
+// "inputs", "exhaustive" (1 or 0: sampled)}, and with `synth` its "area" (spec_area.h). Deterministic: the same parameters and
 // request give the same record, byte for byte, on any machine (no timings in it).
 nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req,
                                  const SynthTool* synth = nullptr);
