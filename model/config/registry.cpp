@@ -6,8 +6,6 @@
 #include <algorithm>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -67,15 +65,11 @@ PromContent promFromJson(const nlohmann::json& value, const std::string& where) 
 }
 
 std::string readFile(const std::string& path) {
-  // A configuration is a few hundred bytes.
-  if (const std::string why = inputFileProblem(path, uint64_t{1} << 20); !why.empty())
-    throw std::invalid_argument(fmt::format("{}: {}", path, why));
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::invalid_argument(fmt::format("{}: cannot open it: {}", path, std::strerror(errno)));
-  noteInput(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  try {
+    return readInputFile(path, uint64_t{1} << 20);  // a configuration is a few hundred bytes
+  } catch (const std::runtime_error& e) {
+    throw std::invalid_argument(e.what());
+  }
 }
 
 // The registry entry or the file, parsed by Config::parse.

@@ -8,7 +8,9 @@
 #include <cerrno>
 #include <climits>
 #include <cstring>
+#include <fstream>
 #include <mutex>
+#include <sstream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -124,6 +126,18 @@ std::string inputFileProblem(const std::string& path, uint64_t max_bytes) {
     return fmt::format("{} bytes, more than the {} bytes a file of this kind may have", st.st_size, max_bytes);
   if (::access(path.c_str(), R_OK) != 0) return std::strerror(errno);
   return {};
+}
+
+std::string readInputFile(const std::string& path, uint64_t max_bytes) {
+  if (const std::string why = inputFileProblem(path, max_bytes); !why.empty())
+    throw std::runtime_error(fmt::format("{}: {}", path, why));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(fmt::format("{}: cannot open it: {}", path, std::strerror(errno)));
+  noteInput(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw std::runtime_error(fmt::format("{}: cannot read it", path));
+  return s.str();
 }
 
 std::string outputTarget(const std::string& path) {

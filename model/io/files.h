@@ -41,6 +41,10 @@ void noteInput(const std::string& path);
 // fill the memory.
 std::string inputFileProblem(const std::string& path, uint64_t max_bytes);
 
+// The whole of a small input file, by the rules above (inputFileProblem, noteInput).
+// std::runtime_error "<path>: <why>" when it cannot be read.
+std::string readInputFile(const std::string& path, uint64_t max_bytes);
+
 // The path an output to `path` replaces: `path` itself, or the file a symbolic link names
 // (relative links resolved against the link's directory, chains followed). Throws when the
 // target exists and is not a regular file, is a noted input, or is new in a directory that does

@@ -7,11 +7,9 @@
 #include <cctype>
 #include <algorithm>
 #include <cmath>
-#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <map>
 #include <sstream>
@@ -649,16 +647,15 @@ class SceneReader {
 };
 
 Scene loadSceneFile(const std::string& file) {
-  if (const std::string why = inputFileProblem(file, kMaxSceneFileBytes); !why.empty())
-    throw SceneError(fmt::format("{}: {}", file, why));
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw SceneError(fmt::format("{}: cannot open it: {}", file, std::strerror(errno)));
-  noteInput(file);
-  std::ostringstream text;
-  text << in.rdbuf();
+  std::string text;
+  try {
+    text = readInputFile(file, kMaxSceneFileBytes);
+  } catch (const std::runtime_error& e) {
+    throw SceneError(e.what());
+  }
   json root;
   try {
-    root = parseJsonStrict(text.str());
+    root = parseJsonStrict(text);
   } catch (const json::exception& e) {  // parse_error; out_of_range for 1e999
     throw SceneError(fmt::format("{}: not valid JSON: {}", file, e.what()));
   } catch (const std::invalid_argument& e) {  // a repeated key

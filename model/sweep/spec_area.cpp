@@ -1,17 +1,10 @@
 #include "sweep/spec_area.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
-#include <algorithm>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -20,9 +13,8 @@
 #include "device/prom_io.h"
 #include "io/files.h"
 #include "io/json_strict.h"
+#include "io/process.h"
 #include "sweep/grid.h"
-
-extern char** environ;
 
 namespace shd {
 
@@ -30,30 +22,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string readText(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+constexpr uint64_t kMaxAreaFileBytes = 16 << 20;  // a cached area, synth.py's summary
 
-// Runs argv with stdout and stderr into `log`; its exit status, or -1 if it could not start.
-int runLogged(const std::vector<std::string>& argv, const std::string& log) {
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, args[0], &fa, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) return -1;
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+// Runs argv; std::runtime_error naming `what`, with the end of what it said, unless it exits 0.
+std::string run(const std::vector<std::string>& argv, const std::string& what) {
+  std::string out, err, error;
+  const int rc = runProcess(argv, out, err, error);
+  if (rc == 0) return out;
+  std::string said = out + err;
+  if (said.size() > 600) said = "..." + said.substr(said.size() - 600);
+  throw std::runtime_error(fmt::format("{} failed ({}):\n{}", what, rc < 0 ? error : fmt::format("exit {}", rc), said));
 }
 
 // The figures of one target from synth.py's summary (no timings: a cached result is the same on
@@ -66,24 +44,17 @@ nlohmann::json targetFigures(const nlohmann::json& t) {
 }  // namespace
 
 std::string synthToolVersion(const std::string& script) {
-  char tmpl[] = "/tmp/shadesim-yosys-XXXXXX";
-  const int fd = mkstemp(tmpl);
-  if (fd < 0) throw std::runtime_error(fmt::format("cannot make a temporary file: {}", std::strerror(errno)));
-  close(fd);
-  const int rc = runLogged({"yosys", "-V"}, tmpl);
-  std::string v = readText(tmpl);
-  unlink(tmpl);
-  if (rc != 0) throw std::runtime_error(fmt::format("--area: yosys -V failed (exit {}): {}", rc, v));
+  std::string v = run({"yosys", "-V"}, "--area: yosys -V");
   while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
   // The flow and the RTL it synthesises (rtl/ beside scripts/).
-  std::string sources = readText(script);
+  std::string sources = readInputFile(script, kMaxAreaFileBytes);
   const fs::path rtl = fs::path(script).parent_path().parent_path() / "rtl";
   std::vector<fs::path> files;
   std::error_code ec;
   for (const auto& e : fs::directory_iterator(rtl, ec))
     if (e.path().extension() == ".v") files.push_back(e.path());
   std::sort(files.begin(), files.end());
-  for (const fs::path& f : files) sources += f.filename().string() + "\n" + readText(f);
+  for (const fs::path& f : files) sources += f.filename().string() + "\n" + readInputFile(f.string(), kMaxAreaFileBytes);
   return v + " flow " + textHash(sources);
 }
 
@@ -109,7 +80,7 @@ nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
     try {
-      return parseJsonStrict(readText(cached)).at("area");
+      return parseJsonStrict(readInputFile(cached.string(), kMaxAreaFileBytes)).at("area");
     } catch (const std::exception& e) {
       throw std::runtime_error(fmt::format("{}: not a cached area ({}); remove it", cached.string(), e.what()));
     }
@@ -135,18 +106,11 @@ nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
                                 {"n", table.request.n.text}}}};
   writeFileAtomic((tmp / "spec_sweep.json").string(), cfg.dump(2) + "\n");
   writeFileAtomic((tmp / "spec_sweep.hex").string(), hex);
-  const std::string log = (tmp / "synth.log").string();
-  const int rc = runLogged({"python3", tool.script, (tmp / "spec_sweep.json").string(), "--unit", "spec", "--prom",
-                            (tmp / "spec_sweep.hex").string(), "--out", (tmp / "out").string(), "--target",
-                            tool.targets},
-                           log);
-  if (rc != 0) {
-    // The log goes with the temporary directory: keep its end in the message.
-    std::string tail = readText(log);
-    if (tail.size() > 600) tail = "..." + tail.substr(tail.size() - 600);
-    throw std::runtime_error(fmt::format("synthesis of point {} failed ({}: exit {}):\n{}", key, tool.script, rc, tail));
-  }
-  const nlohmann::json summary = parseJsonStrict(readText(tmp / "out" / "summary.json"));
+  run({"python3", tool.script, (tmp / "spec_sweep.json").string(), "--unit", "spec", "--prom",
+       (tmp / "spec_sweep.hex").string(), "--out", (tmp / "out").string(), "--target", tool.targets},
+      fmt::format("synthesis of point {} ({})", key, tool.script));
+  const nlohmann::json summary =
+      parseJsonStrict(readInputFile((tmp / "out" / "summary.json").string(), kMaxAreaFileBytes));
   nlohmann::json area = nlohmann::json::object();
   for (const auto& item : summary.at("targets").items()) area[item.key()] = targetFigures(item.value());
   writeFileAtomic(cached.string(),

@@ -30,7 +30,8 @@ std::string findSynthScript();
 // {"<target>": {"luts", "ffs", "carries", "dsps", "brams", "bram_kbits", "cells"}} for the
 // point whose PROM `table` is (its unit parameters are table.unit). From the cache when it holds
 // the key; otherwise synthesised (in a temporary directory inside the cache, removed after) and
-// cached. std::runtime_error naming the point's hash and the log when yosys fails.
+// cached. std::runtime_error naming the point's hash, with the end of synth.py's output, when it
+// fails.
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool);
 
 }  // namespace shd

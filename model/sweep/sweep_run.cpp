@@ -4,9 +4,9 @@
 #include <atomic>
 #include <exception>
 #include <filesystem>
-#include <fstream>
+#include <limits>
+#include <optional>
 #include <mutex>
-#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -27,15 +27,15 @@ constexpr uint64_t kMaxPlanBytes = 1 << 20;
 std::string planPath(const std::string& dir) { return (fs::path(dir) / "sweep-plan.json").string(); }
 std::string pointName(uint64_t index) { return fmt::format("point-{:07}.json", index); }
 
-std::string readSmallFile(const std::string& path, uint64_t max_bytes) {
-  const std::string problem = inputFileProblem(path, max_bytes);
-  if (!problem.empty()) throw std::runtime_error(fmt::format("{}: {}", path, problem));
-  noteInput(path);
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (!in && !in.eof()) throw std::runtime_error(fmt::format("{}: cannot read it", path));
-  return ss.str();
+// A JSON file of the sweep: std::runtime_error naming the file when it cannot be read, is no
+// JSON or repeats a key ("<path>: not <what> (...)").
+nlohmann::json readJsonFile(const std::string& path, uint64_t max_bytes, const char* what) {
+  const std::string text = readInputFile(path, max_bytes);  // its errors name the file
+  try {
+    return parseJsonStrict(text);
+  } catch (const std::exception& e) {  // malformed JSON, a repeated key
+    throw std::runtime_error(fmt::format("{}: not {} ({})", path, what, e.what()));
+  }
 }
 
 void requireDir(const std::string& dir) {
@@ -103,20 +103,35 @@ std::string csvTable(const std::vector<const nlohmann::json*>& rows, const std::
 
 // The points not dominated in (datapath error, cost): no other point has both at most as large
 // and one smaller. In index order. The datapath error is what the widths control; the
-// approximation error is the fit's, the same at every point of a sweep.
+// approximation error is the fit's, the same at every point of a sweep. By error, then cost: a
+// point is on the front when its cost is the least among its error's and below every smaller
+// error's least (O(n log n): a sweep may hold 10^6 points).
 std::vector<const nlohmann::json*> paretoFront(const SweepRecords& records, const std::vector<std::string>& cost) {
-  std::vector<const nlohmann::json*> all;
-  for (const auto& kv : records) all.push_back(&kv.second);
-  auto err = [](const nlohmann::json* r) { return r->at("error").at("datapath_max_lsb").get<double>(); };
-  auto cst = [&](const nlohmann::json* r) { return at(*r, cost).get<double>(); };
-  std::vector<const nlohmann::json*> front;
-  for (const nlohmann::json* a : all) {
-    bool dominated = false;
-    for (const nlohmann::json* b : all)
-      dominated = dominated || (err(b) <= err(a) && cst(b) <= cst(a) && (err(b) < err(a) || cst(b) < cst(a)));
-    if (!dominated) front.push_back(a);
+  struct Point {
+    double err, cost;
+    uint64_t index;
+    const nlohmann::json* record;
+  };
+  std::vector<Point> all;
+  for (const auto& [k, r] : records)
+    all.push_back({r.at("error").at("datapath_max_lsb").get<double>(), at(r, cost).get<double>(), k, &r});
+  std::sort(all.begin(), all.end(), [](const Point& a, const Point& b) {
+    return a.err != b.err ? a.err < b.err : a.cost < b.cost;
+  });
+  std::vector<Point> front;
+  double least = std::numeric_limits<double>::infinity();  // over every smaller error
+  for (size_t i = 0; i < all.size();) {
+    size_t j = i;
+    while (j < all.size() && all[j].err == all[i].err) ++j;
+    if (all[i].cost < least)
+      for (size_t k = i; k < j && all[k].cost == all[i].cost; ++k) front.push_back(all[k]);
+    least = std::min(least, all[i].cost);
+    i = j;
   }
-  return front;
+  std::sort(front.begin(), front.end(), [](const Point& a, const Point& b) { return a.index < b.index; });
+  std::vector<const nlohmann::json*> out;
+  for (const Point& p : front) out.push_back(p.record);
+  return out;
 }
 
 }  // namespace
@@ -130,17 +145,10 @@ SweepPlan SweepPlan::make(nlohmann::json plan) {
 
 SweepPlan readSweepPlan(const std::string& dir) {
   const std::string path = planPath(dir);
-  nlohmann::json j;
-  try {
-    j = parseJsonStrict(readSmallFile(path, kMaxPlanBytes));
-    if (!j.is_object() || !j.contains("hash") || !j.at("hash").is_string() || !j.contains("points") ||
-        !j.at("points").is_number_unsigned())
-      throw std::runtime_error("not a sweep plan");
-  } catch (const nlohmann::json::exception& e) {
-    throw std::runtime_error(fmt::format("{}: not a sweep plan ({})", path, e.what()));
-  } catch (const std::runtime_error& e) {
-    throw std::runtime_error(fmt::format("{}: {}", path, e.what()));
-  }
+  nlohmann::json j = readJsonFile(path, kMaxPlanBytes, "a sweep plan");
+  if (!j.is_object() || !j.contains("hash") || !j.at("hash").is_string() || !j.contains("points") ||
+      !j.at("points").is_number_unsigned())
+    throw std::runtime_error(fmt::format("{}: not a sweep plan", path));
   const std::string hash = j.at("hash").get<std::string>();
   j.erase("hash");
   SweepPlan p = SweepPlan::make(std::move(j));
@@ -172,12 +180,7 @@ SweepRecords readSweepRecords(const std::string& dir, const SweepPlan& plan) {
     const std::string name = e.path().filename().string();
     if (name.rfind("point-", 0) != 0 || e.path().extension() != ".json") continue;
     const std::string path = e.path().string();
-    nlohmann::json r;
-    try {
-      r = parseJsonStrict(readSmallFile(path, kMaxRecordBytes));
-    } catch (const nlohmann::json::exception& ex) {
-      throw std::runtime_error(fmt::format("{}: not a point record ({})", path, ex.what()));
-    }
+    nlohmann::json r = readJsonFile(path, kMaxRecordBytes, "a point record");
     const bool ok = r.is_object() && r.contains("plan") && r.at("plan") == plan.hash && r.contains("index") &&
                     r.at("index").is_number_unsigned() && r.at("index").get<uint64_t>() < points &&
                     pointName(r.at("index").get<uint64_t>()) == name;
@@ -275,12 +278,13 @@ void writeSweepResults(const std::string& dir, const SweepPlan& plan, const Swee
 void mergeSweeps(const std::vector<std::string>& dirs, const std::string& out) {
   if (dirs.empty()) throw std::runtime_error("no shard directories given");
   requireDir(out);  // before the work
-  const SweepPlan plan = readSweepPlan(dirs.at(0));
+  std::optional<SweepPlan> plan;  // the first directory's
   SweepRecords all;
   for (const std::string& d : dirs) {
     const SweepPlan p = readSweepPlan(d);
-    if (p.hash != plan.hash)
-      throw std::runtime_error(fmt::format("{} and {} hold different sweeps (plans {} and {})", dirs[0], d, plan.hash,
+    if (!plan) plan = p;
+    if (p.hash != plan->hash)
+      throw std::runtime_error(fmt::format("{} and {} hold different sweeps (plans {} and {})", dirs[0], d, plan->hash,
                                            p.hash));
     for (auto& kv : readSweepRecords(d, p)) {
       const auto it = all.find(kv.first);
@@ -289,16 +293,16 @@ void mergeSweeps(const std::vector<std::string>& dirs, const std::string& out) {
       all[kv.first] = std::move(kv.second);
     }
   }
-  const std::vector<uint64_t> missing = missingPoints(plan, all);
+  const std::vector<uint64_t> missing = missingPoints(*plan, all);
   if (!missing.empty()) {
     std::string some;
     for (size_t i = 0; i < std::min<size_t>(missing.size(), 8); ++i) some += fmt::format("{}{}", i ? ", " : "", missing[i]);
     throw std::runtime_error(fmt::format("{} of the sweep's {} points are in none of the directories ({}{}): a shard "
                                          "is missing or unfinished",
-                                         missing.size(), planPoints(plan), some, missing.size() > 8 ? ", ..." : ""));
+                                         missing.size(), planPoints(*plan), some, missing.size() > 8 ? ", ..." : ""));
   }
-  claimSweepDir(out, plan);
-  writeSweepResults(out, plan, all);
+  claimSweepDir(out, *plan);
+  writeSweepResults(out, *plan, all);
 }
 
 }  // namespace shd

@@ -2,8 +2,8 @@
 // model (exhaustive error, latency, PROM size); shadesim sweep-merge: shard directories joined.
 // The directory layout and the resume rule: model/sweep/sweep_run.h.
 #include <cstdio>
-#include <map>
 #include <optional>
+#include <set>
 #include <thread>
 #include <tuple>
 
@@ -108,12 +108,12 @@ class SweepCmd final : public Command {
   // Every point's parameters, and every distinct coefficient format's PROM, before any work: a
   // point that breaks a derivation or whose coefficients do not fit stops the sweep here.
   static void validatePoints(const Grid& grid, const SpecUnitParams& base, const PromRequest& req) {
-    std::map<std::tuple<int, int, int, int, int>, bool> tables;
+    std::set<std::tuple<int, int, int, int, int>> tables;  // the coefficient formats built
     for (uint64_t k = 0; k < grid.size(); ++k) {
       const auto values = grid.point(k);
       const SpecUnitParams p = argOr(specPointParams, base, values);
       const auto key = std::make_tuple(p.Degree, p.CosFracBits, p.ShinBits, p.CoefIntBits, p.CoefFracBits);
-      if (tables.count(key) != 0) continue;
+      if (!tables.insert(key).second) continue;
       try {
         buildPromTable(req, p);
       } catch (const std::invalid_argument& e) {
@@ -121,7 +121,6 @@ class SweepCmd final : public Command {
         for (const auto& [name, value] : values) where += fmt::format("{}{}={}", where.empty() ? "" : " ", name, value);
         throw ArgError(fmt::format("point {} ({}): {}", k, where, e.what()));
       }
-      tables[key] = true;
     }
   }
 
