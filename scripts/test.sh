@@ -14,7 +14,7 @@ echo "test.sh: release tests passed after $(( $(date +%s) - start )) s"
 if [ "$sanitize" = 1 ]; then
   # -Og -g1: stack traces with files and lines (-g1: line tables only, a third less compile time
   # than -g). -Og compiles the largest model file (phong_fixed.cpp) in 0.51x the time of -O1
-  # (3 interleaved runs each); -O0 compiles faster still but ran these tests about 3x slower.
+  # (3 interleaved runs each); at -O0 one run of these tests took 243 s (76 s at -Og, another run).
   # No benchmarks (figures, not tests).
   "$root/scripts/build.sh" "$root/build-asan" -DSHD_SANITIZE=ON -DSHD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
     "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-Og -g1 -DNDEBUG"
