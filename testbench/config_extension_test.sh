@@ -15,7 +15,8 @@
 set -euo pipefail
 src=$(cd "$1" && pwd)
 work=$2
-rm -rf "$work"
+source "$(dirname "$0")/fresh_work.sh"
+fresh_work "$work"
 mkdir -p "$work/ext/config" "$work/run"
 ext=$work/ext/config
 step() { echo "config_extension: $*"; "$@"; }

@@ -5,7 +5,8 @@
 set -euo pipefail
 shadesim=$(realpath "$1")
 work=$2
-rm -rf "$work"
+source "$(dirname "$0")/fresh_work.sh"
+fresh_work "$work"
 mkdir -p "$work/a" "$work/b" "$work/cache"
 cd "$work"
 args=(--config narrow --n-list 1,8,64,500 --param CoefFracBits=5:6 --area ice40 --synth-cache cache --quiet)

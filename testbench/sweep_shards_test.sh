@@ -7,7 +7,8 @@ set -euo pipefail
 shadesim=$(realpath "$1")
 work=$2
 root=$(cd "$(dirname "$0")/.." && pwd)
-rm -rf "$work"
+source "$(dirname "$0")/fresh_work.sh"
+fresh_work "$work"
 mkdir -p "$work"
 cd "$work"
 args=(--config narrow --n-list 1,8,64,500 --param CoefFracBits=4:7 --param DiffFracBits=12,16)

@@ -136,7 +136,12 @@ namespace {
 // A plan of `points` points and an evaluation that counts its calls (the directory logic does
 // not depend on what a point holds).
 SweepPlan fakePlan(uint64_t points, const std::string& tag = "t") {
-  return SweepPlan::make({{"format", "test"}, {"tag", tag}, {"points", points}});
+  return SweepPlan::make({{"format", "test"},
+                          {"tag", tag},
+                          {"points", points},
+                          {"params", "rtl"},
+                          {"front", {{"error", "datapath_max_lsb"}, {"costs", {"latency", "prom_bits"}}}},
+                          {"area", "none"}});
 }
 
 nlohmann::json fakeRecord(uint64_t k) {
@@ -152,7 +157,8 @@ void runAll(const fs::path& dir, const SweepPlan& plan, const Shard& shard, std:
             unsigned jobs = 2) {
   claimSweepDir(dir.string(), plan);
   SweepRecords done = readSweepRecords(dir.string(), plan);
-  runSweepPoints(dir.string(), plan, shard, jobs, [&](uint64_t k) { ++calls; return fakeRecord(k); }, done, {});
+  runSweepJobs(dir.string(), plan, "point", shardPoints(plan, shard), jobs, [&](uint64_t k) { ++calls; return fakeRecord(k); },
+               done, {});
   if (missingPoints(plan, done).empty()) writeSweepResults(dir.string(), plan, done);
 }
 
@@ -191,7 +197,8 @@ TEST(SweepDir, ShardsMergedEqualTheUnshardedRunByteForByte) {
   const std::string e = errorOf<std::runtime_error>([&] { mergeSweeps({shards[0], shards[2]}, (root / "merged").string()); });
   EXPECT_NE(e.find("4 of the sweep's 11 points are in none of the directories (1, 4, 7, 10)"), std::string::npos) << e;
   EXPECT_EQ(testutil::dirEntries(root / "merged"), std::vector<std::string>{});
-  mergeSweeps(shards, (root / "merged").string());
+  const auto [plan_m, records_m] = mergeSweeps(shards, (root / "merged").string());
+  writeSweepResults((root / "merged").string(), plan_m, records_m);
   for (const char* f : {"sweep.csv", "sweep.json", "pareto.csv", "sweep-plan.json"})
     EXPECT_EQ(slurp(root / "merged" / f), slurp(root / "whole" / f)) << f;
 }
@@ -201,7 +208,8 @@ TEST(SweepDir, ParetoFrontsOfErrorAgainstEachCost) {
   std::atomic<int> calls{0};
   runAll(dir, fakePlan(12), Shard{}, calls);
   // datapath_max_lsb by k: 0.5 + ((7k) mod 5)/4: k = 0, 5, 10 reach 0.5; latency 2 at even k, so
-  // the latency front is k = 0 and 10 (0.5 at latency 2); prom_bits 1000 at k mod 4 = 0: k = 0.
+  // the latency front is k = 0 or 10 (0.5 at latency 2), of which the fewer parameter bits: k = 0
+  // (A + B = 0; k = 10 has 4); prom_bits 1000 at k mod 4 = 0: k = 0.
   const std::string pareto = slurp(dir / "pareto.csv");
   EXPECT_EQ(pareto.substr(0, pareto.find('\n')), "front,index,hash,A,B,datapath_max_lsb,latency,prom_bits");
   std::set<std::string> rows;
@@ -212,7 +220,61 @@ TEST(SweepDir, ParetoFrontsOfErrorAgainstEachCost) {
     rows.insert(line.substr(0, line.find(',', line.find(',') + 1)));
     at = end + 1;
   }
-  EXPECT_EQ(rows, (std::set<std::string>{"error-latency,0", "error-latency,10", "error-prom_bits,0"}));
+  EXPECT_EQ(rows, (std::set<std::string>{"error-latency,0", "error-prom_bits,0"}));
+}
+
+namespace {
+
+// A 3 x 3 grid, A = 1:3 and B = 3,1,2 (a list out of order), error max(3 - A, 3 - B).
+SweepPlan areaPlan() {
+  return SweepPlan::make({{"format", "test"},
+                          {"points", 9},
+                          {"params", "rtl"},
+                          {"front", {{"error", "datapath_max_lsb"}, {"costs", {"latency"}}}},
+                          {"area", "ice40 (test)"},
+                          {"axes",
+                           {{{"name", "A"}, {"text", "1:3"}, {"values", {1, 2, 3}}},
+                            {{"name", "B"}, {"text", "3,1,2"}, {"values", {3, 1, 2}}}}}});
+}
+
+SweepRecords areaRecords(const SweepPlan& plan) {
+  SweepRecords r;
+  const Grid g = planGrid(plan);
+  for (uint64_t k = 0; k < 9; ++k) {
+    const int a = g.point(k)[0].second, b = g.point(k)[1].second;
+    r[k] = {{"index", k}, {"hash", "h"}, {"rtl", {{"A", a}, {"B", b}}},
+            {"error", {{"datapath_max_lsb", std::max(3 - a, 3 - b)}}}, {"latency", 2}};
+  }
+  return r;
+}
+
+}  // namespace
+
+// A point is synthesised only when no point no wider on every axis has at most its error.
+TEST(SweepArea, PointsThatCannotReachAFrontAreNotSynthesised) {
+  const SweepPlan plan = areaPlan();
+  const SweepRecords records = areaRecords(plan);
+  // (1,1) error 2, (2,2) error 1, (3,3) error 0 are synthesised; (3,2) [index 8] and (2,3) [3]
+  // are matched by (2,2) [5]; every other point by (1,1) [1].
+  EXPECT_EQ(areaDominators(plan, records), (std::vector<int64_t>{1, -1, 1, 5, 1, -1, -1, 1, 5}));
+  nlohmann::json all = plan.json;
+  all["area_all"] = true;
+  EXPECT_EQ(areaDominators(SweepPlan::make(all), records), std::vector<int64_t>(9, -1));
+  // The results: the pruned points with area_pruned_by, the front over the synthesised ones.
+  const fs::path dir = testutil::freshTestDir("sweep");
+  SweepRecords areas;
+  for (uint64_t k : {1, 5, 6}) areas[k] = {{"index", k}, {"area", {{"ice40", {{"luts", 100 * (k + 1)}}}}}};
+  EXPECT_THROW(writeSweepResults(dir.string(), plan, records, {}), std::logic_error);
+  writeSweepResults(dir.string(), plan, records, areas);
+  const std::string csv = slurp(dir / "sweep.csv");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "index,hash,A,B,datapath_max_lsb,latency,ice40_luts,area_pruned_by");
+  EXPECT_NE(csv.find("\n5,h,2,2,1,2,600,\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n8,h,3,2,1,2,,5\n"), std::string::npos) << csv;
+  const std::string pareto = slurp(dir / "pareto.csv");
+  for (const char* row : {"error-ice40_luts,1,", "error-ice40_luts,5,", "error-ice40_luts,6,"})
+    EXPECT_NE(pareto.find(row), std::string::npos) << row << "\n" << pareto;
+  EXPECT_NE(pareto.find("error-latency,6,"), std::string::npos) << pareto;
+  EXPECT_EQ(std::count(pareto.begin(), pareto.end(), '\n'), 5);
 }
 
 TEST(SweepDir, RefusesAnotherSweepAndForeignOrCorruptedPoints) {

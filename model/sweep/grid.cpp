@@ -68,9 +68,15 @@ Grid::Grid(std::vector<GridAxis> axes) : axes_(std::move(axes)) {
   }
 }
 
-std::vector<std::pair<std::string, int>> Grid::point(uint64_t index) const {
+std::string describePoint(const PointValues& values) {
+  std::string where;
+  for (const auto& [name, value] : values) where += fmt::format("{}{}={}", where.empty() ? "" : " ", name, value);
+  return where;
+}
+
+PointValues Grid::point(uint64_t index) const {
   if (index >= size_) throw std::out_of_range(fmt::format("grid point {} of {}", index, size_));
-  std::vector<std::pair<std::string, int>> p(axes_.size());
+  PointValues p(axes_.size());
   for (size_t k = axes_.size(); k-- > 0;) {  // the last axis varies fastest
     const uint64_t n = axes_[k].values.size();
     p[k] = {axes_[k].name, axes_[k].values[index % n]};

@@ -11,6 +11,12 @@
 
 namespace shd {
 
+// A point's parameter values, in the order of the grid's axes.
+using PointValues = std::vector<std::pair<std::string, int>>;
+
+// "Name=v Name2=w": a point as messages name it.
+std::string describePoint(const PointValues& values);
+
 struct GridAxis {
   std::string name;         // a parameter of the unit ("CoefFracBits")
   std::string text;         // as given: "8:16", "8:16:2", "4,6,9"
@@ -31,7 +37,7 @@ class Grid {
   const std::vector<GridAxis>& axes() const { return axes_; }
   uint64_t size() const { return size_; }
   // The parameter values of point `index` (< size()), in the order of the axes.
-  std::vector<std::pair<std::string, int>> point(uint64_t index) const;
+  PointValues point(uint64_t index) const;
 
  private:
   std::vector<GridAxis> axes_;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <set>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -17,14 +18,10 @@ std::vector<std::string> specParamNames() {
   return names;
 }
 
-SpecUnitParams specPointParams(const SpecUnitParams& base, const std::vector<std::pair<std::string, int>>& values) {
+SpecUnitParams specPointParams(const SpecUnitParams& base, const PointValues& values) {
   nlohmann::json rtl = base.toJson();
-  std::string where;
-  for (const auto& [name, value] : values) {
-    rtl[name] = value;
-    where += fmt::format("{}{}={}", where.empty() ? "" : " ", name, value);
-  }
-  return SpecUnitParams::fromJson(rtl, "point " + where);
+  for (const auto& [name, value] : values) rtl[name] = value;
+  return SpecUnitParams::fromJson(rtl, "point " + describePoint(values));
 }
 
 std::string specPointHash(const SpecUnitParams& p) { return textHash(p.toJson().dump()); }
@@ -45,8 +42,7 @@ std::vector<int64_t> specSampleCodes(const SpecUnitParams& p, size_t entries, ui
   return {codes.begin(), codes.end()};
 }
 
-nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req,
-                                 const SynthTool* synth) {
+nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req) {
   const PromTable table = buildPromTable(req, p);
   const std::vector<int64_t> codes = specSampleCodes(p, table.entries.size(), kSpecSampleSeed);
   const SpecErrorReport r = computeSpecError("sweep", table, {}, codes);
@@ -77,8 +73,65 @@ nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const 
   j["prom_bits"] = static_cast<int64_t>(p.promDepth()) * p.promWordBits();
   j["inputs"] = static_cast<int64_t>(table.entries.size()) * (codes.empty() ? p.cosOne() + 1 : static_cast<int64_t>(codes.size()));
   j["exhaustive"] = codes.empty() ? 1 : 0;
-  if (synth != nullptr) j["area"] = specPointArea(table, *synth);
   return j;
+}
+
+nlohmann::json specSweepBase(const std::string& config, const SpecUnitParams& rtl, const PromContent& prom) {
+  return {{"unit", "spec"},
+          {"config", config},
+          {"rtl", rtl.toJson()},
+          {"prom", {{"fit", prom.fit}, {"level", prom.level}, {prom.is_list ? "n_list" : "n", prom.n}}}};
+}
+
+SweepUnit specSweepUnit(const nlohmann::json& base_json) {
+  const SpecUnitParams base = SpecUnitParams::fromJson(base_json.at("rtl"), "the sweep's base");
+  const nlohmann::json& pj = base_json.at("prom");
+  const bool is_list = pj.contains("n_list");
+  const PromRequest req = PromRequest::fromContent(
+      {pj.at("fit").get<std::string>(), pj.at("level").get<double>(), pj.at(is_list ? "n_list" : "n").get<std::string>(),
+       is_list});
+  SweepUnit u;
+  u.name = "spec";
+  u.base = base_json;
+  u.base_options = fmt::format("--config {} --fit {} --level {} --{} {}", base_json.at("config").get<std::string>(),
+                               pj.at("fit").get<std::string>(), pj.at("level").dump(), is_list ? "n-list" : "n",
+                               pj.at(is_list ? "n_list" : "n").get<std::string>());
+  u.params = specParamNames();
+  u.params_member = "rtl";
+  u.front_error = "datapath_max_lsb";
+  u.front_costs = {"latency", "prom_bits"};
+  u.validate = [base, req](const Grid& grid) {
+    std::set<std::tuple<int, int, int, int, int>> tables;  // the coefficient formats built
+    for (uint64_t k = 0; k < grid.size(); ++k) {
+      const PointValues values = grid.point(k);
+      const SpecUnitParams p = specPointParams(base, values);
+      if (!tables.insert(std::make_tuple(p.Degree, p.CosFracBits, p.ShinBits, p.CoefIntBits, p.CoefFracBits)).second)
+        continue;
+      try {
+        buildPromTable(req, p);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(fmt::format("point {} ({}): {}", k, describePoint(values), e.what()));
+      }
+    }
+  };
+  u.evaluate = [base, req](uint64_t index, const PointValues& values) {
+    return evaluateSpecPoint(index, specPointParams(base, values), req);
+  };
+  u.area = [base, req](const PointValues& values, const SynthTool& tool) {
+    return specPointArea(buildPromTable(req, specPointParams(base, values)), tool);
+  };
+  u.config = [base, pj](const PointValues& values, const std::string& name, const std::string& description) {
+    return nlohmann::json{{"name", name},
+                          {"description", description},
+                          {"rtl", specPointParams(base, values).toJson()},
+                          {"prom", pj}};
+  };
+  // The datapath's own widths; CosFracBits, ShinBits and LightBits are its interface (the
+  // inputs' formats and the PROM's depth), PipeStages and Degree no widths. HornerFracBits only
+  // at degree 3 (the quadratic unit has no Horner step).
+  u.widths = {"CoefIntBits", "CoefFracBits", "DiffFracBits", "SpecFracBits"};
+  if (base.Degree == 3) u.widths.push_back("HornerFracBits");
+  return u;
 }
 
 }  // namespace shd

@@ -14,13 +14,14 @@
 
 #include "device/prom.h"
 #include "device/spec_params.h"
-#include "sweep/spec_area.h"
+#include "sweep/area.h"
+#include "sweep/sweep_unit.h"
 
 namespace shd {
 
 // The base parameters with `values` set (names as in SpecUnitParams::toJson). std::invalid_argument
 // naming the point and the derivation a width breaks (SpecUnitParams::validate).
-SpecUnitParams specPointParams(const SpecUnitParams& base, const std::vector<std::pair<std::string, int>>& values);
+SpecUnitParams specPointParams(const SpecUnitParams& base, const PointValues& values);
 
 constexpr uint64_t kSpecExhaustiveInputs = uint64_t{1} << 28;
 constexpr uint64_t kSpecSampleSeed = 20261125;
@@ -35,10 +36,19 @@ std::vector<int64_t> specSampleCodes(const SpecUnitParams& p, size_t entries, ui
 std::vector<std::string> specParamNames();
 
 // The point's record: {"index", "hash", "rtl", "error": {...}, "latency", "prom_bits",
-// "inputs", "exhaustive" (1 or 0: sampled)}, and with `synth` its "area" (spec_area.h). Deterministic: the same parameters and
-// request give the same record, byte for byte, on any machine (no timings in it).
-nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req,
-                                 const SynthTool* synth = nullptr);
+// "inputs", "exhaustive" (1 or 0: sampled)}. Deterministic: the same parameters and request
+// give the same record, byte for byte, on any machine (no timings in it).
+nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req);
+
+// The base of a specular sweep as its plan records it: {"unit": "spec", "config": what --config
+// names, "rtl": the parameters, "prom": the configuration's "prom" member}.
+nlohmann::json specSweepBase(const std::string& config, const SpecUnitParams& rtl, const PromContent& prom);
+
+// The specular unit as a sweep sees it: the base's parameters with the grid's values, each
+// point's PROM built by the base's request. validate() builds the PROM of every distinct
+// coefficient format (coefficients that do not fit stop the sweep); the fronts weigh
+// datapath_max_lsb against latency and PROM bits.
+SweepUnit specSweepUnit(const nlohmann::json& base);
 
 // The hash naming a point's parameters (textHash of its "rtl" object).
 std::string specPointHash(const SpecUnitParams& p);

@@ -3,9 +3,12 @@
 //                            version, the command); its hash names the sweep
 //   DIR/point-<index>.json   one record per evaluated point, each written atomically, so a killed
 //                            sweep started again skips the points already recorded
+//   DIR/area-<index>.json    the area of a point that may reach a front (areaDominators), written
+//                            after every point is recorded, each atomically too
 //   DIR/sweep.json, sweep.csv, pareto.csv
-//                            the results, written once every point is recorded (by the run that
-//                            records the last one, or by sweep-merge from shard directories)
+//                            the results, written once every point (and area) is recorded (by
+//                            the run that records the last one, or by sweep-merge from shard
+//                            directories)
 // A directory holding another sweep's plan is refused; a point file that does not belong to its
 // plan (corrupted, edited, of another sweep) is an error naming it.
 #pragma once
@@ -14,6 +17,7 @@
 #include <functional>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -44,24 +48,55 @@ SweepPlan readSweepPlan(const std::string& dir);
 // plan's point count, the index in its name). std::runtime_error naming a file that fails.
 SweepRecords readSweepRecords(const std::string& dir, const SweepPlan& plan);
 
-// Evaluates the points of `shard` not in `done` with `jobs` threads, writing each record to
-// DIR/point-<index>.json as it finishes and adding it to `done`. `evaluate(index)` returns the
-// record; `progress(recorded, total)` is called after each. The first exception of an
-// evaluation stops the run (points already written stay) and is rethrown.
-void runSweepPoints(const std::string& dir, const SweepPlan& plan, const Shard& shard, unsigned jobs,
-                    const std::function<nlohmann::json(uint64_t)>& evaluate, SweepRecords& done,
-                    const std::function<void(uint64_t, uint64_t)>& progress);
+// Runs `work(index)` for each of `indices` not in `done` with `jobs` threads, writing each
+// result (with the plan's hash) to DIR/<prefix>-<index>.json as it finishes and adding it to
+// `done`; `progress(recorded, total)` is called after each. The first exception stops the run
+// (results already written stay) and is rethrown.
+void runSweepJobs(const std::string& dir, const SweepPlan& plan, const std::string& prefix,
+                  const std::vector<uint64_t>& indices, unsigned jobs,
+                  const std::function<nlohmann::json(uint64_t)>& work, SweepRecords& done,
+                  const std::function<void(uint64_t, uint64_t)>& progress);
+
+// The grid of a plan (its "axes").
+Grid planGrid(const SweepPlan& plan);
+
+// The indices of the plan's points in `shard`.
+std::vector<uint64_t> shardPoints(const SweepPlan& plan, const Shard& shard);
 
 // The indices of the plan's points missing from `records`.
 std::vector<uint64_t> missingPoints(const SweepPlan& plan, const SweepRecords& records);
 
+// Area, the second phase of a sweep whose plan asks for it ("area" other than "none"), run once
+// every point's record is there (by the run that records the last point, or by sweep-merge).
+// Which points can still reach an error-area front: point p cannot when another point q of the
+// grid is no wider than p on every axis and has at most p's front error (plan "front"
+// "error"), for then q has at most p's area too IF area does not decrease when a width grows
+// (an assumption about the synthesis tool: docs/sweeps.md measures where it fails) and p adds
+// nothing to any front of error against an area figure. Such a q is found for each point
+// through its neighbours one value lower on one axis (the least error of everything below p).
+// Returns, per point, -1 for a point to synthesise, else the index of a q (the least-error one,
+// then the least index). With the plan's "area_all" every point is synthesised.
+std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& records);
+
+// The area records in DIR (area-<index>.json), checked like the point records.
+SweepRecords readSweepAreas(const std::string& dir, const SweepPlan& plan);
+
+// The records of a complete sweep in index order, without "plan", each with its "area" or, if
+// areaDominators() rules it out, "area_pruned_by" (with area; std::logic_error when `areas`
+// lacks one it needs).
+nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, const SweepRecords& areas = {});
+
 // sweep.json, sweep.csv and pareto.csv of a complete sweep into DIR, as one set of files. The
-// same plan and records give the same bytes.
-void writeSweepResults(const std::string& dir, const SweepPlan& plan, const SweepRecords& records);
+// same plan and records give the same bytes. With area, `areas` holds the area of every point
+// that areaDominators() does not rule out; the others are recorded with "area_pruned_by".
+void writeSweepResults(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
+                       const SweepRecords& areas = {});
 
 // Joins shard directories of one sweep: the same plan (else std::runtime_error naming both
 // directories and hashes) and together every point (else an error naming the missing points).
-// Writes the plan and the results into `out` (claimed like a sweep directory).
-void mergeSweeps(const std::vector<std::string>& dirs, const std::string& out);
+// Claims `out` like a sweep directory and writes the plan and every point's record there (so that
+// `out` is the finished sweep's directory, like an unsharded run's); returns them. The caller then
+// runs the area phase, if any, into `out` and writes the results there.
+std::pair<SweepPlan, SweepRecords> mergeSweeps(const std::vector<std::string>& dirs, const std::string& out);
 
 }  // namespace shd

@@ -1,4 +1,4 @@
-#include "sweep/spec_area.h"
+#include "sweep/area.h"
 
 #include <algorithm>
 #include <cerrno>
@@ -58,25 +58,24 @@ std::string synthToolVersion(const std::string& script) {
   return v + " flow " + textHash(sources);
 }
 
-std::string findSynthScript() {
+std::string findShareFile(const std::string& relative) {
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    const fs::path installed = exe.parent_path().parent_path() / "share" / "shadesim" / "scripts" / "synth.py";
+    const fs::path installed = exe.parent_path().parent_path() / "share" / "shadesim" / relative;
     if (fs::is_regular_file(installed, ec)) return installed.string();
   }
 #ifdef SHD_SOURCE_ROOT
-  const fs::path source = fs::path(SHD_SOURCE_ROOT) / "scripts" / "synth.py";
+  const fs::path source = fs::path(SHD_SOURCE_ROOT) / relative;
   if (fs::is_regular_file(source, ec)) return source.string();
 #endif
   return "";
 }
 
-nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
-  const std::string hex = renderProm(table, PromFormat::Hex);
-  const nlohmann::json rtl = table.unit.toJson();
-  const std::string key = textHash(fmt::format("spec {} {} {} {}", rtl.dump(), tool.targets, tool.version, hex));
-  const fs::path cached = fs::path(tool.cache_dir) / fmt::format("spec-{}.json", key);
+nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+                             const nlohmann::json& prom_desc, const SynthTool& tool) {
+  const std::string key = textHash(fmt::format("{} {} {} {} {}", unit, rtl.dump(), tool.targets, tool.version, prom));
+  const fs::path cached = fs::path(tool.cache_dir) / fmt::format("{}-{}.json", unit, key);
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
     try {
@@ -86,7 +85,7 @@ nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
     }
   }
   // A private directory in the cache for the inputs and yosys's output.
-  std::string tmpl = (fs::path(tool.cache_dir) / fmt::format("spec-{}.XXXXXX", key)).string();
+  std::string tmpl = (fs::path(tool.cache_dir) / fmt::format("{}-{}.XXXXXX", unit, key)).string();
   if (mkdtemp(tmpl.data()) == nullptr)
     throw std::runtime_error(fmt::format("{}: cannot make a directory in it: {}", tool.cache_dir, std::strerror(errno)));
   const fs::path tmp(tmpl);
@@ -97,18 +96,18 @@ nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
       fs::remove_all(p, e);
     }
   } cleanup{tmp};
-  const nlohmann::json cfg = {{"name", "sweep"},
-                              {"description", "a point of a shadesim sweep"},
-                              {"rtl", rtl},
-                              {"prom",
-                               {{"fit", toString(table.request.fit)},
-                                {"level", table.request.level},
-                                {"n", table.request.n.text}}}};
-  writeFileAtomic((tmp / "spec_sweep.json").string(), cfg.dump(2) + "\n");
-  writeFileAtomic((tmp / "spec_sweep.hex").string(), hex);
-  run({"python3", tool.script, (tmp / "spec_sweep.json").string(), "--unit", "spec", "--prom",
-       (tmp / "spec_sweep.hex").string(), "--out", (tmp / "out").string(), "--target", tool.targets},
-      fmt::format("synthesis of point {} ({})", key, tool.script));
+  nlohmann::json cfg = {{"name", "sweep"}, {"description", "a point of a shadesim sweep"}, {"rtl", rtl}};
+  const std::string cfg_file = (tmp / (unit + "_sweep.json")).string();
+  std::vector<std::string> argv = {"python3", tool.script, cfg_file, "--unit", unit};
+  if (unit == "spec") {
+    cfg["prom"] = prom_desc;
+    const std::string hex = (tmp / "spec_sweep.hex").string();
+    writeFileAtomic(hex, prom);
+    argv.insert(argv.end(), {"--prom", hex});
+  }
+  writeFileAtomic(cfg_file, cfg.dump(2) + "\n");
+  argv.insert(argv.end(), {"--out", (tmp / "out").string(), "--target", tool.targets});
+  run(argv, fmt::format("synthesis of point {} ({})", key, tool.script));
   const nlohmann::json summary =
       parseJsonStrict(readInputFile((tmp / "out" / "summary.json").string(), kMaxAreaFileBytes));
   nlohmann::json area = nlohmann::json::object();
@@ -116,6 +115,12 @@ nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
   writeFileAtomic(cached.string(),
                   nlohmann::json{{"key", key}, {"tools", tool.version}, {"rtl", rtl}, {"area", area}}.dump(1) + "\n");
   return area;
+}
+
+nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
+  return unitPointArea("spec", table.unit.toJson(), renderProm(table, PromFormat::Hex),
+                       {{"fit", toString(table.request.fit)}, {"level", table.request.level}, {"n", table.request.n.text}},
+                       tool);
 }
 
 }  // namespace shd

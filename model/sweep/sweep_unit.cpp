@@ -1,0 +1,45 @@
+#include "sweep/sweep_unit.h"
+
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "sweep/spec_sweep.h"
+
+namespace shd {
+
+namespace {
+
+struct UnitEntry {
+  const char* name;
+  const char* what;  // for --help
+  SweepUnit (*make)(const nlohmann::json& base);
+};
+
+// The units a sweep can vary: the one list.
+const UnitEntry kUnits[] = {
+    {"spec", "the specular unit (error over every input, latency, PROM bits, area)", specSweepUnit},
+};
+
+}  // namespace
+
+std::vector<std::string> sweepUnitNames() {
+  std::vector<std::string> names;
+  for (const UnitEntry& u : kUnits) names.push_back(u.name);
+  return names;
+}
+
+std::string sweepUnitHelp() {
+  std::string help;
+  for (const UnitEntry& u : kUnits) help += fmt::format("{}{}: {}", help.empty() ? "" : "; ", u.name, u.what);
+  return help;
+}
+
+SweepUnit makeSweepUnit(const nlohmann::json& base) {
+  const std::string name = base.at("unit").get<std::string>();
+  for (const UnitEntry& u : kUnits)
+    if (name == u.name) return u.make(base);
+  throw std::invalid_argument(fmt::format("no sweep unit \"{}\"", name));
+}
+
+}  // namespace shd
