@@ -6,7 +6,10 @@ may add directories with SHD_CONFIG_DIRS). The files generated from it live besi
 directory: the PROM table <dir>/../prom/spec_<name>.hex and the vector file
 <dir>/../cycles/<unit>_<name>.vec (vectors/prom/ and vectors/cycles/ for the registry).
 
-    { "name": "<name>", "description": "...", "rtl": { "<Parameter>": <integer>, ... }, ... }
+    { "name": "<name>", "description": "...", "rtl": { "<Parameter>": <integer>, ... }, ...,
+      "expected": { "<group>": { "<figure>": <number>, ... }, ... } }
+
+`expected` (optional) records the figures scripts/regress.py checks; EXPECTED lists them.
 
 `rtl` holds the Verilog parameters of the unit's top module. This script is the one place that
 turns a configuration into the options of Verilator (-G), Icarus (-P) and yosys (chparam), and
@@ -39,6 +42,20 @@ UNITS = {
     "spec": {"top": "shd_spec_unit", "rtl": ["shd_spec_unit.v", "shd_coef_rom.v", "shd_pipe_reg.v"]},
     "span": {"top": "shd_span_unit", "rtl": ["shd_span_unit.v"]},
 }
+# The figures a configuration's optional "expected" member may record, per unit: group -> figure
+# names, or None for a group that is itself one number. scripts/regress.py computes and checks
+# them (docs/configurations.md); model/config/registry.cpp holds the same table.
+_AREA = ("luts", "ffs", "carries", "dsps", "brams")
+_SPEC_SCENE = ("spec_cycles", "spec_evaluations", "max_abs_lsb")
+_SPAN_SCENE = ("cycles", "fragments")
+EXPECTED = {
+    "spec": {"error": ("total_max_lsb", "total_peak_max_lsb", "datapath_max_lsb", "datapath_max_f_lsb"),
+             "latency": None, "sphere": _SPEC_SCENE, "still_life": _SPEC_SCENE,
+             "ice40": _AREA, "xc7": _AREA},
+    "span": {"sphere": _SPAN_SCENE, "still_life": _SPAN_SCENE, "ice40": _AREA, "xc7": _AREA},
+}
+SCENES = ("sphere", "still_life")  # the named scenes: vectors/scenes/<scene>.json
+TARGETS = ("ice40", "xc7")
 NAME_RE = re.compile(r"[a-z][a-z0-9]*")  # a configuration name: also a C++ identifier part
 PARAM_RE = re.compile(r"[A-Z][A-Za-z0-9]*")
 RAW_END = ')shdjson"'  # the raw-string delimiter of the embedded text
@@ -88,9 +105,40 @@ def parse(text, where, unit=None, name=None):
         # Verilog parameters are 32-bit integers: a larger value would wrap (4294967304 to 8).
         if not -2**31 <= v < 2**31:
             raise ConfigError(f"{where}: rtl.{k} = {v} does not fit a 32-bit Verilog parameter")
+    if "expected" in j:
+        check_expected(j["expected"], where, unit)
     if RAW_END in text:
         raise ConfigError(f"{where}: contains {RAW_END!r}, which cannot be embedded")
     return Config(unit, jname, rtl, where, text)
+
+
+def _is_number(v):
+    return type(v) in (int, float)
+
+
+def check_expected(exp, where, unit):
+    """Refuses an "expected" member that is not groups of known figures holding numbers."""
+    if unit is None:  # unit unknown (stdin): any unit's table
+        table = {g: f for u in EXPECTED.values() for g, f in u.items()}
+    else:
+        table = EXPECTED[unit]
+    if not isinstance(exp, dict):
+        raise ConfigError(f"{where}: \"expected\" must be an object of figure groups")
+    for g, v in exp.items():
+        if g not in table:
+            raise ConfigError(f"{where}: expected.{g}: unknown group (known: {', '.join(table)})")
+        if table[g] is None:
+            if not _is_number(v):
+                raise ConfigError(f"{where}: expected.{g} = {json.dumps(v)} is not a number")
+            continue
+        if not isinstance(v, dict):
+            raise ConfigError(f"{where}: expected.{g} must be an object of figures")
+        for f, x in v.items():
+            if f not in table[g]:
+                raise ConfigError(f"{where}: expected.{g}.{f}: unknown figure "
+                                  f"(known: {', '.join(table[g])})")
+            if not _is_number(x):
+                raise ConfigError(f"{where}: expected.{g}.{f} = {json.dumps(x)} is not a number")
 
 
 def load_file(path, unit=None):

@@ -60,14 +60,21 @@ task=$(printf '%q ' "$shadesim" sweep "${sweep_args[@]}")
 task+="--shard \${SLURM_ARRAY_TASK_ID}/$shards --jobs $cpus --quiet -o $(printf '%q' "$dir")/shard-\${SLURM_ARRAY_TASK_ID}"
 merge=$(printf '%q ' "$shadesim" sweep-merge)
 for i in $(seq 1 "$shards"); do merge+="$(printf '%q' "$dir/shard-$i") "; done
-merge+="-o $(printf '%q' "$dir/merged")"
+merge+="-o $(printf '%q' "$dir/merged") --jobs $cpus --quiet"
+# A sweep with --area: the shards evaluate the model only; the merge runs the area phase.
+for ((i = 0; i < ${#sweep_args[@]}; i++)); do
+  case "${sweep_args[$i]}" in
+    --synth-cache) merge+=" --synth-cache $(printf '%q' "${sweep_args[$((i + 1))]:-}")" ;;
+    --synth-cache=*) merge+=" --synth-cache $(printf '%q' "${sweep_args[$i]#--synth-cache=}")" ;;
+  esac
+done
 
 array_cmd=(sbatch --parsable "--array=1-$shards" "--cpus-per-task=$cpus" --job-name=shadesim-sweep
   "${sbatch_args[@]}" "--output=$dir/shard-%a.log" --wrap "$task")
 if [ "$dry" = 1 ]; then
   echo "mkdir -p $(printf '%q' "$dir")/shard-{1..$shards} $(printf '%q' "$dir/merged")"
   printf '%q ' "${array_cmd[@]}"; echo
-  merge_cmd=(sbatch --parsable "--dependency=afterok:<the array's job id>" --job-name=shadesim-sweep-merge
+  merge_cmd=(sbatch --parsable "--dependency=afterok:<the array's job id>" "--cpus-per-task=$cpus" --job-name=shadesim-sweep-merge
     "${sbatch_args[@]}" "--output=$dir/merge.log" --wrap "$merge")
   printf '%q ' "${merge_cmd[@]}"; echo
   exit 0
@@ -76,6 +83,6 @@ for i in $(seq 1 "$shards"); do mkdir -p "$dir/shard-$i"; done
 mkdir -p "$dir/merged"
 job=$("${array_cmd[@]}")
 job=${job%%;*}
-merge_job=$(sbatch --parsable "--dependency=afterok:$job" --job-name=shadesim-sweep-merge "${sbatch_args[@]}" \
+merge_job=$(sbatch --parsable "--dependency=afterok:$job" "--cpus-per-task=$cpus" --job-name=shadesim-sweep-merge "${sbatch_args[@]}" \
   "--output=$dir/merge.log" --wrap "$merge")
 echo "sweep_slurm: array job $job ($shards tasks), merge job ${merge_job%%;*}; the merged sweep: $dir/merged"

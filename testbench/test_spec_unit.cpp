@@ -56,6 +56,44 @@ TEST(SpecUnitConfig, RejectsWidthsTheUnitCannotHold) {
   EXPECT_THROW(SpecUnitParams::fromJson(j, "t.json"), std::invalid_argument);
 }
 
+TEST(SpecUnitConfig, ExpectedFiguresAreCheckedStrictly) {
+  // The narrow configuration's parameters with `expected` as its "expected" member.
+  const auto with = [](const std::string& expected) {
+    const nlohmann::json j = {{"name", "t"},
+                              {"rtl", specConfig("narrow").rtl.toJson()},
+                              {"prom", {{"fit", "level"}, {"level", 0.5}, {"n", "1:1000"}}},
+                              {"expected", nlohmann::json::parse(expected)}};
+    return j.dump();
+  };
+  const auto error = [&](const std::string& expected) {
+    try {
+      SpecUnitConfig::parse(with(expected), "t.json");
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NO_THROW(SpecUnitConfig::parse(
+      with(R"({"error": {"total_max_lsb": 1.5}, "latency": 2, "xc7": {"luts": 10}})"), "t.json"));
+  EXPECT_EQ(error(R"({"error": {"total_max": 1}})"),
+            "t.json: expected.error.total_max: unknown figure (known: total_max_lsb, total_peak_max_lsb, "
+            "datapath_max_lsb, datapath_max_f_lsb)");
+  EXPECT_EQ(error(R"({"ice40": {"luts": "10"}})"), "t.json: expected.ice40.luts = \"10\" is not a number");
+  EXPECT_EQ(error(R"({"latency": {"cycles": 2}})"), "t.json: expected.latency = {\"cycles\":2} is not a number");
+  EXPECT_NE(error(R"({"torus": {}})").find("t.json: expected.torus: unknown group"), std::string::npos);
+  EXPECT_EQ(error(R"([1])"), "t.json: \"expected\" must be an object of figure groups");
+  // The span unit's groups are its own: no error figures.
+  for (const BuiltinConfig& b : builtinConfigs()) {
+    if (std::string(b.unit) != "span") continue;
+    nlohmann::json j = nlohmann::json::parse(b.json);
+    j["expected"] = {{"sphere", {{"cycles", 1}, {"fragments", 2}}}};
+    EXPECT_NO_THROW(SpanUnitConfig::parse(j.dump(), "t.json"));
+    j["expected"] = {{"error", nlohmann::json::object()}};
+    EXPECT_THROW(SpanUnitConfig::parse(j.dump(), "t.json"), std::invalid_argument);
+    break;
+  }
+}
+
 TEST(SpecUnitConfig, CoefficientThatDoesNotFitIsNamed) {
   SpecUnitParams p;
   p.CoefIntBits = 9;  // inflection a reaches 786.4 at n = 1000

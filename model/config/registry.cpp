@@ -64,6 +64,61 @@ PromContent promFromJson(const nlohmann::json& value, const std::string& where) 
   return c;
 }
 
+// The figures "expected" may record (scripts/regress.py computes and checks them; the table is
+// also in scripts/shd_config.py, EXPECTED): group -> figure names; a group with no figure names
+// is itself one number.
+struct ExpectedGroup {
+  const char* group;
+  std::vector<const char*> figures;
+};
+const std::vector<ExpectedGroup>& expectedGroups(const std::string& unit) {
+  static const std::vector<const char*> area = {"luts", "ffs", "carries", "dsps", "brams"};
+  static const std::vector<const char*> spec_scene = {"spec_cycles", "spec_evaluations", "max_abs_lsb"};
+  static const std::vector<const char*> span_scene = {"cycles", "fragments"};
+  static const std::vector<ExpectedGroup> spec = {
+      {"error", {"total_max_lsb", "total_peak_max_lsb", "datapath_max_lsb", "datapath_max_f_lsb"}},
+      {"latency", {}},
+      {"sphere", spec_scene},
+      {"still_life", spec_scene},
+      {"ice40", area},
+      {"xc7", area}};
+  static const std::vector<ExpectedGroup> span = {
+      {"sphere", span_scene}, {"still_life", span_scene}, {"ice40", area}, {"xc7", area}};
+  return unit == "spec" ? spec : span;
+}
+
+// "expected": the figures the configuration is known to reach; only its shape is checked here.
+void checkExpected(const nlohmann::json& value, const std::string& where, const std::string& unit) {
+  if (!value.is_object())
+    throw std::invalid_argument(fmt::format("{}: \"expected\" must be an object of figure groups", where));
+  const auto& groups = expectedGroups(unit);
+  for (const auto& [gk, gv] : value.items()) {
+    const auto g = std::find_if(groups.begin(), groups.end(), [&](const ExpectedGroup& e) { return gk == e.group; });
+    if (g == groups.end()) {
+      std::vector<std::string> names;
+      for (const ExpectedGroup& e : groups) names.emplace_back(e.group);
+      throw std::invalid_argument(
+          fmt::format("{}: expected.{}: unknown group (known: {})", where, gk, fmt::join(names, ", ")));
+    }
+    if (g->figures.empty()) {
+      if (!gv.is_number())
+        throw std::invalid_argument(fmt::format("{}: expected.{} = {} is not a number", where, gk, gv.dump()));
+      continue;
+    }
+    if (!gv.is_object())
+      throw std::invalid_argument(fmt::format("{}: expected.{} must be an object of figures", where, gk));
+    for (const auto& [fk, fv] : gv.items()) {
+      if (std::find_if(g->figures.begin(), g->figures.end(), [&](const char* f) { return fk == f; }) ==
+          g->figures.end())
+        throw std::invalid_argument(fmt::format("{}: expected.{}.{}: unknown figure (known: {})", where, gk, fk,
+                                                fmt::join(g->figures, ", ")));
+      if (!fv.is_number())
+        throw std::invalid_argument(
+            fmt::format("{}: expected.{}.{} = {} is not a number", where, gk, fk, fv.dump()));
+    }
+  }
+}
+
 std::string readFile(const std::string& path) {
   try {
     return readInputFile(path, uint64_t{1} << 20);  // a configuration is a few hundred bytes
@@ -111,6 +166,7 @@ SpecUnitConfig SpecUnitConfig::parse(const std::string& text, const std::string&
     else if (key == "description") c.description = stringMember(value, where, "description");
     else if (key == "rtl") c.rtl = SpecUnitParams::fromJson(value, where), has_rtl = true;
     else if (key == "prom") c.prom = promFromJson(value, where), has_prom = true;
+    else if (key == "expected") checkExpected(value, where, "spec");
     else throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", where, key));
   }
   // A file states the whole unit: nothing falls back to a default the user did not see.
@@ -134,6 +190,7 @@ SpanUnitConfig SpanUnitConfig::parse(const std::string& text, const std::string&
     if (key == "name") c.name = stringMember(value, where, "name");
     else if (key == "description") c.description = stringMember(value, where, "description");
     else if (key == "rtl") c.rtl = SpanParams::fromJson(value, where), has_rtl = true;
+    else if (key == "expected") checkExpected(value, where, "span");
     else throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", where, key));
   }
   if (c.name.empty()) throw std::invalid_argument(fmt::format("{}: missing \"name\"", where));

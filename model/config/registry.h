@@ -7,7 +7,9 @@
 //   { "name": "<name>",                      // lower-case letters and digits, as in the file name
 //     "description": "...",                  // free text
 //     "rtl":  { "<Parameter>": <integer> },  // the Verilog parameters of the unit's top module
-//     "prom": { "fit": ..., "level": ..., "n": ... } }   // spec only: the PROM's contents
+//     "prom": { "fit": ..., "level": ..., "n": ... },    // spec only: the PROM's contents
+//     "expected": { "<group>": { "<figure>": <number> } } }  // optional: the figures
+//                                        // scripts/regress.py checks (docs/configurations.md)
 // CMake verilates one model per registry file with every member of "rtl" as -G<Name>=<value>
 // (scripts/shd_config.py makes the options of Verilator, Icarus and yosys); the model reads the
 // same members here. A span configuration is a lane mode: its name is the mode's name and its
