@@ -138,8 +138,9 @@ void printNarrower(const nlohmann::json& narrower) {
       what = fmt::format("still within it ({:.6g} LSB): not minimal in this width", n.at("error").get<double>());
     } else {
       what = fmt::format("still within it ({:.6g} LSB), {}; {}", n.at("error").get<double>(), areaText(n.at("area")),
-                         n.at("smaller").get<bool>() ? "fewer LUTs: NOT minimal, the grid misses this value"
-                                                     : "no fewer LUTs (synthesis is not monotone in this width)");
+                         n.at("smaller").get<bool>() ? "fewer LUTs: NOT minimal (a value the grid misses, or a point "
+                                                       "the pruning dropped: docs/sweeps.md)"
+                                                     : "no fewer LUTs");
     }
     std::printf("    %s %d: %s\n", n.at("width").get<std::string>().c_str(), n.at("value").get<int>(), what.c_str());
   }
