@@ -162,7 +162,27 @@ int runTarget(const std::string& dir, const SweepPlan& plan, const SweepUnit& un
                 describePoint(valuesOf(*best, member)).c_str());
     return kExitFailed;
   }
-  const nlohmann::json& chosen = results.at(static_cast<size_t>(k));
+  nlohmann::json chosen = results.at(static_cast<size_t>(k));
+  // By area: the grid's pick, then one-bit steps down while a narrower width still meets E with
+  // fewer LUTs (a value the grid misses, or a point its pruning dropped), so that every width of
+  // the written configuration is shown minimal.
+  nlohmann::json narrower = narrowerPoints(unit, chosen, synth, req);
+  int steps = 0;
+  for (;;) {
+    const nlohmann::json* step = nullptr;
+    for (const nlohmann::json& n : narrower)
+      if (n.value("smaller", false) && (step == nullptr || luts(n) < luts(*step))) step = &n;
+    if (step == nullptr || req.objective != "area") break;
+    PointValues v = valuesOf(chosen, member);
+    for (auto& [name, value] : v)
+      if (name == step->at("width")) value = step->at("value").get<int>();
+    nlohmann::json next = unit.evaluate(0, v);
+    next["index"] = nullptr;  // not a point of the grid
+    next["area"] = step->at("area");
+    chosen = std::move(next);
+    ++steps;
+    narrower = narrowerPoints(unit, chosen, synth, req);
+  }
   const PointValues values = valuesOf(chosen, member);
   // The configuration file, then the RTL against the model on it.
   const std::string config_file = (fs::path(dir) / fmt::format("{}_{}.json", unit.name, req.name)).string();
@@ -176,14 +196,16 @@ int runTarget(const std::string& dir, const SweepPlan& plan, const SweepUnit& un
   const nlohmann::json base = unit.evaluate(0, {});
   nlohmann::json base_area;
   if (synth != nullptr) base_area = unit.area({}, *synth);
-  const nlohmann::json narrower = narrowerPoints(unit, chosen, synth, req);
   const nlohmann::json report = {{"target_lsb", req.lsb}, {"objective", req.objective}, {"sweep", plan.hash},
                                  {"chosen", chosen},      {"config", config_file},      {"rtl_check", verdict},
+                                 {"grid_point", k},       {"steps_down", steps},
                                  {"base", base},          {"base_area", base_area},     {"one_bit_narrower", narrower}};
   writeFileAtomic((fs::path(dir) / "target.json").string(), report.dump(1) + "\n");
 
-  std::printf("target %g LSB (%s), least %s: point %lld, %s\n", req.lsb, error.c_str(), req.objective.c_str(),
-              static_cast<long long>(k), describePoint(values).c_str());
+  const std::string from = steps == 0 ? fmt::format("point {}", k)
+                                      : fmt::format("point {} and {} one-bit step{} down", k, steps, steps > 1 ? "s" : "");
+  std::printf("target %g LSB (%s), least %s: %s, %s\n", req.lsb, error.c_str(), req.objective.c_str(), from.c_str(),
+              describePoint(values).c_str());
   std::printf("  written as %s\n  %s\n", config_file.c_str(), verdict.c_str());
   std::printf("  %-10s %-16s %-8s %s\n", "", error.c_str(), "latency", "area");
   std::printf("  %-10s %-16.6g %-8lld %s\n", "chosen", chosen.at("error").at(error).get<double>(),
