@@ -121,14 +121,6 @@ std::string csvTable(const std::vector<const nlohmann::json*>& rows, const std::
   return out;
 }
 
-// The sum of a record's parameters: the tie-break of the fronts (the narrowest point).
-int64_t paramSum(const nlohmann::json& record, const std::string& params) {
-  int64_t sum = 0;
-  for (const auto& item : record.at(params).items())
-    if (item.value().is_number_integer()) sum += item.value().get<int64_t>();
-  return sum;
-}
-
 // The points not dominated in (front error, cost): no other point has both at most as large
 // and one smaller; of points equal in both, one: the fewest parameter bits, then the least
 // index. Points without the cost (pruned from synthesis) take no part. In index order. The
@@ -149,7 +141,7 @@ std::vector<const nlohmann::json*> paretoFront(const std::vector<const nlohmann:
   for (const nlohmann::json* r : records) {
     const nlohmann::json& c = at(*r, cost);
     if (c.is_null()) continue;
-    all.push_back({r->at("error").at(error).get<double>(), c.get<double>(), paramSum(*r, params),
+    all.push_back({r->at("error").at(error).get<double>(), c.get<double>(), paramBits(*r, params),
                    r->at("index").get<uint64_t>(), r});
   }
   std::sort(all.begin(), all.end(), [](const Point& a, const Point& b) {
@@ -374,9 +366,20 @@ nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, 
   return points;
 }
 
+int64_t paramBits(const nlohmann::json& record, const std::string& params) {
+  int64_t sum = 0;
+  for (const auto& item : record.at(params).items())
+    if (item.value().is_number_integer()) sum += item.value().get<int64_t>();
+  return sum;
+}
+
 void writeSweepResults(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
                        const SweepRecords& areas) {
-  nlohmann::json points = sweepResults(plan, records, areas);
+  writeSweepResults(dir, plan, sweepResults(plan, records, areas));
+}
+
+void writeSweepResults(const std::string& dir, const SweepPlan& plan, const nlohmann::json& results) {
+  nlohmann::json points = results;
   nlohmann::json all = plan.json;
   all["hash"] = plan.hash;
   const nlohmann::json* synthesised = nullptr;  // the first record with an area

@@ -86,11 +86,17 @@ SweepRecords readSweepAreas(const std::string& dir, const SweepPlan& plan);
 // lacks one it needs).
 nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, const SweepRecords& areas = {});
 
-// sweep.json, sweep.csv and pareto.csv of a complete sweep into DIR, as one set of files. The
-// same plan and records give the same bytes. With area, `areas` holds the area of every point
-// that areaDominators() does not rule out; the others are recorded with "area_pruned_by".
+// sweep.json, sweep.csv and pareto.csv of a complete sweep into DIR, as one set of files, from
+// its results (sweepResults). The same plan and records give the same bytes. With area, `areas`
+// holds the area of every point that areaDominators() does not rule out; the others are
+// recorded with "area_pruned_by".
+void writeSweepResults(const std::string& dir, const SweepPlan& plan, const nlohmann::json& results);
 void writeSweepResults(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
                        const SweepRecords& areas = {});
+
+// The sum of a record's integer parameters (the member `params`): "the fewest parameter bits"
+// that breaks ties between points.
+int64_t paramBits(const nlohmann::json& record, const std::string& params);
 
 // Joins shard directories of one sweep: the same plan (else std::runtime_error naming both
 // directories and hashes) and together every point (else an error naming the missing points).

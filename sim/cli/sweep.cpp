@@ -63,8 +63,8 @@ std::function<void(uint64_t, uint64_t)> progressOf(Progress& progress, const cha
 
 // The second phase of a complete sweep, then its results: the area of every point that can
 // still reach a front (areaDominators), each kept in DIR/area-<index>.json, then sweep.csv,
-// sweep.json and pareto.csv. Returns the areas.
-SweepRecords finishSweep(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
+// sweep.json and pareto.csv. Returns the results (sweepResults).
+nlohmann::json finishSweep(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
                          const SynthTool* synth, unsigned jobs, bool quiet) {
   SweepRecords areas;
   if (plan.json.at("area") != "none") {
@@ -85,8 +85,9 @@ SweepRecords finishSweep(const std::string& dir, const SweepPlan& plan, const Sw
         [&](uint64_t k) { return nlohmann::json{{"index", k}, {"area", unit.area(grid.point(k), *synth)}}; }, areas,
         progressOf(progress, "points"));
   }
-  writeSweepResults(dir, plan, records, areas);
-  return areas;
+  nlohmann::json results = sweepResults(plan, records, areas);
+  writeSweepResults(dir, plan, results);
+  return results;
 }
 
 class SweepCmd final : public Command {
@@ -129,6 +130,7 @@ class SweepCmd final : public Command {
     const bool target = app.count("--target-lsb") > 0;
     checkTargetOptions(app, target);
     const SweepUnit unit = argOr(makeSweepUnit, unitBase());
+    if (target && !unit.config) throw ArgError(fmt::format("--target-lsb: the {} sweep has no configuration to write", unit.name));
     std::vector<GridAxis> axes;
     for (const std::string& p : params_) axes.push_back(argOr(parseGridAxis, p, unit.params));
     const Grid grid = argOr([](std::vector<GridAxis> a) { return Grid(std::move(a)); }, axes);
@@ -163,12 +165,12 @@ class SweepCmd final : public Command {
                   static_cast<unsigned long long>(shard.count), dir_.c_str());
       return kExitOk;
     }
-    const SweepRecords areas = finishSweep(dir_, plan, done, synth ? &*synth : nullptr, jobs, quiet_);
+    const nlohmann::json results = finishSweep(dir_, plan, done, synth ? &*synth : nullptr, jobs, quiet_);
     std::printf("sweep %s: %llu points; %s/sweep.csv, sweep.json, pareto.csv\n", plan.hash.c_str(),
                 static_cast<unsigned long long>(grid.size()), dir_.c_str());
     if (!target) return kExitOk;
     std::fflush(stdout);
-    return runTarget(dir_, plan, unit, sweepResults(plan, done, areas), synth ? &*synth : nullptr, target_);
+    return runTarget(dir_, plan, unit, results, synth ? &*synth : nullptr, target_);
   }
 
  private:
@@ -180,7 +182,6 @@ class SweepCmd final : public Command {
         if (app.count(o) > 0) throw ArgError(fmt::format("{} applies only with --target-lsb", o));
       return;
     }
-    if (unit_ != "spec") throw ArgError(fmt::format("--target-lsb: only for --unit spec, not {}", unit_));
     if (!shard_.empty()) throw ArgError("--target-lsb: not with --shard (pick in the merged directory)");
     if (target_.objective.empty()) target_.objective = area_.empty() ? "latency" : "area";
     if (target_.objective == "area" && area_.empty()) throw ArgError("--objective area needs --area");

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "cli/command.h"
-#include "device/prom_io.h"
 #include "io/files.h"
 #include "io/process.h"
 #include "vectors/vector_gen.h"
@@ -27,12 +26,6 @@ int64_t luts(const nlohmann::json& r) {
   for (const char* t : {"ice40", "xc7"})
     if (r.at("area").contains(t)) return r.at("area").at(t).at("luts").get<int64_t>();
   return -1;
-}
-
-int64_t paramBits(const nlohmann::json& r, const std::string& member) {
-  int64_t sum = 0;
-  for (const auto& item : r.at(member).items()) sum += item.value().get<int64_t>();
-  return sum;
 }
 
 // The values of every parameter of a record (each named, so the base's own values do not matter).
@@ -76,13 +69,9 @@ std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles) {
   if (script.empty())
     throw std::runtime_error("testbench/icarus/run_icarus.sh is neither in this installation nor in the source tree");
   const SpecUnitConfig cfg = specConfig(config_file);
-  const std::string vec = fs::path(config_file).replace_extension(".vec").string(), hex = vec + ".hex";
-  const std::string dir = fs::absolute(vec).parent_path().string();
-  OutputFiles files;
-  files.add(hex, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl), PromFormat::Hex));
+  const std::string vec = fs::path(config_file).replace_extension(".vec").string();
   VectorGenSummary s;
-  files.add(vec, renderSpecVectors(generateSpecVectors(cfg, cycles, kVerifySeed, hex, dir, &s)));
-  files.commit();
+  writeSpecVectorsWithProm(cfg, cycles, kVerifySeed, vec, &s);
   std::string out, err, error;
   const int rc = runProcess({script, vec}, out, err, error);
   if (rc != 0) {

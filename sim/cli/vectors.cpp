@@ -46,13 +46,10 @@ class VectorsCmd final : public Command {
       std::string prom_file = prom_;
       if (!prom_file.empty()) requirePromFileHoldsTable(cfg, prom_file);  // an input: never an output
       outputTarget(output_);  // refused before the work, not after it
-      OutputFiles files;  // the vector file and the PROM written beside it: both or neither
-      if (prom_file.empty()) {
-        prom_file = output_ + ".hex";
-        files.add(prom_file, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl), PromFormat::Hex));
-      }
-      files.add(output_, renderSpecVectors(generateSpecVectors(cfg, cycles_, seed_, prom_file, out_dir, &s)));
-      files.commit();
+      if (prom_file.empty())
+        writeSpecVectorsWithProm(cfg, cycles_, seed_, output_, &s);
+      else
+        writeFileAtomic(output_, renderSpecVectors(generateSpecVectors(cfg, cycles_, seed_, prom_file, out_dir, &s)));
     } else {
       if (!prom_.empty()) throw ArgError("--prom: the span unit has no PROM");
       const SpanUnitConfig cfg = spanConfigArg("--config", config_);

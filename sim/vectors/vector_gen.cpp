@@ -11,6 +11,7 @@
 
 #include "device/prom.h"
 #include "device/prom_io.h"
+#include "io/files.h"
 #include "raster/desc_stream.h"
 #include "raster/setup.h"
 #include "raster/trigen.h"
@@ -28,6 +29,17 @@ std::string VectorGenSummary::text() const {
 }
 
 // ------------------------------------------------------------------ spec
+
+void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& output,
+                              VectorGenSummary* summary) {
+  const std::string prom_file = output + ".hex";
+  OutputFiles files;
+  files.add(prom_file, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl), PromFormat::Hex));
+  files.add(output, renderSpecVectors(generateSpecVectors(cfg, cycles, seed, prom_file,
+                                                          std::filesystem::absolute(output).parent_path().string(),
+                                                          summary)));
+  files.commit();
+}
 
 void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& prom_file) {
   const SpecUnitParams& p = cfg.rtl;

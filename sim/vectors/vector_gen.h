@@ -49,6 +49,10 @@ struct VectorGenSummary {
 // the header relative to `out_dir` (the directory the vector file goes to).
 SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& prom_file,
                                 const std::string& out_dir, VectorGenSummary* summary = nullptr);
+// The vector file `output` and the configuration's PROM beside it as `output`.hex (the file the
+// header refers to), written together (io/files.h OutputFiles: both or neither).
+void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& output,
+                              VectorGenSummary* summary = nullptr);
 // `prom_file` must hold exactly the configuration's table: the expected outputs depend on it
 // (std::runtime_error naming the first differing address otherwise).
 void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& prom_file);
