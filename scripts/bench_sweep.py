@@ -9,9 +9,11 @@
 2. The pruning check: a smaller grid (32 points: CoefFracBits 10:13, DiffFracBits 20:26:2,
    SpecFracBits 15:16) synthesised at every point (--area-all), then swept again with the pruning
    (the same cache: nothing is synthesised twice); prints whether each error-area front is the
-   same, and how many pairs of points q <= p (no wider on any axis) have more LUTs at q (where
-   the rule the pruning assumes does not hold).
-DIR must not exist (it is created). Exit 0 when the fronts agree, 1 when they differ.
+   same, how many pairs of points q <= p (no wider on any axis) have more LUTs at q, and how many
+   of those have the same DSP counts on both targets (the pairs the pruning compares: where the
+   rule it assumes would not hold).
+DIR must not exist (it is created). Exit 0 when the fronts agree and no pair of the same DSP
+counts has more LUTs at the narrower point, 1 otherwise.
 """
 import argparse
 import csv
@@ -83,12 +85,16 @@ def main():
         print(f"  {name}: every point {sorted(fa.get(name, []), key=int)}, pruned {sorted(fp.get(name, []), key=int)}: "
               f"{'the same' if ok else 'DIFFERENT'}")
     axes = [p.split("=")[0] for p in SMALL]
+    dsps = lambda r: tuple(r[f"{t}_dsps"] for t in TARGETS)
     for t in TARGETS:
-        bad = [(q["index"], p["index"], q[f"{t}_luts"], p[f"{t}_luts"]) for q in res for p in res
+        bad = [(q, p) for q in res for p in res
                if q is not p and all(int(q[x]) <= int(p[x]) for x in axes)
                and int(q[f"{t}_luts"]) > int(p[f"{t}_luts"])]
-        print(f"  {t}: {len(bad)} pairs q <= p with more LUTs at q"
-              + (": " + ", ".join(f"{q}->{p} ({lq} > {lp})" for q, p, lq, lp in bad[:6]) if bad else ""))
+        alike = [(q, p) for q, p in bad if dsps(q) == dsps(p)]
+        same &= not alike
+        print(f"  {t}: {len(bad)} pairs q <= p with more LUTs at q, {len(alike)} of them with the same DSP counts"
+              + "".join(f"; {q['index']}->{p['index']} ({q[f'{t}_luts']} > {p[f'{t}_luts']} LUTs, "
+                        f"DSPs {'/'.join(dsps(q))} and {'/'.join(dsps(p))})" for q, p in (alike or bad)[:4]))
     return 0 if same else 1
 
 

@@ -4,6 +4,7 @@ Xilinx 7-series and report its area.
 
 Usage: scripts/synth.py CONFIG [--unit spec|span] [--prom FILE] [--out DIR]
                         [--target ice40|xc7|both] [--check]
+       scripts/synth.py --dsps-of FILE --unit spec|span [--target ice40|xc7|both]
 
 CONFIG is a configuration file (<unit>_<name>.json; --unit names the unit of a file named
 otherwise) or "<unit>:<name>" of the registry vectors/config/ (scripts/shd_config.py reads it:
@@ -87,6 +88,10 @@ configuration's "rtl" object; no PROM (--prom is an error), summary.json has "to
   latches   proc_dlatch inferred no latch (the comb blocks assign every output on every path).
   no_mem    no $mem cell, block RAM or distributed RAM: the unit is registers and logic only.
   warnings  as above.
+
+--dsps-of FILE runs no yosys: FILE holds a JSON array of "rtl" objects of --unit, and the output
+(stdout) is a JSON array with, for each, {"<target>": the DSP count of the "dsps" check below}.
+`shadesim sweep --area` uses it to tell points whose multipliers map alike (docs/sweeps.md).
 
 Exit status: 0 success, 1 a failed check, 2 a usage or input error, 3 yosys failed.
 """
@@ -425,8 +430,10 @@ def write_json(path, obj):
 def parse_args(argv):
     p = argparse.ArgumentParser(prog=PROG, description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("config", metavar="CONFIG",
+    p.add_argument("config", metavar="CONFIG", nargs="?",
                    help="a configuration file, or <unit>:<name> of the registry")
+    p.add_argument("--dsps-of", metavar="FILE",
+                   help="print the DSP counts of the rtl objects in FILE (no synthesis)")
     p.add_argument("--unit", choices=sorted(shd_config.UNITS),
                    help="the unit of a configuration file not named <unit>_<name>.json")
     p.add_argument("--prom", metavar="FILE", help="spec: the PROM hex file")
@@ -436,9 +443,37 @@ def parse_args(argv):
     return p.parse_args(argv)
 
 
+def predict_dsps(path, unit, targets):
+    """The DSP count per target of each rtl object of the JSON array in `path` (--dsps-of)."""
+    if unit is None:
+        raise InputError("--dsps-of: name the unit (--unit spec|span)")
+    try:
+        with open(path) as f:
+            points = json.load(f)
+    except (OSError, ValueError) as e:
+        raise InputError(f"--dsps-of {path}: {e}")
+    if not isinstance(points, list):
+        raise InputError(f"--dsps-of {path}: not a JSON array of rtl objects")
+    out = []
+    for i, rtl in enumerate(points):
+        missing = [n for n in REQUIRED[unit] if not isinstance(rtl, dict) or not isinstance(rtl.get(n), int)]
+        if missing:
+            raise InputError(f"--dsps-of {path}: item {i}: rtl.{missing[0]} is missing or not an integer")
+        out.append({t: sum(tiles(TECH[t], *m[1:]) for m in multipliers(unit, rtl)) for t in targets})
+    json.dump(out, sys.stdout)
+    print()
+    return 0
+
+
 def main(argv):
     a = parse_args(argv)
     targets = ["ice40", "xc7"] if a.target == "both" else [a.target]
+    if a.dsps_of is not None:
+        if a.config is not None or a.prom is not None or a.out is not None or a.check:
+            raise InputError("--dsps-of takes only --unit and --target")
+        return predict_dsps(a.dsps_of, a.unit, targets)
+    if a.config is None:
+        raise InputError("name a CONFIG (or --dsps-of FILE)")
     c = load_config(a.config, a.unit)
     config_file = os.path.realpath(c.path) if os.path.isfile(c.path) else c.path
 

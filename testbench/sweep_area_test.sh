@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # sweep_area_test.sh SHADESIM WORK: a sweep with --area synthesises each point once (yosys, by
 # scripts/synth.py) and records its area; the same sweep in another directory takes every area
-# from the cache (no new cache entry, no synthesis) and writes the same bytes.
+# from the cache (no new cache entry, no synthesis) and writes the same bytes; the DSP counts that
+# the pruning compares (synth.py --dsps-of) equal the synthesised ones.
 set -euo pipefail
 shadesim=$(realpath "$1")
+synth=$(realpath "$(dirname "$0")/../scripts/synth.py")
 work=$2
 source "$(dirname "$0")/fresh_work.sh"
 fresh_work "$work"
@@ -24,6 +26,17 @@ for r in rows:
     assert "xc7_luts" not in r
 print("sweep_area: LUTs", [r["ice40_luts"] for r in rows])
 PY
+# The DSP counts the pruning compares (synth.py --dsps-of, no yosys) are the synthesised ones.
+python3 -c 'import json; json.dump([p["rtl"] for p in json.load(open("a/sweep.json"))["results"]], open("rtl.json", "w"))'
+python3 "$synth" --dsps-of rtl.json --unit spec --target ice40 > dsps.json
+python3 - <<'PY'
+import json
+points = json.load(open("a/sweep.json"))["results"]
+predicted = [d["ice40"] for d in json.load(open("dsps.json"))]
+assert predicted == [p["area"]["ice40"]["dsps"] for p in points], (predicted, [p["area"] for p in points])
+print("sweep_area: predicted DSPs", predicted, "equal the synthesised ones")
+PY
+
 touch -d '2000-01-01' cache/*.json
 "$shadesim" sweep "${args[@]}" -o b
 for f in sweep.csv sweep.json pareto.csv; do cmp "a/$f" "b/$f"; done

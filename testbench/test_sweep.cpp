@@ -159,7 +159,7 @@ void runAll(const fs::path& dir, const SweepPlan& plan, const Shard& shard, std:
   SweepRecords done = readSweepRecords(dir.string(), plan);
   runSweepJobs(dir.string(), plan, "point", shardPoints(plan, shard), jobs, [&](uint64_t k) { ++calls; return fakeRecord(k); },
                done, {});
-  if (missingPoints(plan, done).empty()) writeSweepResults(dir.string(), plan, done);
+  if (missingPoints(plan, done).empty()) writeSweepResults(dir.string(), plan, sweepResults(plan, done));
 }
 
 }  // namespace
@@ -198,7 +198,7 @@ TEST(SweepDir, ShardsMergedEqualTheUnshardedRunByteForByte) {
   EXPECT_NE(e.find("4 of the sweep's 11 points are in none of the directories (1, 4, 7, 10)"), std::string::npos) << e;
   EXPECT_EQ(testutil::dirEntries(root / "merged"), std::vector<std::string>{});
   const auto [plan_m, records_m] = mergeSweeps(shards, (root / "merged").string());
-  writeSweepResults((root / "merged").string(), plan_m, records_m);
+  writeSweepResults((root / "merged").string(), plan_m, sweepResults(plan_m, records_m));
   for (const char* f : {"sweep.csv", "sweep.json", "pareto.csv", "sweep-plan.json"})
     EXPECT_EQ(slurp(root / "merged" / f), slurp(root / "whole" / f)) << f;
 }
@@ -264,8 +264,10 @@ TEST(SweepArea, PointsThatCannotReachAFrontAreNotSynthesised) {
   const fs::path dir = testutil::freshTestDir("sweep");
   SweepRecords areas;
   for (uint64_t k : {1, 5, 6}) areas[k] = {{"index", k}, {"area", {{"ice40", {{"luts", 100 * (k + 1)}}}}}};
-  EXPECT_THROW(writeSweepResults(dir.string(), plan, records, {}), std::logic_error);
-  writeSweepResults(dir.string(), plan, records, areas);
+  const std::vector<int64_t> dominator = areaDominators(plan, records);
+  EXPECT_THROW(sweepResults(plan, records, {}, dominator), std::logic_error);
+  EXPECT_THROW(sweepResults(plan, records, areas, {}), std::logic_error);
+  writeSweepResults(dir.string(), plan, sweepResults(plan, records, areas, dominator));
   const std::string csv = slurp(dir / "sweep.csv");
   EXPECT_EQ(csv.substr(0, csv.find('\n')), "index,hash,A,B,datapath_max_lsb,latency,ice40_luts,area_pruned_by");
   EXPECT_NE(csv.find("\n5,h,2,2,1,2,600,\n"), std::string::npos) << csv;
@@ -275,6 +277,20 @@ TEST(SweepArea, PointsThatCannotReachAFrontAreNotSynthesised) {
     EXPECT_NE(pareto.find(row), std::string::npos) << row << "\n" << pareto;
   EXPECT_NE(pareto.find("error-latency,6,"), std::string::npos) << pareto;
   EXPECT_EQ(std::count(pareto.begin(), pareto.end(), '\n'), 5);
+}
+
+// A point is matched only by points of its class (multipliers mapped alike), reached through
+// points of its class.
+TEST(SweepArea, OnlyPointsOfTheSameClassMatch) {
+  const SweepPlan plan = areaPlan();
+  const SweepRecords records = areaRecords(plan);
+  // Class "y" at A = 2 [indices 3, 4, 5] cuts A = 3 off from A = 1: (3,1) [7] and (3,2) [8],
+  // matched by (1,1) [1] and (2,2) [5] before, are now synthesised, and so is (2,1) [4]; (2,3)
+  // [3] is still matched by (2,2) [5], within its class.
+  std::vector<std::string> classes(9, "x");
+  for (uint64_t k : {3, 4, 5}) classes[k] = "y";
+  EXPECT_EQ(areaDominators(plan, records, classes), (std::vector<int64_t>{1, -1, 1, 5, -1, -1, -1, -1, -1}));
+  EXPECT_THROW(areaDominators(plan, records, std::vector<std::string>(8, "x")), std::logic_error);
 }
 
 TEST(SweepDir, RefusesAnotherSweepAndForeignOrCorruptedPoints) {

@@ -41,6 +41,28 @@ nlohmann::json targetFigures(const nlohmann::json& t) {
           {"brams", t.at("brams")}, {"bram_kbits", t.at("bram_kbits")}, {"cells", t.at("cells_total")}};
 }
 
+// A private directory in `parent`, named from `stem`, removed with everything in it when the
+// object goes.
+class PrivateDir {
+ public:
+  PrivateDir(const std::string& parent, const std::string& stem) {
+    std::string tmpl = (fs::path(parent) / (stem + ".XXXXXX")).string();
+    if (mkdtemp(tmpl.data()) == nullptr)
+      throw std::runtime_error(fmt::format("{}: cannot make a directory in it: {}", parent, std::strerror(errno)));
+    path_ = tmpl;
+  }
+  ~PrivateDir() {
+    std::error_code e;
+    fs::remove_all(path_, e);
+  }
+  PrivateDir(const PrivateDir&) = delete;
+  PrivateDir& operator=(const PrivateDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
 }  // namespace
 
 std::string synthToolVersion(const std::string& script) {
@@ -85,17 +107,8 @@ nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl,
     }
   }
   // A private directory in the cache for the inputs and yosys's output.
-  std::string tmpl = (fs::path(tool.cache_dir) / fmt::format("{}-{}.XXXXXX", unit, key)).string();
-  if (mkdtemp(tmpl.data()) == nullptr)
-    throw std::runtime_error(fmt::format("{}: cannot make a directory in it: {}", tool.cache_dir, std::strerror(errno)));
-  const fs::path tmp(tmpl);
-  struct Cleanup {
-    fs::path p;
-    ~Cleanup() {
-      std::error_code e;
-      fs::remove_all(p, e);
-    }
-  } cleanup{tmp};
+  const PrivateDir dir(tool.cache_dir, fmt::format("{}-{}", unit, key));
+  const fs::path& tmp = dir.path();
   nlohmann::json cfg = {{"name", "sweep"}, {"description", "a point of a shadesim sweep"}, {"rtl", rtl}};
   const std::string cfg_file = (tmp / (unit + "_sweep.json")).string();
   std::vector<std::string> argv = {"python3", tool.script, cfg_file, "--unit", unit};
@@ -115,6 +128,25 @@ nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl,
   writeFileAtomic(cached.string(),
                   nlohmann::json{{"key", key}, {"tools", tool.version}, {"rtl", rtl}, {"area", area}}.dump(1) + "\n");
   return area;
+}
+
+std::vector<std::string> dspClasses(const std::string& unit, const std::vector<nlohmann::json>& rtl,
+                                    const SynthTool& tool) {
+  const PrivateDir dir(tool.cache_dir, unit + "-dsps");
+  const std::string in = (dir.path() / "rtl.json").string();
+  writeFileAtomic(in, nlohmann::json(rtl).dump() + "\n");
+  const std::string out =
+      run({"python3", tool.script, "--dsps-of", in, "--unit", unit, "--target", tool.targets}, "synth.py --dsps-of");
+  const nlohmann::json counts = parseJsonStrict(out);
+  if (!counts.is_array() || counts.size() != rtl.size())
+    throw std::runtime_error(fmt::format("synth.py --dsps-of: {} counts for {} points", counts.size(), rtl.size()));
+  std::vector<std::string> classes;
+  for (const nlohmann::json& c : counts) {
+    std::string text;
+    for (const auto& item : c.items()) text += fmt::format("{}{} {}", text.empty() ? "" : " ", item.key(), item.value().dump());
+    classes.push_back(text);
+  }
+  return classes;
 }
 
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {

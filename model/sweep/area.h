@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -37,6 +38,14 @@ std::string findShareFile(const std::string& relative);
 // output, when it fails.
 nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
                              const nlohmann::json& prom_desc, const SynthTool& tool);
+
+// Per point (`rtl`, the parameters of each), the DSP count each of the tool's targets maps its
+// multipliers to, as text ("ice40 7 xc7 6"): scripts/synth.py --dsps-of, which runs no yosys
+// (the same counts its --check compares with the synthesised netlists). Points of different
+// classes may differ in area either way (a narrower product can fall out of a DSP into LUTs),
+// so areaDominators() (sweep_run.h) compares points within a class only.
+std::vector<std::string> dspClasses(const std::string& unit, const std::vector<nlohmann::json>& rtl,
+                                    const SynthTool& tool);
 
 // The area of the specular-unit point whose PROM `table` is (its parameters are table.unit).
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool);

@@ -120,6 +120,7 @@ SweepUnit specSweepUnit(const nlohmann::json& base_json) {
   u.area = [base, req](const PointValues& values, const SynthTool& tool) {
     return specPointArea(buildPromTable(req, specPointParams(base, values)), tool);
   };
+  u.rtl = [base](const PointValues& values) { return specPointParams(base, values).toJson(); };
   u.config = [base, pj](const PointValues& values, const std::string& name, const std::string& description) {
     return nlohmann::json{{"name", name},
                           {"description", description},

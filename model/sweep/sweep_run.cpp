@@ -292,9 +292,11 @@ std::vector<uint64_t> missingPoints(const SweepPlan& plan, const SweepRecords& r
   return missing;
 }
 
-std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& records) {
+std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& records,
+                                    const std::vector<std::string>& classes) {
   const Grid grid = planGrid(plan);
   const uint64_t n = grid.size();
+  if (!classes.empty() && classes.size() != n) throw std::logic_error("areaDominators: not one class per point");
   std::vector<int64_t> dominator(n, -1);
   if (plan.json.value("area_all", false)) return dominator;
   const std::string error = plan.json.at("front").at("error").get<std::string>();
@@ -337,6 +339,7 @@ std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& r
       const int64_t lo = lower[a][position(p, a)];
       if (lo < 0) continue;
       const uint64_t q = p - position(p, a) * stride[a] + static_cast<uint64_t>(lo) * stride[a];
+      if (!classes.empty() && classes[q] != classes[p]) continue;
       best = std::min({best, below[q], Best{err(q), static_cast<int64_t>(q)}});
     }
     below[p] = best;
@@ -345,11 +348,13 @@ std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& r
   return dominator;
 }
 
-nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, const SweepRecords& areas) {
+nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, const SweepRecords& areas,
+                            const std::vector<int64_t>& dominator) {
   if (records.empty() || !missingPoints(plan, records).empty())
     throw std::logic_error("sweepResults: the sweep is incomplete");
   const bool with_area = plan.json.value("area", "none") != "none";
-  const std::vector<int64_t> dominator = with_area ? areaDominators(plan, records) : std::vector<int64_t>();
+  if (with_area && dominator.size() != records.size())
+    throw std::logic_error("sweepResults: the area phase's decision is not one per point");
   nlohmann::json points = nlohmann::json::array();
   for (const auto& [k, record] : records) {
     nlohmann::json r = record;
@@ -371,11 +376,6 @@ int64_t paramBits(const nlohmann::json& record, const std::string& params) {
   for (const auto& item : record.at(params).items())
     if (item.value().is_number_integer()) sum += item.value().get<int64_t>();
   return sum;
-}
-
-void writeSweepResults(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
-                       const SweepRecords& areas) {
-  writeSweepResults(dir, plan, sweepResults(plan, records, areas));
 }
 
 void writeSweepResults(const std::string& dir, const SweepPlan& plan, const nlohmann::json& results) {

@@ -69,30 +69,32 @@ std::vector<uint64_t> missingPoints(const SweepPlan& plan, const SweepRecords& r
 // Area, the second phase of a sweep whose plan asks for it ("area" other than "none"), run once
 // every point's record is there (by the run that records the last point, or by sweep-merge).
 // Which points can still reach an error-area front: point p cannot when another point q of the
-// grid is no wider than p on every axis and has at most p's front error (plan "front"
-// "error"), for then q has at most p's area too IF area does not decrease when a width grows
-// (an assumption about the synthesis tool: docs/sweeps.md measures where it fails) and p adds
-// nothing to any front of error against an area figure. Such a q is found for each point
-// through its neighbours one value lower on one axis (the least error of everything below p).
-// Returns, per point, -1 for a point to synthesise, else the index of a q (the least-error one,
-// then the least index). With the plan's "area_all" every point is synthesised.
-std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& records);
+// grid is no wider than p on every axis, of the same `classes` entry (when given: the DSP
+// count each target maps the point's multipliers to, dspClasses() in area.h), and has at most
+// p's front error (plan "front" "error"), for then q has at most p's area too IF area does not
+// decrease when a width grows while the multipliers map alike (an assumption about the
+// synthesis tool, which docs/sweeps.md checks on a grid synthesised at every point; without the
+// classes it fails on iCE40, where a narrower product can fall out of a DSP into LUTs) and p
+// adds nothing to any front of error against an area figure. Such a q is found for each point
+// through its neighbours one value lower on one axis (the least error of everything of its
+// class below p, reached through points of its class). Returns, per point, -1 for a point to
+// synthesise, else the index of a q (the least-error one, then the least index). With the
+// plan's "area_all" every point is synthesised.
+std::vector<int64_t> areaDominators(const SweepPlan& plan, const SweepRecords& records,
+                                    const std::vector<std::string>& classes = {});
 
 // The area records in DIR (area-<index>.json), checked like the point records.
 SweepRecords readSweepAreas(const std::string& dir, const SweepPlan& plan);
 
-// The records of a complete sweep in index order, without "plan", each with its "area" or, if
-// areaDominators() rules it out, "area_pruned_by" (with area; std::logic_error when `areas`
-// lacks one it needs).
-nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, const SweepRecords& areas = {});
+// The records of a complete sweep in index order, without "plan", each with its "area" or, where
+// the area phase's `dominator` (areaDominators()) ruled it out, "area_pruned_by" (with area;
+// std::logic_error when `areas` lacks one it needs or `dominator` is not one per point).
+nlohmann::json sweepResults(const SweepPlan& plan, const SweepRecords& records, const SweepRecords& areas = {},
+                            const std::vector<int64_t>& dominator = {});
 
 // sweep.json, sweep.csv and pareto.csv of a complete sweep into DIR, as one set of files, from
-// its results (sweepResults). The same plan and records give the same bytes. With area, `areas`
-// holds the area of every point that areaDominators() does not rule out; the others are
-// recorded with "area_pruned_by".
+// its results (sweepResults). The same plan and records give the same bytes.
 void writeSweepResults(const std::string& dir, const SweepPlan& plan, const nlohmann::json& results);
-void writeSweepResults(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
-                       const SweepRecords& areas = {});
 
 // The sum of a record's integer parameters (the member `params`): "the fewest parameter bits"
 // that breaks ties between points.

@@ -37,8 +37,10 @@ struct SweepUnit {
   std::function<void(const Grid&)> validate;
   // The record of point `index` with these values.
   std::function<nlohmann::json(uint64_t index, const PointValues&)> evaluate;
-  // The point's area (area.h), or empty when the unit has no RTL to synthesise.
+  // The point's area (area.h), or empty when the unit has no RTL to synthesise; then also its
+  // RTL parameters (the "rtl" of a configuration file: what dspClasses() reads).
   std::function<nlohmann::json(const PointValues&, const SynthTool&)> area;
+  std::function<nlohmann::json(const PointValues&)> rtl;
   // For --target-lsb (empty if the unit has none): the point as a configuration file's JSON
   // (config/registry.h) named `name`, and the internal widths a chosen point is shown minimal
   // in (each one bit narrower must break the target).

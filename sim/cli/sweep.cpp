@@ -67,12 +67,15 @@ std::function<void(uint64_t, uint64_t)> progressOf(Progress& progress, const cha
 nlohmann::json finishSweep(const std::string& dir, const SweepPlan& plan, const SweepRecords& records,
                          const SynthTool* synth, unsigned jobs, bool quiet) {
   SweepRecords areas;
+  std::vector<int64_t> dominator;
   if (plan.json.at("area") != "none") {
     if (synth == nullptr) throw ArgError("this sweep asks for area: give --synth-cache DIR");
     const SweepUnit unit = makeSweepUnit(plan.json.at("base"));
     const Grid grid = planGrid(plan);
+    std::vector<nlohmann::json> rtl;
+    for (uint64_t k = 0; k < grid.size(); ++k) rtl.push_back(unit.rtl(grid.point(k)));
+    dominator = areaDominators(plan, records, dspClasses(unit.name, rtl, *synth));
     std::vector<uint64_t> todo;
-    const std::vector<int64_t> dominator = areaDominators(plan, records);
     for (uint64_t k = 0; k < dominator.size(); ++k)
       if (dominator[k] < 0) todo.push_back(k);
     areas = readSweepAreas(dir, plan);
@@ -85,7 +88,7 @@ nlohmann::json finishSweep(const std::string& dir, const SweepPlan& plan, const 
         [&](uint64_t k) { return nlohmann::json{{"index", k}, {"area", unit.area(grid.point(k), *synth)}}; }, areas,
         progressOf(progress, "points"));
   }
-  nlohmann::json results = sweepResults(plan, records, areas);
+  nlohmann::json results = sweepResults(plan, records, areas, dominator);
   writeSweepResults(dir, plan, results);
   return results;
 }
