@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "sweep/span_sweep.h"
 #include "sweep/spec_sweep.h"
 
 namespace shd {
@@ -19,6 +20,8 @@ struct UnitEntry {
 // The units a sweep can vary: the one list.
 const UnitEntry kUnits[] = {
     {"spec", "the specular unit (error over every input, latency, PROM bits, area)", specSweepUnit},
+    {"span", "the span unit and triangle setup's widths (error against the exact plane, cycles, lanes, area)",
+     spanSweepUnit},
 };
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "cli/progress.h"
 #include "cli/sweep_target.h"
 #include "cli/table_options.h"
+#include "sweep/span_sweep.h"
 #include "sweep/spec_sweep.h"
 #include "sweep/sweep_run.h"
 #include "sweep/sweep_unit.h"
@@ -100,6 +101,16 @@ class SweepCmd final : public Command {
         ->check(CLI::IsMember(sweepUnitNames()))
         ->default_val("spec");
     table_.add(app);
+    app.get_option("--config")
+        ->description(fmt::format("the base configuration: spec {}; span {} (default serial)", configChoices("spec"),
+                                  configChoices("span")));
+    app.add_option("--triangles", triangles_, "span: the triangles of the error's set (seeded, raster/trigen.h)")
+        ->check(countIn(1, static_cast<int64_t>(kMaxSpanSweepTriangles)))
+        ->default_val(kSpanSweepTriangles);
+    app.add_option("--seed", seed_, "span: the seed of the triangle set")->default_val(kSpanSweepSeed);
+    app.add_option("--scene", scenes_, "span, phong: the bundled scenes (vectors/scenes) to count cycles or error on")
+        ->delimiter(',')
+        ->default_str("sphere,still_life");
     app.add_option("--param", params_,
                    "a parameter and its values, Name=lo:hi[:step] or Name=v1,v2,...; repeat for more axes "
                    "(the others keep the --config's values)")
@@ -132,7 +143,7 @@ class SweepCmd final : public Command {
   int run(const CLI::App& app) override {
     const bool target = app.count("--target-lsb") > 0;
     checkTargetOptions(app, target);
-    const SweepUnit unit = argOr(makeSweepUnit, unitBase());
+    const SweepUnit unit = argOr(makeSweepUnit, unitBase(app));
     if (target && !unit.config) throw ArgError(fmt::format("--target-lsb: the {} sweep has no configuration to write", unit.name));
     std::vector<GridAxis> axes;
     for (const std::string& p : params_) axes.push_back(argOr(parseGridAxis, p, unit.params));
@@ -192,8 +203,21 @@ class SweepCmd final : public Command {
       throw ArgError(fmt::format("--target-name {}: letters, digits and '_' only, starting with a letter", target_.name));
   }
 
-  // The base configuration of --unit, from its options.
-  nlohmann::json unitBase() const {
+  // The base of --unit, from its options; an option of another unit is an error.
+  nlohmann::json unitBase(const CLI::App& app) const {
+    auto only = [&](const std::vector<const char*>& options, std::initializer_list<const char*> units) {
+      if (std::find(units.begin(), units.end(), unit_) != units.end()) return;
+      for (const char* o : options)
+        if (app.count(o) > 0) throw ArgError(fmt::format("{} does not apply to --unit {}", o, unit_));
+    };
+    only({"--fit", "--level", "--degree", "--n", "--n-list", "--coef-format"}, {"spec"});
+    only({"--triangles", "--seed"}, {"span"});
+    only({"--scene"}, {"span", "phong"});
+    only({"--config"}, {"spec", "span"});
+    const std::vector<std::string> scenes = scenes_.empty() ? std::vector<std::string>{"sphere", "still_life"} : scenes_;
+    if (unit_ == "span")
+      return argOr(spanSweepBase, spanConfigArg("--config", app.count("--config") ? table_.config : "serial"),
+                   triangles_, seed_, scenes);
     SpecUnitConfig cfg;
     table_.build(cfg, false);
     return specSweepBase(cfg.ref(), cfg.rtl, cfg.prom);
@@ -224,7 +248,8 @@ class SweepCmd final : public Command {
   TableOptions table_;
   TargetRequest target_;
   std::string unit_ = "spec", shard_, dir_, area_, synth_cache_;
-  std::vector<std::string> params_;
+  std::vector<std::string> params_, scenes_;
+  uint64_t triangles_ = kSpanSweepTriangles, seed_ = kSpanSweepSeed;
   unsigned jobs_ = 0;
   bool area_all_ = false, quiet_ = false;
 };
