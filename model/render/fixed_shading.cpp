@@ -3,6 +3,7 @@
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -35,7 +36,14 @@ uint32_t lobeFactorCode(double f) {
 }
 }  // namespace
 
-std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess) {
+uint32_t lobeCode(double f, const LobeFormat& format) {
+  if (!(f >= 0)) throw std::logic_error(fmt::format("phong-fixed: a lobe value of {}", f));
+  const double x = f * std::ldexp(1.0, format.code_bits);
+  const double max = std::ldexp(1.0, format.code_bits + format.int_bits) - 1;
+  return x >= max ? static_cast<uint32_t>(max) : static_cast<uint32_t>(std::llround(x));
+}
+
+std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess, const LobeFormat& format) {
   double (*f)(double, double) = nullptr;
   switch (lobe) {
     case Lobe::Phong: f = phongLobe; break;
@@ -47,20 +55,30 @@ std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess) {
     case Lobe::Quadratic:
     case Lobe::Cubic: throw std::logic_error(fmt::format("lobeTable: {} is not a lobe of one cosine", toString(lobe)));
   }
+  if (format.cos_bits < 0 || format.cos_bits > 24 || format.code_bits < 0 || format.int_bits < 0 ||
+      format.code_bits + format.int_bits > 32)
+    throw std::logic_error("lobeTable: a format the 32-bit tables cannot hold");
   static std::mutex mutex;
-  static std::map<std::pair<double (*)(double, double), double>, std::shared_ptr<const LobeTable>> cache;
+  static std::map<std::tuple<double (*)(double, double), double, int, int, int>, std::shared_ptr<const LobeTable>> cache;
+  static size_t cached_entries = 0;
   const std::lock_guard<std::mutex> lock(mutex);
-  const auto key = std::make_pair(f, shininess);
+  const auto key = std::make_tuple(f, shininess, format.cos_bits, format.code_bits, format.int_bits);
   if (const auto it = cache.find(key); it != cache.end()) return it->second;
-  if (cache.size() >= 64) cache.clear();  // a long run over many exponents: start over (tables in use live on)
+  const size_t entries = (size_t{1} << format.cos_bits) + 2;
+  // A long run over many exponents or formats: start over (tables in use live on).
+  if (cache.size() >= 64 || cached_entries + entries > (size_t{1} << 24)) {
+    cache.clear();
+    cached_entries = 0;
+  }
   auto t = std::make_shared<LobeTable>();
   std::vector<uint32_t>& code = t->code;
-  code.resize((size_t{1} << kFixedCosFrac) + 2);
-  for (size_t c = 0; c + 1 < code.size(); ++c)
-    code[c] = lobeFactorCode(f(static_cast<double>(c) / (1 << kFixedCosFrac), shininess));
+  code.resize(entries);
+  const double codes = static_cast<double>(uint64_t{1} << format.cos_bits);
+  for (size_t c = 0; c + 1 < code.size(); ++c) code[c] = lobeCode(f(static_cast<double>(c) / codes, shininess), format);
   code.back() = code[code.size() - 2];
   while (t->zero_below + 1 < code.size() && code[t->zero_below] == 0 && code[t->zero_below + 1] == 0) ++t->zero_below;
   cache.emplace(key, t);
+  cached_entries += entries;
   return t;
 }
 

@@ -71,16 +71,28 @@ inline std::array<uint8_t, 3> fixedColour(const FixedShade& s) {
 
 // A lobe of one cosine (phong over R.V; blinn, pow, normalized-blinn, schlick over N.H) at every
 // cosine code c / 2^16, c = 0..2^16: f_code = round(f 2^24), saturated at 2^32 - 1 (f < 256),
-// and a copy of the last entry (the interpolation's right neighbour at c = 1).
-// A pure function of the lobe and the shininess, so the tables are built once per process
-// (65,537 evaluations each) and shared; std::logic_error for a lobe of several cosines.
+// and a copy of the last entry (the interpolation's right neighbour at c = 1). Other formats
+// (LobeFormat) for the datapath at runtime widths (render/fixed_widths.h).
+// A pure function of the lobe, the shininess and the format, so the tables are built once per
+// process (65,537 evaluations each at the fixed path's format) and shared; std::logic_error
+// for a lobe of several cosines or a format of more than 32-bit words or 2^24 codes.
 struct LobeTable {
-  std::vector<uint32_t> code;  // 2^16 + 2 entries
+  std::vector<uint32_t> code;  // 2^16 + 2 entries (2^cos_bits + 2)
   // The first i with code[i] or code[i + 1] nonzero: below it the lobe is 0 (for a high
   // exponent, most of the table), so a kernel may skip the reads there.
   uint32_t zero_below = 0;
 };
-std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess);
+// The tables' format: cosine codes c 2^-cos_bits, f_code = round(f 2^code_bits) in
+// uQint_bits.code_bits, saturated at 2^(code_bits + int_bits) - 1 (the fixed path's:
+// kFixedCosFrac, 24 and 8).
+struct LobeFormat {
+  int cos_bits = kFixedCosFrac;
+  int code_bits = 24;
+  int int_bits = 8;
+};
+std::shared_ptr<const LobeTable> lobeTable(Lobe lobe, double shininess, const LobeFormat& format = {});
+// A lobe value f >= 0 as f_code in `format` (std::logic_error for a negative or NaN f).
+uint32_t lobeCode(double f, const LobeFormat& format);
 
 // The specular unit's results by cos code for each (shininess code, light codes) it is asked
 // about, filled on first use from the unit's bit-exact model: exact, because the unit is a

@@ -80,7 +80,9 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
   rc.attr_frac_bits = {kColourFrac, kColourFrac, kColourFrac, kUnitFrac};
   rc.validate();
   rc_colour_ = rc_unit_ = rc;
-  rc_unit_.attr_frac_bits = {kUnitFrac, kUnitFrac, kUnitFrac, kUnitFrac};
+  // The normal at phong-fixed's NormalFracBits when it runs at runtime widths; the depth as ever.
+  const int normal_frac = f.opt.phong_widths ? f.opt.phong_widths->NormalFracBits : kUnitFrac;
+  rc_unit_.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
 }
 
 // The object's material, lobe and specular unit (Frame::obj).
@@ -197,6 +199,12 @@ RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& sp
 
 void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& engines, RenderResult& res) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (opt.phong_widths) {
+    if (opt.method != Method::PhongFixed)
+      throw std::invalid_argument(
+          fmt::format("render: datapath widths apply to phong-fixed only, not to {}", toString(opt.method)));
+    opt.phong_widths->validate();
+  }
   res.stats = RenderStats{};
   res.triangles.clear();
   clearFramebuffer(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);

@@ -21,7 +21,8 @@
 //   flat, gouraud       methods/colour_runs.cpp
 //   gouraud-classical   methods/gouraud_classical.cpp
 //   phong, phong-incremental, normal-bisection   methods/phong.cpp
-//   phong-fixed         methods/phong_fixed.cpp (the datapath: render/fixed_shading.h)
+//   phong-fixed         methods/phong_fixed.cpp (the datapath: render/fixed_shading.h; at
+//                       runtime widths methods/phong_fixed_widths.cpp, render/fixed_widths.h)
 //   biquadratic         methods/biquadratic.cpp
 //   modified-gouraud    methods/modified_gouraud.cpp (splits, then gouraud)
 //   adaptive            methods/adaptive.cpp (gouraud or phong per triangle)
@@ -33,6 +34,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,7 @@
 #include "device/spec_unit.h"
 #include "raster/setup.h"
 #include "render/fixed_shading.h"
+#include "render/phong_widths.h"
 #include "render/shading.h"
 #include "scene/scene.h"
 
@@ -130,6 +133,11 @@ struct RenderOptions {
   // The AVX-512 paths (render/fixed_simd.h) where the CPU has them; false: the scalar paths
   // alone (the same images: test Render.VectorPathsEqualTheScalarPaths compares them).
   bool vector_kernel = true;
+  // phong-fixed only (std::invalid_argument with another method or invalid widths): absent, the
+  // fixed datapath of render/fixed_shading.h with its run and vector kernels; present, the same
+  // datapath at these widths, fragment by fragment (render/fixed_widths.h), the span unit
+  // interpolating the normal at their NormalFracBits. PhongWidths{} gives the same images.
+  std::optional<PhongWidths> phong_widths;
 };
 
 struct RenderStats {

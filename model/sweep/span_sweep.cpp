@@ -206,7 +206,7 @@ class SceneCache {
     std::lock_guard<std::mutex> lock(m_);
     auto it = loaded_.find(name);
     if (it != loaded_.end()) return *it->second;
-    auto sc = std::make_unique<const Scene>(loadScene(spanSceneFile(name)));
+    auto sc = std::make_unique<const Scene>(loadScene(sweepSceneFile(name)));
     RenderOptions ro;
     ro.method = Method::Gouraud;
     if (!deviceLobesUsed(*sc, ro).empty())
@@ -548,15 +548,6 @@ std::vector<std::string> spanParamNames() {
   for (auto it = rtl.begin(); it != rtl.end(); ++it) names.push_back(it.key());
   names.insert(names.end(), std::begin(kRasterNames), std::end(kRasterNames));
   return names;
-}
-
-std::string spanSceneFile(const std::string& name) {
-  checkSceneNames({name});
-  const std::string file = findShareFile("vectors/scenes/" + name + ".json");
-  if (file.empty())
-    throw std::invalid_argument(fmt::format("scene {}: no vectors/scenes/{}.json in this installation or the source tree",
-                                            name, name));
-  return file;
 }
 
 nlohmann::json spanSweepBase(const SpanUnitConfig& cfg, uint64_t triangles, uint64_t seed,

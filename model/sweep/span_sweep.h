@@ -76,10 +76,6 @@ SpanPoint spanPointParams(const nlohmann::json& base, const PointValues& values)
 // other options TriGenOptions's defaults.
 TriGenOptions spanSweepTriangleOptions(const nlohmann::json& base);
 
-// The scene file of a scene name: vectors/scenes/<name>.json of the installation or the source
-// tree (findShareFile). std::invalid_argument for a name that is not [a-z0-9_]+ or no file.
-std::string spanSceneFile(const std::string& name);
-
 // The span unit as a sweep sees it. A record:
 //   {"index", "hash" (textHash of "params"), "params",
 //    "error": {"max_lsb" (the front error: the worse of colour and depth, each in its output

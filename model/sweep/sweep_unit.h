@@ -48,6 +48,11 @@ struct SweepUnit {
   std::vector<std::string> widths;
 };
 
+// The file of a bundled scene a sweep renders: vectors/scenes/<name>.json of the installation or
+// the source tree (findShareFile). std::invalid_argument for a name that is not [a-z0-9_]+ or
+// no such file.
+std::string sweepSceneFile(const std::string& name);
+
 // The units a sweep can vary ("spec", ...), and one line on each for --help.
 std::vector<std::string> sweepUnitNames();
 std::string sweepUnitHelp();

@@ -14,6 +14,7 @@
 #include "cli/progress.h"
 #include "cli/sweep_target.h"
 #include "cli/table_options.h"
+#include "sweep/phong_sweep.h"
 #include "sweep/span_sweep.h"
 #include "sweep/spec_sweep.h"
 #include "sweep/sweep_run.h"
@@ -218,6 +219,7 @@ class SweepCmd final : public Command {
     if (unit_ == "span")
       return argOr(spanSweepBase, spanConfigArg("--config", app.count("--config") ? table_.config : "serial"),
                    triangles_, seed_, scenes);
+    if (unit_ == "phong") return argOr(phongSweepBase, scenes);
     SpecUnitConfig cfg;
     table_.build(cfg, false);
     return specSweepBase(cfg.ref(), cfg.rtl, cfg.prom);

@@ -222,6 +222,13 @@ class PhongFixedUnit final : public MethodUnit {
 
 }  // namespace
 
-std::unique_ptr<MethodUnit> makePhongFixedUnit(Frame& f) { return std::make_unique<PhongFixedUnit>(f); }
+std::unique_ptr<MethodUnit> makePhongWidthsUnit(Frame& f);  // phong_fixed_widths.cpp
+
+// At runtime widths (RenderOptions::phong_widths) the scalar datapath of fixed_widths.h; else
+// this file's unit, as ever.
+std::unique_ptr<MethodUnit> makePhongFixedUnit(Frame& f) {
+  if (f.opt.phong_widths) return makePhongWidthsUnit(f);
+  return std::make_unique<PhongFixedUnit>(f);
+}
 
 }  // namespace shd
