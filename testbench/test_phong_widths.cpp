@@ -116,23 +116,12 @@ TEST(PhongWidths, DefaultsAreBitIdenticalOnEveryScene) {
 // The RTL's way with device lobes (no model: every request batched per triangle) at the
 // defaults equals the memo's image.
 TEST(PhongWidths, DefaultsBatchedDeviceRequestsEqualTheMemo) {
-  class BatchOnly final : public SpecEngine {
-   public:
-    explicit BatchOnly(SpecEngine& e) : e_(e) {}
-    const PromTable& table() const override { return e_.table(); }
-    uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
-      return e_.evaluate(in, out);
-    }
-
-   private:
-    SpecEngine& e_;
-  };
   const Scene s = loadScene("builtin:sphere");
   RenderOptions o;
   o.method = Method::PhongFixed;
   o.brdf = "quadratic";
   LobeEngines e = modelLobeEngines(s, o, LobeConfigs{});
-  BatchOnly batch(*e.view.quadratic);
+  testutil::BatchOnly batch(*e.view.quadratic);
   SpecEngines view;
   view.quadratic = &batch;
   ModelSpanEngine span(SpanParams{});

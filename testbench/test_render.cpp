@@ -194,22 +194,11 @@ TEST(Render, MethodsAgainstTheReference) {
 // engine without a model it sends every request to evaluate() in batches, as with the RTL.
 // Both give the same image and the same specular-unit statistics.
 TEST(Render, PhongFixedMemoEqualsTheBatchedRequests) {
-  class BatchOnly final : public SpecEngine {
-   public:
-    explicit BatchOnly(SpecEngine& e) : e_(e) {}
-    const PromTable& table() const override { return e_.table(); }
-    uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
-      return e_.evaluate(in, out);
-    }
-
-   private:
-    SpecEngine& e_;
-  };
   for (const char* scene : {"builtin:sphere", "builtin:plane"}) {
     const Scene s = loadScene(scene);
     const RenderResult memo = renderModel(s, Method::PhongFixed, "quadratic", "serial");
     ModelEngines e("serial");
-    BatchOnly batch(*e.quad);
+    testutil::BatchOnly batch(*e.quad);
     SpecEngines view;
     view.quadratic = &batch;
     RenderOptions o;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "config/registry.h"
+#include "render/render.h"
 
 namespace shd::testutil {
 
@@ -48,5 +49,19 @@ std::string errorOf(F f) {
   }
   return "";
 }
+
+// A specular engine that only forwards evaluate(): no model for the memo, so a renderer sends
+// every request in batches, as to the RTL.
+class BatchOnly final : public SpecEngine {
+ public:
+  explicit BatchOnly(SpecEngine& e) : e_(e) {}
+  const PromTable& table() const override { return e_.table(); }
+  uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
+    return e_.evaluate(in, out);
+  }
+
+ private:
+  SpecEngine& e_;
+};
 
 }  // namespace shd::testutil

@@ -99,28 +99,34 @@ uint64_t SpecResultMemo::evaluate(uint32_t shin, uint32_t cos, const std::array<
   return e;
 }
 
-FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding,
-                                   SpecResultMemo* memo)
-    : ctx_(ctx), m_(m), memo_(memo) {
+FixedCosine fixedCosineOf(Lobe lobe) {
   switch (lobe) {
     case Lobe::Quadratic:
-    case Lobe::Cubic: cosine_ = Cosine::Device; break;
-    case Lobe::Phong: cosine_ = Cosine::RV; break;
-    case Lobe::CookTorrance: cosine_ = Cosine::CookTorrance; break;
+    case Lobe::Cubic: return FixedCosine::Device;
+    case Lobe::Phong: return FixedCosine::RV;
+    case Lobe::CookTorrance: return FixedCosine::CookTorrance;
     case Lobe::Blinn:
     case Lobe::Pow:
     case Lobe::NormalizedBlinn:
-    case Lobe::Schlick: cosine_ = Cosine::NH; break;
+    case Lobe::Schlick: break;
   }
-  if (cosine_ == Cosine::Device) {
-    if (coding == nullptr) throw std::logic_error("FixedPointShader: a device lobe needs the specular unit's coding");
-    coding_ = *coding;
-    if (coding_->cos_frac_bits < 1 || coding_->cos_frac_bits > 30)
-      throw std::invalid_argument(
-          fmt::format("phong-fixed: the specular unit's CosFracBits {} is outside 1..30", coding_->cos_frac_bits));
-    if (memo_ != nullptr && memo_->model().params().CosFracBits != coding_->cos_frac_bits)
-      throw std::logic_error("FixedPointShader: the memo's unit is not the coding's");
-  }
+  return FixedCosine::NH;
+}
+
+DeviceCoding checkedDeviceCoding(const DeviceCoding* coding, const SpecResultMemo* memo, const char* who) {
+  if (coding == nullptr) throw std::logic_error(fmt::format("{}: a device lobe needs the specular unit's coding", who));
+  if (coding->cos_frac_bits < 1 || coding->cos_frac_bits > 30)
+    throw std::invalid_argument(
+        fmt::format("phong-fixed: the specular unit's CosFracBits {} is outside 1..30", coding->cos_frac_bits));
+  if (memo != nullptr && memo->model().params().CosFracBits != coding->cos_frac_bits)
+    throw std::logic_error(fmt::format("{}: the memo's unit is not the coding's", who));
+  return *coding;
+}
+
+FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding,
+                                   SpecResultMemo* memo)
+    : ctx_(ctx), m_(m), cosine_(fixedCosineOf(lobe)), memo_(memo) {
+  if (cosine_ == Cosine::Device) coding_ = checkedDeviceCoding(coding, memo, "FixedPointShader");
   if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) table_ = lobeTable(lobe, m.shininess);
   v_ = unitCodes(ctx.view);
   const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};

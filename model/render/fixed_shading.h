@@ -144,6 +144,16 @@ inline uint32_t lobeAt(const uint32_t* t, int64_t c32) {
 }
 }  // namespace fixed_detail
 
+// The cosine a lobe reads in phong-fixed: N.H (blinn, pow, normalized-blinn, schlick), R.V
+// (phong), the three of cook-torrance, or the specular unit's (the device lobes).
+enum class FixedCosine { NH, RV, CookTorrance, Device };
+FixedCosine fixedCosineOf(Lobe lobe);
+
+// A device lobe's request coding, checked for a shader named `who`: std::logic_error when there
+// is none or `memo` (if any) belongs to a unit of other CosFracBits, std::invalid_argument for
+// CosFracBits outside 1..30.
+DeviceCoding checkedDeviceCoding(const DeviceCoding* coding, const SpecResultMemo* memo, const char* who);
+
 class FixedPointShader {
  public:
   // coding: the specular unit's request coding (device lobes; std::logic_error if null then).
@@ -170,7 +180,7 @@ class FixedPointShader {
   void withRunKernel(F&& f);  // f(kernel), kernel a RunKernel<C, NL> for this shader (takesRuns())
 
  private:
-  enum class Cosine { NH, RV, CookTorrance, Device };
+  using Cosine = FixedCosine;
   // The lobe reads N.V (phong's R.V, cook-torrance).
   static constexpr bool needsNv(Cosine c) { return c == Cosine::RV || c == Cosine::CookTorrance; }
   struct PerLight {

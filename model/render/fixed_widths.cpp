@@ -74,25 +74,8 @@ FixedWidthsShader::FixedWidthsShader(const ShadeContext& ctx, const Material& m,
                                      SpecResultMemo* memo, const PhongWidths& w)
     : ctx_(ctx), m_(m), w_(w), memo_(memo), lobe_format_{w.LobeCosBits, w.LobeCodeBits, w.LobeIntBits} {
   w_.validate();
-  switch (lobe) {
-    case Lobe::Quadratic:
-    case Lobe::Cubic: cosine_ = Cosine::Device; break;
-    case Lobe::Phong: cosine_ = Cosine::RV; break;
-    case Lobe::CookTorrance: cosine_ = Cosine::CookTorrance; break;
-    case Lobe::Blinn:
-    case Lobe::Pow:
-    case Lobe::NormalizedBlinn:
-    case Lobe::Schlick: cosine_ = Cosine::NH; break;
-  }
-  if (cosine_ == Cosine::Device) {
-    if (coding == nullptr) throw std::logic_error("FixedWidthsShader: a device lobe needs the specular unit's coding");
-    coding_ = *coding;
-    if (coding_->cos_frac_bits < 1 || coding_->cos_frac_bits > 30)
-      throw std::invalid_argument(
-          fmt::format("phong-fixed: the specular unit's CosFracBits {} is outside 1..30", coding_->cos_frac_bits));
-    if (memo_ != nullptr && memo_->model().params().CosFracBits != coding_->cos_frac_bits)
-      throw std::logic_error("FixedWidthsShader: the memo's unit is not the coding's");
-  }
+  cosine_ = fixedCosineOf(lobe);
+  if (cosine_ == Cosine::Device) coding_ = checkedDeviceCoding(coding, memo, "FixedWidthsShader");
   if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) table_ = lobeTable(lobe, m.shininess, lobe_format_);
   seeds_ = rsqrtSeedTable(w_.RsqrtSeedBits, w_.RsqrtSeedFracBits);
   v_ = {unitCode(ctx.view.x), unitCode(ctx.view.y), unitCode(ctx.view.z)};

@@ -56,7 +56,7 @@ class FixedWidthsShader {
   const PhongWidths& widths() const { return w_; }
 
  private:
-  enum class Cosine { NH, RV, CookTorrance, Device };
+  using Cosine = FixedCosine;
   struct PerLight {
     const CameraLight* light = nullptr;
     std::array<int64_t, 3> l{}, h{};  // sQ1.UnitFracBits (point lights: this pixel's)
