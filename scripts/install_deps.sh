@@ -4,8 +4,8 @@
 # machine may already have, so that nothing depends on a hand-installed tool.
 set -euo pipefail
 packages=(
-  build-essential cmake ninja-build pkg-config python3
-  verilator iverilog yosys
+  build-essential cmake ninja-build pkg-config python3 python3-matplotlib
+  verilator iverilog yosys nextpnr-ice40
   sollya gappa clang parallel
   libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev

@@ -8,7 +8,8 @@
 #     replay of the written vector file on the installed verilated models;
 #   - shadesim_systemc replaying a vector file of the default configuration;
 #   - share/shadesim/testbench/icarus/run_icarus.sh replaying it under Icarus;
-#   - share/shadesim/scripts/synth.py synthesising a configuration for iCE40 with its checks.
+#   - share/shadesim/scripts/synth.py synthesising a configuration for iCE40 with its checks;
+#   - shadesim report, its plots made by share/shadesim/scripts/plot_report.py.
 set -euo pipefail
 
 checks() {  # checks PREFIX RUN_DIR
@@ -35,6 +36,9 @@ checks() {  # checks PREFIX RUN_DIR
   step "$share/testbench/icarus/run_icarus.sh" narrow.vec
   step "$share/scripts/synth.py" spec:narrow --prom "$share/vectors/prom/spec_narrow.hex" --target ice40 --out synth --check
   test -s synth/summary.json
+  # report: its plots by the installed scripts/plot_report.py
+  step "$S" report --modes serial --bench 1 -o report --quiet
+  grep -q '"made": true' report/report.json && test -s report/error_vs_cycles.png
   echo "install_test: the installed tree works from $2"
 }
 

@@ -1,6 +1,8 @@
 // Images: PNG files round-trip byte-exact, are written atomically and read strictly; the
 // metrics follow their definitions (metrics.h) on hand-made cases; the heat map's ramp and the
-// masks are respected; the RTL-vs-model diff tools find every differing pixel.
+// masks are respected; the RTL-vs-model diff tools find every differing pixel; the contact
+// sheet's composition (compose.h) averages, stacks and tiles as stated.
+#include "image/compose.h"
 #include "image/image.h"
 #include "image/metrics.h"
 
@@ -441,4 +443,44 @@ TEST(ImageDiff, FindsEveryDifferingPixelAndTheFirst) {
   EXPECT_EQ(px(shd::diffMask(filled(1, 1, 255, 255, 255), filled(1, 1, 255, 255, 255)), 0, 0), (Rgb8{63, 63, 63}));
   EXPECT_THROW(shd::diffMask(a, Image(17, 8)), std::invalid_argument);
   EXPECT_THROW(shd::firstDifference(a, Image(1, 9)), std::invalid_argument);
+}
+
+TEST(Compose, DownscaleAveragesBlocksAndCutBlocksAtTheEdges) {
+  Image img(5, 3);  // value of a pixel: 10 x + y (every channel)
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x)
+      for (int k = 0; k < 3; ++k) img.at(x, y)[k] = static_cast<uint8_t>(10 * x + y);
+  const Image d = shd::downscaleBox(img, 2);
+  ASSERT_EQ(d.width, 3);
+  ASSERT_EQ(d.height, 2);
+  EXPECT_EQ(d.at(0, 0)[0], 6);   // (0 + 1 + 10 + 11) / 4 = 5.5, rounded half up
+  EXPECT_EQ(d.at(2, 0)[1], 41);  // the cut column x = 4: (40 + 41) / 2 = 40.5
+  EXPECT_EQ(d.at(2, 1)[2], 42);  // the corner pixel alone
+  EXPECT_EQ(shd::downscaleBox(img, 1), img);
+  EXPECT_THROW(shd::downscaleBox(img, 0), std::invalid_argument);
+  EXPECT_THROW(shd::downscaleBox(Image(), 2), std::invalid_argument);
+}
+
+TEST(Compose, StackAndGridPlaceTilesAtTheirCells) {
+  Image a(2, 1), b(3, 2);
+  a.at(0, 0)[0] = 200;
+  b.at(2, 1)[1] = 100;
+  const Image s = shd::stackVertical(a, b, 1, {7, 7, 7});
+  ASSERT_EQ(s.width, 3);
+  ASSERT_EQ(s.height, 4);
+  EXPECT_EQ(s.at(0, 0)[0], 200);
+  EXPECT_EQ(s.at(2, 0)[0], 7);  // beside the narrower image: background
+  EXPECT_EQ(s.at(1, 1)[0], 7);  // the gap
+  EXPECT_EQ(s.at(2, 3)[1], 100);
+  // 3 tiles in 2 columns of 3 x 4 cells with a gap of 1: 9 x 11 pixels; the null tile is `empty`.
+  const Image g = shd::tileGrid({&s, nullptr, &a}, 2, 3, 4, 1, {255, 255, 255}, {9, 9, 9});
+  ASSERT_EQ(g.width, 1 + 2 * (3 + 1));
+  ASSERT_EQ(g.height, 1 + 2 * (4 + 1));
+  EXPECT_EQ(g.at(0, 0)[0], 255);
+  EXPECT_EQ(g.at(1, 1)[0], 200);  // s at cell (0, 0)
+  EXPECT_EQ(g.at(5, 1)[0], 9);    // the empty cell (1, 0)
+  EXPECT_EQ(g.at(1, 6)[0], 200);  // a at cell (0, 1)
+  EXPECT_EQ(g.at(5, 6)[0], 255);  // no tile: background
+  EXPECT_THROW(shd::tileGrid({&b}, 1, 2, 2, 0, {0, 0, 0}, {0, 0, 0}), std::invalid_argument);  // too large
+  EXPECT_THROW(shd::tileGrid({}, 1, 2, 2, 0, {0, 0, 0}, {0, 0, 0}), std::invalid_argument);
 }

@@ -32,6 +32,10 @@ struct CommandInfo {
 // Every subcommand, in the order `shadesim --help` lists them.
 const std::vector<CommandInfo>& commands();
 
+// The command line of this run as typed, each argument shell-quoted where it needs it: what a
+// report records of how it was made ("" outside cli::run).
+const std::string& commandLine();
+
 // A configuration option (registry name or JSON file). Errors are ArgError: an unknown name
 // names the option, an error in a file "configuration file <path>: <member>: ...".
 SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg);

@@ -24,6 +24,26 @@ std::unique_ptr<Command> makeReplayCmd();
 std::unique_ptr<Command> makeConfigsCmd();
 std::unique_ptr<Command> makeSweepCmd();
 std::unique_ptr<Command> makeSweepMergeCmd();
+std::unique_ptr<Command> makeReportCmd();
+
+namespace {
+
+std::string command_line;  // commandLine(): set once by run()
+
+// An argument as a POSIX shell reads it back: bare when it holds only safe characters, else in
+// single quotes (a quote inside written '\'').
+std::string shellQuoted(const std::string& a) {
+  const bool safe = !a.empty() && a.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                                      "_-+=.,:/@%") == std::string::npos;
+  if (safe) return a;
+  std::string q = "'";
+  for (char c : a) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+}  // namespace
+
+const std::string& commandLine() { return command_line; }
 
 const std::vector<CommandInfo>& commands() {
   static const std::vector<CommandInfo> all = {
@@ -37,11 +57,15 @@ const std::vector<CommandInfo>& commands() {
       {"configs", "list the unit configurations built in, and which have a verilated model", makeConfigsCmd},
       {"sweep", "evaluate the specular unit over a grid of its parameters (error, latency, PROM size, area)", makeSweepCmd},
       {"sweep-merge", "join the shard directories of one sweep", makeSweepMergeCmd},
+      {"report", "what each shading method and lobe costs and buys on a scene: error, time, cycles, area",
+       makeReportCmd},
   };
   return all;
 }
 
 int run(int argc, char** argv) {
+  command_line = "shadesim";
+  for (int i = 1; i < argc; ++i) command_line += " " + shellQuoted(argv[i]);
   CLI::App app{fmt::format("shadesim {}: cycle-accurate models and RTL of the shading hardware", SHD_VERSION)};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("shadesim ") + SHD_VERSION);

@@ -13,8 +13,8 @@
 #include <unistd.h>
 
 #include "cli/command.h"
+#include "cli/render_common.h"
 #include "cosim/render_rtl.h"
-#include "device/prom_io.h"
 #include "image/image.h"
 #include "image/metrics.h"
 #include "render/fixed_simd.h"
@@ -29,33 +29,6 @@ namespace fs = std::filesystem;
 namespace shd::cli {
 
 namespace {
-
-// The engines of one path (model or RTL) for the device lobes the scene uses.
-struct Engines {
-  std::unique_ptr<SpanEngine> span;
-  std::vector<std::unique_ptr<SpecEngine>> spec;
-  SpecEngines view;
-};
-
-// The image against the reference: metrics over the covered pixels and the highlight.
-struct Comparison {
-  ImageMetrics all, highlight;
-  Image reference, heat;
-};
-
-// The RTL-in-the-loop frame against the model's.
-struct RtlCheck {
-  nlohmann::json json;
-  uint64_t mismatches = 0;
-  std::string first_mismatch;
-  bool ok() const { return mismatches == 0 && json["cycles_equal"].get<bool>(); }
-};
-
-Image toImage(const Framebuffer& fb) {
-  Image img(fb.width, fb.height);
-  img.rgb = fb.rgb;
-  return img;
-}
 
 class RenderCmd final : public Command {
  public:
@@ -76,12 +49,8 @@ class RenderCmd final : public Command {
     const fs::path dir = fs::path(output_).parent_path();
     return dir.empty() ? "." : dir.string();
   }
-  SpecUnitConfig lobeConfig(Lobe l) const;
   // Before any work: the verilated models --rtl needs exist (ArgError naming the option).
   void requireRtl(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span) const;
-  Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span, bool with_rtl,
-                      const fs::path& tmp) const;
-  Comparison compare(const RenderResult& res, const RenderResult& ref) const;
   RtlCheck renderRtl(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span, const RenderResult& res,
                      const fs::path& tmp) const;
   nlohmann::json statistics(const Scene& sc, const RenderOptions& ro, const RenderResult& res, double ms,
@@ -117,35 +86,6 @@ void RenderCmd::add(CLI::App& app) {
   app.add_flag("--quiet", quiet_, "no progress lines");
 }
 
-Engines RenderCmd::makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span, bool with_rtl,
-                               const fs::path& tmp) const {
-  Engines e;
-  // A disagreement between a unit and its model saves the failing case beside the image.
-  if (with_rtl) e.span = std::make_unique<RtlSpanEngine>(span, failDir());
-  else e.span = std::make_unique<ModelSpanEngine>(span.rtl);
-  for (Lobe l : deviceLobesUsed(sc, ro)) {
-    const SpecUnitConfig cfg = lobeConfig(l);
-    PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
-    if (with_rtl) {
-      fs::create_directories(tmp);
-      e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg, std::move(t), (tmp / ("spec_" + cfg.name + ".hex")).string(),
-                                                       failDir()));
-    } else {
-      e.spec.push_back(std::make_unique<ModelSpecEngine>(std::move(t)));
-    }
-    (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.spec.back().get();
-  }
-  return e;
-}
-
-SpecUnitConfig RenderCmd::lobeConfig(Lobe l) const {
-  try {
-    return lobes_.load(l);
-  } catch (const std::invalid_argument& e) {
-    throw ArgError(fmt::format("--{}-config: {}", toString(l), e.what()));
-  }
-}
-
 void RenderCmd::requireRtl(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span) const {
   try {
     requireVerilated(span);
@@ -154,91 +94,38 @@ void RenderCmd::requireRtl(const Scene& sc, const RenderOptions& ro, const SpanU
   }
   for (Lobe l : deviceLobesUsed(sc, ro)) {
     try {
-      requireVerilated(lobeConfig(l));
+      requireVerilated(lobeConfigArg(lobes_, l));
     } catch (const std::invalid_argument& e) {
       throw ArgError(fmt::format("--{}-config {}: {}", toString(l), lobes_.forLobe(l), e.what()));
     }
   }
 }
 
-Comparison RenderCmd::compare(const RenderResult& res, const RenderResult& ref) const {
-  const Image img = toImage(res.fb);
-  ImageF reff(ref.fb.width, ref.fb.height), spec_ref(ref.fb.width, ref.fb.height);
-  // What a display shows: the reference clamped to the output range (an over-exposed
-  // highlight is 255, not its unclamped value).
-  reff.rgb = ref.fb.lsb;
-  for (double& v : reff.rgb) v = std::clamp(v, 0.0, 255.0);
-  spec_ref.rgb = ref.fb.spec_lsb;
-  PixelMask covered(img.width, img.height);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      if (res.fb.covered(x, y) && ref.fb.covered(x, y)) covered.set(x, y);
-  const PixelMask highlight = intersect(covered, thresholdMask(spec_ref, highlight_lsb_));
-  return {imageMetrics(img, reff, covered), imageMetrics(img, reff, highlight), roundToUnorm8(reff),
-          errorHeatmap(img, reff, heat_scale_, covered)};
-}
-
 RtlCheck RenderCmd::renderRtl(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span,
                               const RenderResult& res, const fs::path& tmp) const {
   say("the same frame with the verilated span and specular units");
-  Engines hw = makeEngines(sc, ro, span, true, tmp);
+  Engines hw = makeEngines(sc, ro, span, lobes_, true, tmp, failDir());
   const RenderResult hres = render(sc, ro, *hw.span, hw.view);
   fs::remove_all(tmp);
-  const Image img = toImage(res.fb), himg = toImage(hres.fb);
-  RtlCheck c;
-  c.mismatches = differingPixels(img, himg).count();
-  if (auto d = firstDifference(img, himg)) {
-    const size_t p = static_cast<size_t>(d->y) * img.width + d->x;
-    auto who = [&](const RenderResult& r, int32_t t) {
-      if (t < 0) return std::string("no triangle");
-      const ScreenTriangleInfo& i = r.triangles[static_cast<size_t>(t)];
-      return fmt::format("triangle {} of object '{}' (mesh triangle {}, screen ({:.2f},{:.2f}) ({:.2f},{:.2f}) "
-                         "({:.2f},{:.2f}))",
-                         t, sc.objects[static_cast<size_t>(i.object)].name, i.mesh_triangle, i.xy[0][0], i.xy[0][1],
-                         i.xy[1][0], i.xy[1][1], i.xy[2][0], i.xy[2][1]);
-    };
-    c.first_mismatch = fmt::format("pixel ({}, {}): model ({}, {}, {}) written by {}; rtl ({}, {}, {}) written by {}",
-                                   d->x, d->y, d->a.r, d->a.g, d->a.b, who(res, res.fb.tri[p]), d->b.r, d->b.g,
-                                   d->b.b, who(hres, hres.fb.tri[p]));
-  }
-  c.json = {{"ms", hres.stats.ms},
-            {"span_cycles", hres.stats.span_cycles},
-            {"spec_cycles", hres.stats.spec_cycles},
-            {"cycles_equal",
-             hres.stats.span_cycles == res.stats.span_cycles && hres.stats.spec_cycles == res.stats.spec_cycles}};
-  return c;
+  return checkRtlFrame(sc, res, hres);
 }
 
 nlohmann::json RenderCmd::statistics(const Scene& sc, const RenderOptions& ro, const RenderResult& res, double ms,
                                      size_t frames, const Comparison& c) const {
-  const RenderStats& st = res.stats;
-  nlohmann::json j = {{"scene", sc.name},
-                      {"method", method_},
-                      {"brdf", brdf_.empty() ? "per material" : brdf_},
-                      {"mode", mode_},
-                      {"width", res.fb.width},
-                      {"height", res.fb.height},
-                      {"triangles", st.triangles},
-                      {"culled", st.culled},
-                      {"clipped", st.clipped},
-                      {"drawn", st.drawn},
-                      {"fragments", st.fragments},
-                      {"pixels_covered", st.pixels_covered},
-                      {"cycles", st.span_cycles},
-                      {"spec_cycles", st.spec_cycles},
-                      {"spec_evaluations", st.spec_evaluations},
-                      {"divisions", st.divisions},
-                      {"split_parts", st.split_parts},
-                      {"normalisations", st.normalisations},
-                      {"adaptive_gouraud", st.adaptive_gouraud},
-                      {"adaptive_phong", st.adaptive_phong},
-                      {"ms", ms},
-                      {"frames", frames},
-                      {"max_abs_lsb", c.all.max_abs_lsb},
-                      {"psnr_db", toJson(c.all)["psnr_db"]},
-                      {"metrics", toJson(c.all)},
-                      {"highlight_lsb_threshold", highlight_lsb_},
-                      {"highlight", toJson(c.highlight)}};
+  nlohmann::json j = frameCounts(res.stats);
+  j.update({{"scene", sc.name},
+            {"method", method_},
+            {"brdf", brdf_.empty() ? "per material" : brdf_},
+            {"mode", mode_},
+            {"width", res.fb.width},
+            {"height", res.fb.height},
+            {"ms", ms},
+            {"frames", frames},
+            {"max_abs_lsb", c.all.max_abs_lsb},
+            {"psnr_db", toJson(c.all)["psnr_db"]},
+            {"metrics", toJson(c.all)},
+            {"highlight_lsb_threshold", highlight_lsb_},
+            {"highlight", toJson(c.highlight)}});
   // phong-fixed: whether the AVX-512 kernel shades its one-light N.H-lobe fragments here.
   if (ro.method == Method::PhongFixed) j["fixed_kernel"] = fixed_simd::available() ? "avx512" : "scalar";
   return j;
@@ -274,24 +161,16 @@ int RenderCmd::run(const CLI::App& app) {
   if (!json_path_.empty()) outputTarget(json_path_);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-render-{}", getpid());
   // The golden model, frame after frame into the same buffers as a renderer does.
-  Engines model = makeEngines(sc, ro, span, false, tmp);
+  Engines model = makeEngines(sc, ro, span, lobes_, false, tmp, failDir());
   say(fmt::format("{} with {} ({}), model", sc.name, method_, mode_));
-  RenderResult res = render(sc, ro, *model.span, model.view);
-  std::vector<double> frame_ms{res.stats.ms};
-  RenderResult frame;
-  for (int i = 1; i < bench_; ++i) {
-    render(sc, ro, *model.span, model.view, frame);
-    frame_ms.push_back(frame.stats.ms);
-  }
-  std::sort(frame_ms.begin(), frame_ms.end());
-  const double ms = frame_ms[frame_ms.size() / 2];
+  const RenderResult res = render(sc, ro, *model.span, model.view);
+  const size_t frames = static_cast<size_t>(std::max(1, bench_));
+  RenderResult scratch;
+  const double ms = medianFrameMs(sc, ro, model, res, frames, scratch);
   // The reference and the error against it.
-  RenderOptions rref = ro;
-  rref.method = Method::Reference;
-  ModelSpanEngine serial(SpanParams{});
   say("reference (double precision, exact pow)");
-  const Comparison c = compare(res, render(sc, rref, serial, SpecEngines{}));
-  nlohmann::json j = statistics(sc, ro, res, ms, frame_ms.size(), c);
+  const Comparison c = compareWithReference(res, renderReference(sc, ro), highlight_lsb_, heat_scale_);
+  nlohmann::json j = statistics(sc, ro, res, ms, frames, c);
   if (res.stats.pixels_covered == 0) {  // a blank image is not a result: say so (and in the JSON)
     const std::string w = fmt::format("nothing drawn: all {} triangles are culled or outside the view (check the "
                                       "camera and the transforms)",

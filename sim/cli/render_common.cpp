@@ -1,0 +1,129 @@
+#include "cli/render_common.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "cli/options.h"
+#include "cosim/render_rtl.h"
+#include "device/prom_io.h"
+
+namespace fs = std::filesystem;
+
+namespace shd::cli {
+
+Image toImage(const Framebuffer& fb) {
+  Image img(fb.width, fb.height);
+  img.rgb = fb.rgb;
+  return img;
+}
+
+SpecUnitConfig lobeConfigArg(const LobeConfigs& lobes, Lobe l) {
+  try {
+    return lobes.load(l);
+  } catch (const std::invalid_argument& e) {
+    throw ArgError(fmt::format("--{}-config: {}", toString(l), e.what()));
+  }
+}
+
+Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span, const LobeConfigs& lobes,
+                    bool with_rtl, const fs::path& tmp, const std::string& fail_dir) {
+  Engines e;
+  if (with_rtl) e.span = std::make_unique<RtlSpanEngine>(span, fail_dir);
+  else e.span = std::make_unique<ModelSpanEngine>(span.rtl);
+  for (Lobe l : deviceLobesUsed(sc, ro)) {
+    const SpecUnitConfig cfg = lobeConfigArg(lobes, l);
+    PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
+    if (with_rtl) {
+      fs::create_directories(tmp);
+      e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg, std::move(t), (tmp / ("spec_" + cfg.name + ".hex")).string(),
+                                                       fail_dir));
+    } else {
+      e.spec.push_back(std::make_unique<ModelSpecEngine>(std::move(t)));
+    }
+    (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.spec.back().get();
+  }
+  return e;
+}
+
+RenderResult renderReference(const Scene& sc, const RenderOptions& ro) {
+  RenderOptions rref = ro;
+  rref.method = Method::Reference;
+  ModelSpanEngine serial(SpanParams{});
+  return render(sc, rref, serial, SpecEngines{});
+}
+
+Comparison compareWithReference(const RenderResult& res, const RenderResult& ref, double highlight_lsb,
+                                double heat_scale) {
+  const Image img = toImage(res.fb);
+  ImageF reff(ref.fb.width, ref.fb.height), spec_ref(ref.fb.width, ref.fb.height);
+  // What a display shows: the reference clamped to the output range (an over-exposed
+  // highlight is 255, not its unclamped value).
+  reff.rgb = ref.fb.lsb;
+  for (double& v : reff.rgb) v = std::clamp(v, 0.0, 255.0);
+  spec_ref.rgb = ref.fb.spec_lsb;
+  PixelMask covered(img.width, img.height);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x)
+      if (res.fb.covered(x, y) && ref.fb.covered(x, y)) covered.set(x, y);
+  const PixelMask highlight = intersect(covered, thresholdMask(spec_ref, highlight_lsb));
+  return {imageMetrics(img, reff, covered), imageMetrics(img, reff, highlight), roundToUnorm8(reff),
+          errorHeatmap(img, reff, heat_scale, covered)};
+}
+
+RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderResult& hres) {
+  const Image img = toImage(res.fb), himg = toImage(hres.fb);
+  RtlCheck c;
+  c.mismatches = differingPixels(img, himg).count();
+  if (auto d = firstDifference(img, himg)) {
+    const size_t p = static_cast<size_t>(d->y) * img.width + d->x;
+    auto who = [&](const RenderResult& r, int32_t t) {
+      if (t < 0) return std::string("no triangle");
+      const ScreenTriangleInfo& i = r.triangles[static_cast<size_t>(t)];
+      return fmt::format("triangle {} of object '{}' (mesh triangle {}, screen ({:.2f},{:.2f}) ({:.2f},{:.2f}) "
+                         "({:.2f},{:.2f}))",
+                         t, sc.objects[static_cast<size_t>(i.object)].name, i.mesh_triangle, i.xy[0][0], i.xy[0][1],
+                         i.xy[1][0], i.xy[1][1], i.xy[2][0], i.xy[2][1]);
+    };
+    c.first_mismatch = fmt::format("pixel ({}, {}): model ({}, {}, {}) written by {}; rtl ({}, {}, {}) written by {}",
+                                   d->x, d->y, d->a.r, d->a.g, d->a.b, who(res, res.fb.tri[p]), d->b.r, d->b.g,
+                                   d->b.b, who(hres, hres.fb.tri[p]));
+  }
+  c.json = {{"ms", hres.stats.ms},
+            {"span_cycles", hres.stats.span_cycles},
+            {"spec_cycles", hres.stats.spec_cycles},
+            {"cycles_equal",
+             hres.stats.span_cycles == res.stats.span_cycles && hres.stats.spec_cycles == res.stats.spec_cycles}};
+  return c;
+}
+
+nlohmann::json frameCounts(const RenderStats& st) {
+  return {{"triangles", st.triangles},
+          {"culled", st.culled},
+          {"clipped", st.clipped},
+          {"drawn", st.drawn},
+          {"fragments", st.fragments},
+          {"pixels_covered", st.pixels_covered},
+          {"cycles", st.span_cycles},
+          {"spec_cycles", st.spec_cycles},
+          {"spec_evaluations", st.spec_evaluations},
+          {"divisions", st.divisions},
+          {"split_parts", st.split_parts},
+          {"normalisations", st.normalisations},
+          {"adaptive_gouraud", st.adaptive_gouraud},
+          {"adaptive_phong", st.adaptive_phong}};
+}
+
+double medianFrameMs(const Scene& sc, const RenderOptions& ro, Engines& model, const RenderResult& first,
+                     size_t frames, RenderResult& scratch) {
+  // Frame after frame into the same buffers, as a renderer does.
+  std::vector<double> frame_ms{first.stats.ms};
+  for (size_t i = 1; i < frames; ++i) {
+    render(sc, ro, *model.span, model.view, scratch);
+    frame_ms.push_back(scratch.stats.ms);
+  }
+  std::sort(frame_ms.begin(), frame_ms.end());
+  return frame_ms[frame_ms.size() / 2];
+}
+
+}  // namespace shd::cli

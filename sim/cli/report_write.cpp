@@ -1,0 +1,381 @@
+#include "cli/report_write.h"
+
+#include <algorithm>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <set>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "image/compose.h"
+#include "io/files.h"
+#include "io/process.h"
+#include "sweep/area.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace shd::cli {
+
+namespace {
+
+constexpr const char* kNotApplicable = "—";
+const std::vector<std::string> kAreaFigures = {"luts", "ffs", "dsps", "brams"};
+
+// A JSON value at a path of keys, null where a key is missing.
+using Path = std::vector<std::string>;
+const json& at(const json& j, const Path& path) {
+  static const json null;
+  const json* p = &j;
+  for (const std::string& k : path) {
+    if (!p->is_object() || !p->contains(k)) return null;
+    p = &(*p)[k];
+  }
+  return *p;
+}
+
+// A number with `decimals` decimals (scaled first), or "—" for null.
+std::string num(const json& v, int decimals, double scale = 1) {
+  if (v.is_null()) return kNotApplicable;
+  if (decimals == 0 && v.is_number_integer()) return v.dump();
+  return fmt::format("{:.{}f}", v.get<double>() * scale, decimals);
+}
+
+// A CSV cell: a number or boolean as JSON writes it (every digit), a string as itself, null empty.
+std::string csvCell(const json& v) {
+  if (v.is_null()) return "";
+  if (v.is_string()) return v.get<std::string>();
+  if (v.is_array()) {
+    std::string s;
+    for (const json& e : v) s += (s.empty() ? "" : "+") + csvCell(e);
+    return s;
+  }
+  return v.dump();
+}
+
+std::vector<std::string> targetsOf(const json& report) {
+  const json& t = at(report, {"options", "synth_targets"});
+  return t.is_array() ? t.get<std::vector<std::string>>() : std::vector<std::string>{};
+}
+
+// The distinct values of a key over the rows that pass `keep`, in row order.
+std::vector<std::string> distinct(const json& rows, const char* key, const std::function<bool(const json&)>& keep) {
+  std::vector<std::string> v;
+  for (const json& r : rows)
+    if (keep(r) && std::find(v.begin(), v.end(), r[key].get<std::string>()) == v.end())
+      v.push_back(r[key].get<std::string>());
+  return v;
+}
+
+// A Markdown table row.
+std::string mdRow(const std::vector<std::string>& cells) { return "| " + fmt::format("{}", fmt::join(cells, " | ")) + " |\n"; }
+
+std::string mdHeader(const std::vector<std::string>& cells) {
+  return mdRow(cells) + mdRow(std::vector<std::string>(cells.size(), "---"));
+}
+
+// One column of a lobe's table: its header and its cell of a row (first: the method's first
+// mode, where the error figures are shown; the image is the same in every mode).
+struct MdColumn {
+  std::string header;
+  std::function<std::string(const json& row, bool first)> cell;
+};
+
+std::vector<MdColumn> lobeColumns(const json& report) {
+  auto err = [](const Path& path, int decimals, double scale = 1) {
+    return [path, decimals, scale](const json& r, bool first) {
+      if (!first) return std::string();
+      const bool highlight = path.front() == "highlight";
+      if (highlight && at(r, {"highlight", "pixels"}).get<uint64_t>() == 0) return std::string(kNotApplicable);
+      const json& v = at(r, path);
+      return v.is_null() ? std::string("∞") : num(v, decimals, scale);  // psnr_db null: equal images
+    };
+  };
+  auto val = [](const Path& path, int decimals) {
+    return [path, decimals](const json& r, bool) { return num(at(r, path), decimals); };
+  };
+  std::vector<MdColumn> c = {
+      {"method", [](const json& r, bool) { return "`" + r["method"].get<std::string>() + "`"; }},
+      {"mode", [](const json& r, bool) { return r["mode"].get<std::string>(); }},
+      {"max LSB", err({"metrics", "max_abs_lsb"}, 2)},
+      {"RMSE LSB", err({"metrics", "rmse_lsb"}, 3)},
+      {"PSNR dB", err({"metrics", "psnr_db"}, 2)},
+      {"> 1 LSB %", err({"metrics", "share_over_1lsb"}, 2, 100)},
+      {"hl max LSB", err({"highlight", "max_abs_lsb"}, 2)},
+      {"hl RMSE LSB", err({"highlight", "rmse_lsb"}, 3)},
+      {"hl > 1 LSB %", err({"highlight", "share_over_1lsb"}, 2, 100)},
+      {"model ms", val({"ms"}, 2)},
+      {"span cycles", val({"span_cycles"}, 0)},
+      {"spec cycles", val({"spec_cycles"}, 0)},
+      {"total cycles", val({"total_cycles"}, 0)}};
+  if (at(report, {"options", "rtl"}).get<bool>()) {
+    c.push_back({"RTL", [](const json& r, bool) {
+                   return at(r, {"rtl", "pixel_mismatches"}).get<uint64_t>() == 0 && at(r, {"rtl", "cycles_equal"}).get<bool>()
+                              ? std::string("equal")
+                              : std::string("**DIFFERENT**");
+                 }});
+    c.push_back({"RTL ms", val({"rtl", "ms"}, 1)});
+  }
+  for (const std::string& t : targetsOf(report))
+    for (const std::string f : {"luts", "dsps"})
+      c.push_back({fmt::format("{} {}", t == "ice40" ? "iCE40" : t, f == "luts" ? "LUT" : "DSP"),
+                   [t, f](const json& r, bool) { return num(at(r, {"area", t, f}), 0); }});
+  return c;
+}
+
+// The table of one lobe: a row per method and mode.
+std::string lobeTable(const json& report, const std::string& lobe) {
+  const std::vector<MdColumn> cols = lobeColumns(report);
+  std::vector<std::string> headers;
+  for (const MdColumn& c : cols) headers.push_back(c.header);
+  std::string md = mdHeader(headers);
+  std::string last_method;
+  for (const json& r : report["rows"]) {
+    if (r["lobe"] != lobe) continue;
+    const bool first = r["method"] != last_method;
+    last_method = r["method"].get<std::string>();
+    std::vector<std::string> cells;
+    for (const MdColumn& c : cols) cells.push_back(c.cell(r, first));
+    md += mdRow(cells);
+  }
+  return md;
+}
+
+// The units and their area.
+std::string unitsTable(const json& report) {
+  const std::vector<std::string> targets = targetsOf(report);
+  std::vector<std::string> headers = {"unit", "configuration", "lanes", "degree"};
+  for (const std::string& t : targets)
+    for (const char* f : {"LUT", "FF", "DSP", "BRAM"}) headers.push_back(fmt::format("{} {}", t == "ice40" ? "iCE40" : t, f));
+  std::string md = mdHeader(headers);
+  for (const char* unit : {"span", "spec"})
+    for (const auto& [name, u] : report["units"][unit].items()) {
+      std::vector<std::string> cells = {unit, "`" + name + "`", num(at(u, {"lanes"}), 0), num(at(u, {"degree"}), 0)};
+      for (const std::string& t : targets)
+        for (const std::string& f : kAreaFigures) cells.push_back(num(at(u, {"area", t, f}), 0));
+      md += mdRow(cells);
+    }
+  return md;
+}
+
+std::string checksSection(const json& report) {
+  const json& ch = report["checks"];
+  std::string md = "## Checks\n\n";
+  md += fmt::format("- Images across lane modes: {} ({} images compared with the first mode's).\n",
+                    ch["images_equal_across_modes"].get<bool>() ? "equal" : "**DIFFERENT**",
+                    ch["mode_comparisons"].get<uint64_t>());
+  md += ch["rtl"].is_null() ? std::string("- RTL in the loop: not run (give `--rtl`).\n")
+                            : fmt::format("- RTL in the loop: {} (images and cycles of every row).\n",
+                                          ch["rtl"].get<bool>() ? "equal to the model" : "**DIFFERENT**");
+  for (const json& f : ch["failures"]) md += "- FAILED: " + f.get<std::string>() + "\n";
+  return md + "\n";
+}
+
+std::string sheetAndPlotsSections(const json& report) {
+  const json& sheet = report["contact_sheet"];
+  std::string md = "## Contact sheet\n\n`contact_sheet.png`: " + sheet["what"].get<std::string>() + ".\n\n";
+  md += mdHeader({"position", "lobe"});
+  for (size_t i = 0; i < sheet["rows"].size(); ++i)
+    md += mdRow({fmt::format("row {}", i + 1), sheet["rows"][i].get<std::string>()});
+  md += "\n" + mdHeader({"position", "method"});
+  for (size_t i = 0; i < sheet["columns"].size(); ++i)
+    md += mdRow({fmt::format("column {}", i + 1), "`" + sheet["columns"][i].get<std::string>() + "`"});
+  const json& plots = report["plots"];
+  md += "\n## Plots\n\n";
+  if (plots["made"].get<bool>()) {
+    for (const json& f : plots["files"]) md += fmt::format("- `{}`\n", f.get<std::string>());
+    md += "\nEach PNG's data is the CSV beside it (scripts/plot_report.py, docs/report.md).\n\n";
+  } else {
+    md += "Skipped: " + plots["why"].get<std::string>() + ".\n\n";
+  }
+  return md;
+}
+
+}  // namespace
+
+json notApplicable(const json& report) {
+  const json& rows = report["rows"];
+  json na = json::array();
+  auto add = [&na](std::vector<std::string> columns, const std::string& where, const std::string& why) {
+    na.push_back({{"columns", columns}, {"where", where}, {"why", why}});
+  };
+  const std::vector<std::string> no_hw =
+      distinct(rows, "method", [](const json& r) { return r["span_cycles"].is_null(); });
+  if (!no_hw.empty())
+    add({"span_cycles", "spec_cycles", "total_cycles", "area"}, fmt::format("methods {}", fmt::join(no_hw, ", ")),
+        "computed per pixel in double precision, by neither unit: no hardware time and no area");
+  const std::vector<std::string> no_spec = distinct(
+      rows, "lobe", [](const json& r) { return !r["span_cycles"].is_null() && r["spec_cycles"].is_null(); });
+  if (!no_spec.empty())
+    add({"spec_cycles", "specular-unit area"}, fmt::format("lobes {}", fmt::join(no_spec, ", ")),
+        "evaluated exactly, in double precision, without the specular unit (only the device lobes quadratic and "
+        "cubic use it)");
+  const std::vector<std::string> no_hl =
+      distinct(rows, "lobe", [](const json& r) { return r["highlight"]["pixels"].get<uint64_t>() == 0; });
+  if (!no_hl.empty())
+    add({"highlight"}, fmt::format("lobes {}", fmt::join(no_hl, ", ")),
+        fmt::format("no covered pixel's reference specular part exceeds {} LSB: the image has no highlight",
+                    at(report, {"options", "highlight_lsb"}).get<double>()));
+  if (!at(report, {"options", "rtl"}).get<bool>())
+    add({"rtl"}, "every row", "not run: give --rtl to render every row with the verilated units as well");
+  if (targetsOf(report).empty())
+    add({"area"}, "every row", "not measured: give --synth-cache DIR for the yosys area of each unit configuration");
+  return na;
+}
+
+std::string reportCsv(const json& report) {
+  const std::vector<std::string> targets = targetsOf(report);
+  const bool rtl = at(report, {"options", "rtl"}).get<bool>();
+  std::vector<std::pair<std::string, Path>> cols = {
+      {"method", {"method"}}, {"lobe", {"lobe"}}, {"mode", {"mode"}}, {"span_config", {"span_config"}},
+      {"spec_configs", {"spec_configs"}}};
+  for (const char* group : {"metrics", "highlight"})
+    for (const char* f : {"max_abs_lsb", "rmse_lsb", "psnr_db", "share_over_1lsb", "pixels"})
+      cols.push_back({fmt::format("{}{}", group == std::string("metrics") ? "" : "highlight_", f), {group, f}});
+  for (const char* f : {"ms", "frames", "span_cycles", "spec_cycles", "total_cycles", "spec_evaluations",
+                        "image_equals_first_mode"})
+    cols.push_back({f, {f}});
+  if (rtl)
+    for (const char* f : {"pixel_mismatches", "cycles_equal", "ms"}) cols.push_back({fmt::format("rtl_{}", f), {"rtl", f}});
+  std::string csv;
+  for (size_t i = 0; i < cols.size(); ++i) csv += (i ? "," : "") + cols[i].first;
+  for (const std::string& t : targets)
+    for (const std::string& f : kAreaFigures) csv += fmt::format(",{}_{}", t, f);
+  csv += "\n";
+  for (const json& r : report["rows"]) {
+    std::string line;
+    for (size_t i = 0; i < cols.size(); ++i) line += (i ? "," : "") + csvCell(at(r, cols[i].second));
+    for (const std::string& t : targets)
+      for (const std::string& f : kAreaFigures) line += "," + csvCell(at(r, {"area", t, f}));
+    csv += line + "\n";
+  }
+  return csv;
+}
+
+std::string reportMarkdown(const json& report) {
+  const json& sc = report["scene"];
+  const json& opt = report["options"];
+  std::string md = fmt::format("# shadesim report: {}\n\n", sc["name"].get<std::string>());
+  md += fmt::format("Made by {} with `{}`. Scene hash `{}`: {}x{} pixels; objects {}, triangles {}, lights {}. "
+                    "Every figure below is formatted from `report.json`; shadesim's `docs/report.md` explains the columns.\n\n",
+                    report["tool"].get<std::string>(), report["command"].get<std::string>(),
+                    sc["hash"].get<std::string>(), sc["width"].get<int>(), sc["height"].get<int>(),
+                    sc["objects"].get<int>(), sc["triangles"].get<uint64_t>(), sc["lights"].get<int>());
+  md += fmt::format("Lane modes: {}. Model time: the median of {} frames per row. The error figures are the same in "
+                    "every lane mode (the images are, checked below) and are shown on the method's first row.\n\n",
+                    fmt::join(opt["modes"].get<std::vector<std::string>>(), ", "), opt["frames"].get<uint64_t>());
+  for (const json& lobe : report["lobes"]) {
+    const std::string name = lobe.get<std::string>();
+    bool any = false;
+    for (const json& r : report["rows"]) any = any || r["lobe"] == name;
+    if (!any) continue;
+    md += fmt::format("## Lobe {}\n\n", name == "material" ? "material (each material's own)" : "`" + name + "`");
+    md += lobeTable(report, name) + "\n";
+  }
+  md += "## Units\n\n" + unitsTable(report) + "\n";
+  md += "## Columns that do not apply\n\n";
+  for (const json& n : report["not_applicable"])
+    md += fmt::format("- {} ({}): {}.\n", fmt::join(n["columns"].get<std::vector<std::string>>(), ", "),
+                      n["where"].get<std::string>(), n["why"].get<std::string>());
+  md += "\n## Skipped\n\n";
+  if (report["skipped"].empty()) md += "Nothing: every method rendered with every lobe.\n";
+  const json& skipped = report["skipped"];
+  for (size_t i = 0; i < skipped.size();) {  // one line per run of one reason
+    size_t k = i;
+    std::set<std::string> methods, lobes;
+    for (; k < skipped.size() && skipped[k]["why"] == skipped[i]["why"]; ++k) {
+      methods.insert(skipped[k]["method"].get<std::string>());
+      lobes.insert(skipped[k]["lobe"].get<std::string>());
+    }
+    auto names = [&](const char* key) {  // in the order of the entries
+      std::vector<std::string> v;
+      for (size_t e = i; e < k; ++e) {
+        const std::string n = skipped[e][key].get<std::string>();
+        const std::string shown = n == "*" ? "every method" : "`" + n + "`";
+        if (std::find(v.begin(), v.end(), shown) == v.end()) v.push_back(shown);
+      }
+      return fmt::format("{}", fmt::join(v, ", "));
+    };
+    md += methods.size() == 1 || lobes.size() == 1
+              ? fmt::format("- {} with {}: {}.\n", names("method"), names("lobe"), skipped[i]["why"].get<std::string>())
+              : fmt::format("- {} (methods) with {} (lobes), each pair: {}.\n", names("method"), names("lobe"),
+                            skipped[i]["why"].get<std::string>());
+    i = k;
+  }
+  if (!report["warnings"].empty()) md += "\n## Warnings\n\n";
+  for (const json& w : report["warnings"]) md += "- " + w.get<std::string>() + "\n";
+  md += "\n" + sheetAndPlotsSections(report) + checksSection(report);
+  return md;
+}
+
+ContactSheet contactSheet(const Measured& m) {
+  std::vector<const Image*> tiles;
+  ContactSheet sheet;
+  sheet.json = {{"file", "contact_sheet.png"},
+                {"what", "one row per lobe, one column per method; in each cell the image above its error heat map "
+                         "(reduced), an empty cell where the pair was not rendered"},
+                {"rows", json::array()},
+                {"columns", json::array()}};
+  for (Method meth : m.methods) sheet.json["columns"].push_back(toString(meth));
+  int w = 1, h = 1;
+  for (size_t g = 0; g < m.groups.size(); ++g) {
+    bool any = false;
+    for (size_t k = 0; k < m.methods.size(); ++k) any = any || m.images.count({g, k}) > 0;
+    if (!any) continue;
+    sheet.json["rows"].push_back(m.groups[g].name);
+    for (size_t k = 0; k < m.methods.size(); ++k) {
+      const auto it = m.images.find({g, k});
+      tiles.push_back(it == m.images.end() ? nullptr : &it->second.thumb);
+      if (it != m.images.end()) w = std::max(w, it->second.thumb.width), h = std::max(h, it->second.thumb.height);
+    }
+  }
+  sheet.json["cell_width"] = w;
+  sheet.json["cell_height"] = h;
+  sheet.image = tileGrid(tiles, static_cast<int>(m.methods.size()), w, h, 6, Rgb{255, 255, 255}, Rgb{200, 200, 200});
+  return sheet;
+}
+
+Plots makePlots(const json& report, const fs::path& tmp) {
+  Plots p;
+  const std::string script = findShareFile("scripts/plot_report.py");
+  if (script.empty()) {
+    p.json = {{"made", false}, {"why", "scripts/plot_report.py is neither in this installation nor in the source tree"}};
+    return p;
+  }
+  // The python3 of PATH, else Debian's, where python3-matplotlib installs (a PATH python3 of
+  // pyenv or a venv may lack it): the first that imports matplotlib.
+  std::string python, out, err, error;
+  for (const char* candidate : {"python3", "/usr/bin/python3"})
+    if (python.empty() && runProcess({candidate, "-c", "import matplotlib"}, out, err, error) == 0) python = candidate;
+  if (python.empty()) {
+    p.json = {{"made", false},
+              {"why", "no python3 with matplotlib was found (python3 of PATH, /usr/bin/python3); install the Debian "
+                      "package python3-matplotlib"}};
+    return p;
+  }
+  fs::create_directories(tmp);
+  const std::string in = (tmp / "report.json").string();
+  writeFileAtomic(in, report.dump(1) + "\n");
+  const int rc = runProcess({python, script, in, "-o", tmp.string()}, out, err, error);
+  if (rc != 0) {
+    std::string said = err.size() > 400 ? "..." + err.substr(err.size() - 400) : err;
+    while (!said.empty() && said.back() == '\n') said.pop_back();
+    p.json = {{"made", false}, {"why", fmt::format("{} {} failed ({}): {}", python, script,
+                                                   rc < 0 ? error : fmt::format("exit {}", rc), said)}};
+    return p;
+  }
+  json files = json::array();
+  for (const char* f : {"error_vs_cycles.png", "error_vs_cycles.csv", "error_vs_area.png", "error_vs_area.csv"}) {
+    std::error_code ec;
+    if (!fs::is_regular_file(tmp / f, ec)) continue;
+    std::ifstream in_file(tmp / f, std::ios::binary);
+    p.files.emplace_back(f, std::string(std::istreambuf_iterator<char>(in_file), std::istreambuf_iterator<char>()));
+    files.push_back(f);
+  }
+  p.json = {{"made", true}, {"python", python}, {"files", files}};
+  return p;
+}
+
+}  // namespace shd::cli

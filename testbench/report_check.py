@@ -1,0 +1,320 @@
+#!/usr/bin/env python3
+"""report_check.py DIR [METHOD,LOBE,MODE,RENDER_JSON,RENDER_PNG ...]: checks a `shadesim report`
+directory against its report.json (testbench/report_test.sh):
+
+  - every cell of every table of report.md is report.json's value formatted as docs/report.md
+    states (no figure copied by hand), and no table holds a number it does not account for;
+  - report.csv has one line per row of report.json, with its values;
+  - the plots are valid PNG files (signature, chunk CRCs, IDAT inflating to the image's size,
+    IEND last) whose embedded data (tEXt "shadesim-plot-data") is the CSV beside them, and that
+    CSV is the rows of report.json with the Pareto front computed here independently;
+  - the images are equal across the lane modes (the report's own check, and every row of one
+    method and lobe names one image), contact_sheet.png and every image are valid PNG files;
+  - per sample row: `shadesim render --json` gives the same error figures and cycles, and its
+    image (rendered in that row's mode) has the same PNG bytes as the report's.
+Only the Python standard library: no matplotlib needed to check the plots.
+"""
+import csv
+import io
+import json
+import os
+import re
+import struct
+import sys
+import zlib
+
+NUMBER = re.compile(r"^-?\d+(\.\d+)?$")
+failures = []
+
+
+def check(cond, msg):
+    if not cond:
+        failures.append(msg)
+
+
+# --- PNG -------------------------------------------------------------------------------------
+
+def read_png(path):
+    """(width, height, {tEXt key: text}) of a valid PNG; a failure is recorded otherwise."""
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        failures.append(f"{path}: not a PNG (signature)")
+        return None
+    pos, chunks = 8, []
+    while pos < len(data):
+        if pos + 12 > len(data):
+            failures.append(f"{path}: truncated chunk at byte {pos}")
+            return None
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        body = data[pos + 8:pos + 8 + n]
+        crc = struct.unpack(">I", data[pos + 8 + n:pos + 12 + n])[0]
+        if zlib.crc32(kind + body) & 0xFFFFFFFF != crc:
+            failures.append(f"{path}: bad CRC in chunk {kind!r}")
+            return None
+        chunks.append((kind, body))
+        pos += 12 + n
+    if not chunks or chunks[0][0] != b"IHDR" or chunks[-1][0] != b"IEND":
+        failures.append(f"{path}: IHDR not first or IEND not last")
+        return None
+    w, h, depth, colour = struct.unpack(">IIBB", chunks[0][1][:10])
+    channels = {0: 1, 2: 3, 4: 2, 6: 4}.get(colour)
+    if depth != 8 or channels is None:
+        failures.append(f"{path}: unexpected format depth {depth} colour type {colour}")
+        return None
+    raw = zlib.decompress(b"".join(b for k, b in chunks if k == b"IDAT"))
+    check(len(raw) == h * (1 + w * channels), f"{path}: IDAT inflates to {len(raw)} bytes, not {h}x{w}x{channels}")
+    text = {}
+    for k, b in chunks:
+        if k == b"tEXt":
+            key, _, value = b.partition(b"\0")
+            text[key.decode("latin-1")] = value.decode("latin-1")
+    return w, h, text
+
+
+# --- report.md -------------------------------------------------------------------------------
+
+def fmt(v, decimals, scale=1):
+    if v is None:
+        return "—"
+    if decimals == 0 and isinstance(v, int):
+        return str(v)
+    return f"{v * scale:.{decimals}f}"
+
+
+def get(row, path):
+    for k in path:
+        if not isinstance(row, dict) or k not in row:
+            return None
+        row = row[k]
+    return row
+
+
+# header -> (path in the row, decimals, scale, shown on the method's first row only)
+LOBE_COLUMNS = {
+    "max LSB": (("metrics", "max_abs_lsb"), 2, 1, True),
+    "RMSE LSB": (("metrics", "rmse_lsb"), 3, 1, True),
+    "PSNR dB": (("metrics", "psnr_db"), 2, 1, True),
+    "> 1 LSB %": (("metrics", "share_over_1lsb"), 2, 100, True),
+    "hl max LSB": (("highlight", "max_abs_lsb"), 2, 1, True),
+    "hl RMSE LSB": (("highlight", "rmse_lsb"), 3, 1, True),
+    "hl > 1 LSB %": (("highlight", "share_over_1lsb"), 2, 100, True),
+    "model ms": (("ms",), 2, 1, False),
+    "span cycles": (("span_cycles",), 0, 1, False),
+    "spec cycles": (("spec_cycles",), 0, 1, False),
+    "total cycles": (("total_cycles",), 0, 1, False),
+    "RTL ms": (("rtl", "ms"), 1, 1, False),
+}
+for t, name in (("ice40", "iCE40"), ("xc7", "xc7")):
+    LOBE_COLUMNS[f"{name} LUT"] = (("area", t, "luts"), 0, 1, False)
+    LOBE_COLUMNS[f"{name} DSP"] = (("area", t, "dsps"), 0, 1, False)
+
+
+def tables(md):
+    """(heading, header cells, body rows) of every Markdown table, with the last ## heading."""
+    out, heading, lines = [], None, md.splitlines()
+    i = 0
+    while i < len(lines):
+        if lines[i].startswith("## "):
+            heading = lines[i][3:]
+        if lines[i].startswith("| ") and i + 1 < len(lines) and lines[i + 1].startswith("| ---"):
+            header = [c.strip() for c in lines[i].strip("|").split("|")]
+            body, i = [], i + 2
+            while i < len(lines) and lines[i].startswith("|"):
+                body.append([c.strip() for c in lines[i].strip().strip("|").split("|")])
+                i += 1
+            out.append((heading, header, body))
+            continue
+        i += 1
+    return out
+
+
+def expected_lobe_cell(row, header, first):
+    path, decimals, scale, first_only = LOBE_COLUMNS[header]
+    if first_only and not first:
+        return ""
+    if path[0] == "highlight" and row["highlight"]["pixels"] == 0:
+        return "—"
+    v = get(row, path)
+    if header == "PSNR dB" and v is None:
+        return "∞"
+    return fmt(v, decimals, scale)
+
+
+def check_lobe_table(report, heading, header, body):
+    m = re.match(r"Lobe (?:`([^`]+)`|material)", heading)
+    lobe = m.group(1) or "material"
+    rows = {(r["method"], r["mode"]): r for r in report["rows"] if r["lobe"] == lobe}
+    check(len(body) == len(rows), f"report.md lobe {lobe}: {len(body)} lines for {len(rows)} rows")
+    last = None
+    for cells in body:
+        method, mode = cells[0].strip("`"), cells[1]
+        row = rows.get((method, mode))
+        if row is None:
+            failures.append(f"report.md lobe {lobe}: no row {method} {mode} in report.json")
+            continue
+        first, last = method != last, method
+        for h, cell in zip(header[2:], cells[2:]):
+            if h == "RTL":
+                continue
+            if h not in LOBE_COLUMNS:
+                failures.append(f"report.md lobe {lobe}: unknown column {h!r}")
+                continue
+            want = expected_lobe_cell(row, h, first)
+            check(cell == want, f"report.md lobe {lobe} {method} {mode} {h}: {cell!r}, report.json gives {want!r}")
+
+
+def check_units_table(report, header, body):
+    for cells in body:
+        unit, name = cells[0], cells[1].strip("`")
+        u = report["units"][unit][name]
+        want = [fmt(u.get("lanes"), 0), fmt(u.get("degree"), 0)]
+        for h in header[4:]:
+            target, fig = h.split()
+            want.append(fmt(get(u, ("area", "ice40" if target == "iCE40" else target,
+                                    {"LUT": "luts", "FF": "ffs", "DSP": "dsps", "BRAM": "brams"}[fig])), 0))
+        check(cells[2:] == want, f"report.md units {unit} {name}: {cells[2:]} != {want}")
+
+
+def check_markdown(d, report):
+    md = open(os.path.join(d, "report.md"), encoding="utf-8").read()
+    sheet = report["contact_sheet"]
+    seen = 0
+    for heading, header, body in tables(md):
+        if heading.startswith("Lobe "):
+            check_lobe_table(report, heading, header, body)
+            seen += 1
+        elif heading == "Units":
+            check_units_table(report, header, body)
+        elif heading == "Contact sheet":
+            key = "rows" if header[1] == "lobe" else "columns"
+            prefix = "row" if key == "rows" else "column"
+            want = [[f"{prefix} {i + 1}", n if key == "rows" else f"`{n}`"] for i, n in enumerate(sheet[key])]
+            check(body == want, f"report.md contact sheet {key}: {body} != {want}")
+        else:
+            failures.append(f"report.md: a table under '{heading}' that this check does not know")
+    lobes = {r["lobe"] for r in report["rows"]}
+    check(seen == len(lobes), f"report.md: {seen} lobe tables for {len(lobes)} lobes with rows")
+
+
+# --- report.csv and the plots ----------------------------------------------------------------
+
+def same_number(text, v):
+    if v is None:
+        return text == ""
+    if isinstance(v, bool):
+        return text == ("true" if v else "false")
+    if isinstance(v, (int, float)):
+        return text != "" and float(text) == v  # every digit: JSON and CSV write the shortest round trip
+    if isinstance(v, list):
+        return text == "+".join(v)
+    return text == str(v)
+
+
+def check_csv(d, report):
+    rows = list(csv.DictReader(open(os.path.join(d, "report.csv"))))
+    check(len(rows) == len(report["rows"]), f"report.csv: {len(rows)} lines for {len(report['rows'])} rows")
+    for c, r in zip(rows, report["rows"]):
+        for k, text in c.items():
+            if k.startswith("highlight_"):
+                v = r["highlight"][k[len("highlight_"):]]
+            elif k in r["metrics"] and k not in ("ms",):
+                v = r["metrics"][k]
+            elif k.startswith("rtl_"):
+                v = r["rtl"][k[4:]]
+            elif re.match(r"^(ice40|xc7)_", k):
+                t, f = k.split("_", 1)
+                v = r["area"][t][f]
+            else:
+                v = r[k]
+            check(same_number(text, v), f"report.csv {r['method']}/{r['lobe']}/{r['mode']} {k}: {text!r} != {v!r}")
+
+
+def pareto(points):
+    return {i for i, (x, y) in enumerate(points)
+            if not any(x2 <= x and y2 <= y and (x2 < x or y2 < y) for x2, y2 in points)}
+
+
+def check_plots(d, report):
+    plots = report["plots"]
+    check(plots["made"], f"no plots: {plots.get('why')} (install python3-matplotlib)")
+    if not plots["made"]:
+        return
+    check("error_vs_cycles.png" in plots["files"], "error_vs_cycles.png not made")
+    for name in plots["files"]:
+        if not name.endswith(".png"):
+            continue
+        png = read_png(os.path.join(d, name))
+        text = open(os.path.join(d, name[:-4] + ".csv")).read()
+        if png:
+            check(png[2].get("shadesim-plot-data") == text, f"{name}: its data is not the CSV beside it")
+    # error_vs_cycles.csv from report.json, the front computed here.
+    rows = [r for r in report["rows"] if r["total_cycles"] is not None]
+    got = list(csv.DictReader(open(os.path.join(d, "error_vs_cycles.csv"))))
+    check(len(got) == len(rows), f"error_vs_cycles.csv: {len(got)} points for {len(rows)} rows with cycles")
+    fronts = {k: pareto([(r["total_cycles"], r["metrics"][k]) for r in rows]) for k in ("max_abs_lsb", "rmse_lsb")}
+    for i, (g, r) in enumerate(zip(got, rows)):
+        want = {"label": f"{r['method']}/{r['lobe']}", "method": r["method"], "lobe": r["lobe"], "mode": r["mode"],
+                "spec_unit": str(int(bool(r["spec_configs"]))), "total_cycles": str(r["total_cycles"]),
+                "front_max_abs_lsb": str(int(i in fronts["max_abs_lsb"])),
+                "front_rmse_lsb": str(int(i in fronts["rmse_lsb"]))}
+        for k, v in want.items():
+            check(g[k] == v, f"error_vs_cycles.csv point {i} {k}: {g[k]!r} != {v!r}")
+        for k in ("max_abs_lsb", "rmse_lsb"):
+            check(float(g[k]) == r["metrics"][k], f"error_vs_cycles.csv point {i} {k}: {g[k]} != {r['metrics'][k]}")
+    check(any(fronts["max_abs_lsb"]), "no Pareto front")
+
+
+# --- images and sample rows ------------------------------------------------------------------
+
+def check_images(d, report):
+    check(report["checks"]["images_equal_across_modes"], "report: images differ across modes")
+    check(report["checks"]["failures"] == [], f"report: failures {report['checks']['failures']}")
+    by_cell = {}
+    for r in report["rows"]:
+        check(r["image_equals_first_mode"], f"{r['method']}/{r['lobe']} {r['mode']}: image differs from the first mode's")
+        by_cell.setdefault((r["method"], r["lobe"]), set()).add((r["image"], r["heat_map"]))
+    modes = report["options"]["modes"]
+    for cell, files in by_cell.items():
+        check(len(files) == 1, f"{cell}: several images {files}")
+        n = sum(1 for r in report["rows"] if (r["method"], r["lobe"]) == cell)
+        check(n == len(modes), f"{cell}: {n} rows for {len(modes)} modes")
+        for f in next(iter(files)):
+            read_png(os.path.join(d, f))
+    read_png(os.path.join(d, "contact_sheet.png"))
+
+
+def check_sample(d, report, spec):
+    method, lobe, mode, rjson, rpng = spec.split(",")
+    r = json.load(open(rjson))
+    row = next((x for x in report["rows"] if (x["method"], x["lobe"], x["mode"]) == (method, lobe, mode)), None)
+    if row is None:
+        failures.append(f"sample {method}/{lobe}/{mode}: no such row")
+        return
+    check(row["metrics"] == r["metrics"], f"sample {method}/{lobe}: metrics {row['metrics']} != render's {r['metrics']}")
+    check(row["highlight"] == r["highlight"], f"sample {method}/{lobe}: highlight differs from render's")
+    check(row["span_cycles"] == r["cycles"], f"sample {method}/{lobe}: span cycles {row['span_cycles']} != {r['cycles']}")
+    check((row["spec_cycles"] or 0) == r["spec_cycles"], f"sample {method}/{lobe}: spec cycles differ from render's")
+    with open(os.path.join(d, row["image"]), "rb") as a, open(rpng, "rb") as b:
+        check(a.read() == b.read(), f"sample {method}/{lobe}: render --mode {mode} writes other PNG bytes than the report")
+
+
+def main():
+    d = sys.argv[1]
+    report = json.load(open(os.path.join(d, "report.json")))
+    check(report["format"] == "shadesim report 1", "report.json: format")
+    check(report["command"].startswith("shadesim report "), f"report.json: command {report['command']!r}")
+    check(re.fullmatch(r"[0-9a-f]{16}", report["scene"]["hash"]) is not None, "report.json: scene hash")
+    check_markdown(d, report)
+    check_csv(d, report)
+    check_plots(d, report)
+    check_images(d, report)
+    for spec in sys.argv[2:]:
+        check_sample(d, report, spec)
+    for f in failures[:30]:
+        print("FAIL " + f)
+    print(f"report_check: {len(report['rows'])} rows, {len(failures)} failures")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
