@@ -230,41 +230,89 @@ def prom_geometry(path, p):
     return depth, word_bits, varying
 
 
+def prepare(ref, unit, prom_arg):
+    """CONFIG, --unit and --prom as the command line gives them: (the configuration, its file's
+    real path, the PROM's real path or None for span, the PROM geometry or None). Refuses --prom
+    for a span configuration and a PROM that is missing, malformed or not a plain path."""
+    c = load_config(ref, unit)
+    config_file = os.path.realpath(c.path) if os.path.isfile(c.path) else c.path
+    prom = None
+    geometry = None
+    if c.unit == "span":
+        if prom_arg is not None:
+            raise InputError(f"--prom: {c.unit}:{c.name} is a span configuration, which has no "
+                             f"PROM (--prom applies to spec configurations only)")
+    else:
+        prom = prom_arg if prom_arg is not None else default_prom(c, ref)
+        if not os.path.isfile(prom):
+            raise InputError(f"PROM file '{prom}' not found (make it with 'shadesim prom "
+                             f"--config {ref} --format hex -o {prom}')")
+        prom = os.path.realpath(prom)
+        plain_path("PROM", prom)
+        geometry = prom_geometry(prom, c.rtl)
+    return c, config_file, prom, geometry
+
+
+def unit_rtl_files(c):
+    """The unit's RTL files (absolute, the top module's first); an InputError if one is missing."""
+    rtl_files = [os.path.join(ROOT, "rtl", f) for f in shd_config.UNITS[c.unit]["rtl"]]
+    for f in rtl_files:
+        if not os.path.isfile(f):
+            raise InputError(f"RTL file '{f}' not found")
+    return rtl_files
+
+
 # ---------------------------------------------------------------- yosys
 
-def run_yosys(c, tgt, rtl_files, chparams, prom, out):
-    """Synthesises for one target; writes <tgt>.log and <tgt>_stat.json; returns the wall time."""
-    top = c.top
-    log = os.path.join(out, f"{tgt}.log")
-    stat = os.path.join(out, f"{tgt}_stat.json")
+def read_commands(c, rtl_files, chparams, prom):
+    """The yosys commands that read the unit's RTL (deferred) and set its parameters: the
+    configuration's "rtl" object and, for spec, RomFile = the PROM, in one chparam. After them
+    the module c.top is the configured unit (scripts/pnr.py instantiates it in a wrapper)."""
     rom = f' -set RomFile "{prom}"' if c.unit == "spec" else ""
-    script = "\n".join([
-        f"read_verilog -defer {' '.join(rtl_files)}",
-        f"chparam {chparams}{rom} {top}",
-        f"hierarchy -check -top {top}",
-        f"{FLOWS[tgt]} -top {top}",
-        f"tee -q -o {stat}.tmp stat -json",
-    ])
-    for f in (stat + ".tmp", log + ".tmp"):
-        if os.path.exists(f):
-            os.remove(f)
+    return [f"read_verilog -defer {' '.join(rtl_files)}", f"chparam {chparams}{rom} {c.top}"]
+
+
+def yosys_run(commands, log, what):
+    """Runs `yosys -q` on the commands, its log in `log` (written under a temporary name and
+    renamed, also on failure); returns the wall time. Raises YosysError naming `what` with the
+    log's ERROR lines (or yosys's last stderr lines)."""
+    if os.path.exists(log + ".tmp"):
+        os.remove(log + ".tmp")
     t0 = time.monotonic()
-    r = subprocess.run(["yosys", "-q", "-l", log + ".tmp", "-p", script],
+    r = subprocess.run(["yosys", "-q", "-l", log + ".tmp", "-p", "\n".join(commands)],
                        stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     wall = time.monotonic() - t0
     if os.path.exists(log + ".tmp"):
         os.replace(log + ".tmp", log)
     if r.returncode != 0:
-        if os.path.exists(stat + ".tmp"):
-            os.remove(stat + ".tmp")
         lines = []
         if os.path.exists(log):
             with open(log, errors="replace") as f:
                 lines = [l.rstrip("\n") for l in f if "ERROR" in l][:5]
         if not lines:
             lines = r.stderr.decode(errors="replace").splitlines()[-20:]
-        raise YosysError("\n".join([f"yosys failed for {c.name} / {tgt} (full log: {log}):"]
-                                   + lines))
+        raise YosysError("\n".join([f"yosys failed for {what} (full log: {log}):"] + lines))
+    return wall
+
+
+def run_yosys(c, tgt, rtl_files, chparams, prom, out):
+    """Synthesises for one target; writes <tgt>.log and <tgt>_stat.json; returns the wall time."""
+    top = c.top
+    log = os.path.join(out, f"{tgt}.log")
+    stat = os.path.join(out, f"{tgt}_stat.json")
+    commands = read_commands(c, rtl_files, chparams, prom) + [
+        f"hierarchy -check -top {top}",
+        f"{FLOWS[tgt]} -top {top}",
+        f"tee -q -o {stat}.tmp stat -json",
+    ]
+    if os.path.exists(stat + ".tmp"):
+        os.remove(stat + ".tmp")
+    try:
+        wall = yosys_run(commands, log, f"{c.name} / {tgt}")
+    except YosysError:
+        if os.path.exists(stat + ".tmp"):
+            os.remove(stat + ".tmp")
+        raise
     os.replace(stat + ".tmp", stat)
     return float(f"{wall:.2f}")
 
@@ -474,23 +522,7 @@ def main(argv):
         return predict_dsps(a.dsps_of, a.unit, targets)
     if a.config is None:
         raise InputError("name a CONFIG (or --dsps-of FILE)")
-    c = load_config(a.config, a.unit)
-    config_file = os.path.realpath(c.path) if os.path.isfile(c.path) else c.path
-
-    prom = None
-    geometry = None
-    if c.unit == "span":
-        if a.prom is not None:
-            raise InputError(f"--prom: {c.unit}:{c.name} is a span configuration, which has no "
-                             f"PROM (--prom applies to spec configurations only)")
-    else:
-        prom = a.prom if a.prom is not None else default_prom(c, a.config)
-        if not os.path.isfile(prom):
-            raise InputError(f"PROM file '{prom}' not found (make it with 'shadesim prom "
-                             f"--config {a.config} --format hex -o {prom}')")
-        prom = os.path.realpath(prom)
-        plain_path("PROM", prom)
-        geometry = prom_geometry(prom, c.rtl)
+    c, config_file, prom, geometry = prepare(a.config, a.unit, a.prom)
 
     if shutil.which("yosys") is None:
         raise InputError("yosys not found (apt-get install yosys)")
@@ -504,10 +536,7 @@ def main(argv):
         raise InputError(f"cannot create the output directory '{out}': {e.strerror}"
                          + ("" if a.out else " (pass --out DIR)"))
 
-    rtl_files = [os.path.join(ROOT, "rtl", f) for f in shd_config.UNITS[c.unit]["rtl"]]
-    for f in rtl_files:
-        if not os.path.isfile(f):
-            raise InputError(f"RTL file '{f}' not found")
+    rtl_files = unit_rtl_files(c)
     chparams = shd_config.tool_args(c, "yosys")[0]
     yosys_version = subprocess.run(["yosys", "-V"], stdout=subprocess.PIPE,
                                    text=True).stdout.strip()
