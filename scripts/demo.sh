@@ -2,7 +2,9 @@
 # The main job: installs what is missing, builds, then for the default configuration of the
 # specular unit generates the PROM (every format), runs the exhaustive co-simulation of the
 # verilated RTL against the golden model, prints the error table, and synthesises the unit;
-# then measures the span unit's cycles per mode, checked against its RTL. Results go to out/.
+# then measures the span unit's cycles per mode, checked against its RTL; renders the sphere with
+# the main methods; and writes the report of every method, lobe and lane mode on the sphere
+# (error, model time, cycles, area, plots). Results go to out/.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out"
@@ -59,6 +61,19 @@ for j in rows:
           f"{j['highlight']['max_abs_lsb']:>7.2f} {j['cycles']:>8} {j['spec_cycles']:>9} {j['ms']:>7.1f} {j['rtl']['ms']:>7.1f} {j['pixel_mismatches']:>8}")
 PY
 cat "$out/render/summary.txt"
+
+echo "== 7. report of builtin:sphere: every method, lobe and lane mode (out/report/, docs/report.md)"
+mkdir -p "$out/synth-cache"
+"$S" report --scene builtin:sphere --synth-cache "$out/synth-cache" --quiet -o "$out/report"
+python3 - "$out/report/report.json" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+rows = [r for r in j["rows"] if r["mode"] == "serial" and r["lobe"] in ("blinn", "quadratic")]
+print(f"   {'method':<18} {'lobe':<10} {'max LSB':>8} {'RMSE':>7} {'cycles':>8} {'spec cyc':>9} {'model ms':>8}")
+for r in rows:
+    print(f"   {r['method']:<18} {r['lobe']:<10} {r['metrics']['max_abs_lsb']:>8.2f} {r['metrics']['rmse_lsb']:>7.3f} "
+          f"{r['counts']['cycles']:>8} {r['counts']['spec_cycles']:>9} {r['ms']:>8.2f}")
+PY
 
 echo "== results in $out"
 ls -1 "$out"
