@@ -129,9 +129,8 @@ FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, L
   if (cosine_ == Cosine::Device) coding_ = checkedDeviceCoding(coding, memo, "FixedPointShader");
   if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) table_ = lobeTable(lobe, m.shininess);
   v_ = unitCodes(ctx.view);
-  const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
-  const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
-  for (size_t k = 0; k < 3; ++k) ambient_[k] = factorCode(255.0 * amb[k] * base[k]);
+  const LightFactors f = lightFactors(ctx, m);
+  for (size_t k = 0; k < 3; ++k) ambient_[k] = factorCode(f.ambient[k]);
   lights_.resize(ctx.lights.size());
   for (size_t i = 0; i < ctx.lights.size(); ++i) {
     const CameraLight& l = ctx.lights[i];
@@ -139,11 +138,10 @@ FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, L
     pl.light = &l;
     needs_position_ = needs_position_ || l.point;
     if (!l.point) setDirections(pl, l.dir);
-    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
     for (size_t k = 0; k < 3; ++k) {
-      pl.diffuse[k] = factorCode(255.0 * m.kd * base[k] * lc[k]);
-      pl.specular[k] = factorCode(255.0 * m.ks * lc[k]);
-      pl.device_light[k] = deviceLightCode(m.ks * lc[k]);
+      pl.diffuse[k] = factorCode(f.lights[i].diffuse[k]);
+      pl.specular[k] = factorCode(f.lights[i].specular[k]);
+      pl.device_light[k] = f.lights[i].device[k];
     }
     if (cosine_ == Cosine::Device && memo_ != nullptr) pl.memo = memo_->row(coding_->shin, pl.device_light);
   }

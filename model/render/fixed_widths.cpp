@@ -87,9 +87,8 @@ FixedWidthsShader::FixedWidthsShader(const ShadeContext& ctx, const Material& m,
     if (!(x >= 0)) throw std::logic_error(fmt::format("phong-fixed: a lighting factor of {} LSB", lsb));
     return x >= factor_max ? static_cast<int64_t>(factor_max) : std::llround(x);
   };
-  const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
-  const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
-  for (size_t k = 0; k < 3; ++k) ambient_[k] = factor(255.0 * amb[k] * base[k]);
+  const LightFactors f = lightFactors(ctx, m);
+  for (size_t k = 0; k < 3; ++k) ambient_[k] = factor(f.ambient[k]);
   lights_.resize(ctx.lights.size());
   for (size_t i = 0; i < ctx.lights.size(); ++i) {
     const CameraLight& l = ctx.lights[i];
@@ -97,11 +96,10 @@ FixedWidthsShader::FixedWidthsShader(const ShadeContext& ctx, const Material& m,
     pl.light = &l;
     needs_position_ = needs_position_ || l.point;
     if (!l.point) setDirections(pl, l.dir);
-    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
     for (size_t k = 0; k < 3; ++k) {
-      pl.diffuse[k] = factor(255.0 * m.kd * base[k] * lc[k]);
-      pl.specular[k] = factor(255.0 * m.ks * lc[k]);
-      pl.device_light[k] = deviceLightCode(m.ks * lc[k]);
+      pl.diffuse[k] = factor(f.lights[i].diffuse[k]);
+      pl.specular[k] = factor(f.lights[i].specular[k]);
+      pl.device_light[k] = f.lights[i].device[k];
     }
     if (cosine_ == Cosine::Device && memo_ != nullptr) pl.memo = memo_->row(coding_->shin, pl.device_light);
   }

@@ -83,22 +83,33 @@ double lobeValue(Lobe lobe, const Material& m, Vec3 n, Vec3 l, Vec3 v, Vec3 h) {
   throw std::logic_error("lobeValue: device lobes are evaluated by the specular unit");
 }
 
+LightFactors lightFactors(const ShadeContext& ctx, const Material& m) {
+  LightFactors f;
+  const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
+  const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
+  for (size_t k = 0; k < 3; ++k) f.ambient[k] = 255.0 * amb[k] * base[k];
+  for (const CameraLight& l : ctx.lights) {
+    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
+    LightFactors::Light fl;
+    fl.point = l.point;
+    for (size_t k = 0; k < 3; ++k) {
+      fl.diffuse[k] = 255.0 * m.kd * base[k] * lc[k];
+      fl.specular[k] = 255.0 * m.ks * lc[k];
+      fl.device[k] = deviceLightCode(m.ks * lc[k]);
+    }
+    f.lights.push_back(fl);
+  }
+  return f;
+}
+
 PointShader::PointShader(const ShadeContext& ctx, const Material& m, Lobe lobe, const DeviceCoding* coding)
     : ctx_(ctx), m_(m), lobe_(lobe), device_lobe_(isDeviceLobe(lobe)) {
   if (coding != nullptr) coding_ = *coding;
-  const std::array<double, 3> base{m.colour.x, m.colour.y, m.colour.z};
-  const std::array<double, 3> amb{ctx.ambient.x, ctx.ambient.y, ctx.ambient.z};
-  for (size_t k = 0; k < 3; ++k) ambient_[k] = 255.0 * amb[k] * base[k];
-  for (const CameraLight& l : ctx.lights) {
+  const LightFactors f = lightFactors(ctx, m);
+  ambient_ = f.ambient;
+  for (const LightFactors::Light& l : f.lights) {
     needs_position_ = needs_position_ || l.point;
-    const std::array<double, 3> lc{l.colour.x, l.colour.y, l.colour.z};
-    PerLight pl;
-    for (size_t k = 0; k < 3; ++k) {
-      pl.diffuse[k] = 255.0 * m.kd * base[k] * lc[k];
-      pl.specular[k] = 255.0 * m.ks * lc[k];
-      pl.device_light[k] = deviceLightCode(m.ks * lc[k]);
-    }
-    lights_.push_back(pl);
+    lights_.push_back({l.diffuse, l.specular, l.device});
   }
 }
 

@@ -64,6 +64,21 @@ inline uint32_t deviceLightCode(double ks_light) {
   return static_cast<uint32_t>(std::lround(255.0 * std::clamp(ks_light, 0.0, 1.0)));
 }
 
+// A material's colour factors under a scene's lights, in output LSBs (0..255 scale), which each
+// shader codes in its own format: the ambient term 255 ambient base, and per light the diffuse
+// factor 255 k_d base light and the specular factor 255 k_s light per channel, the specular
+// unit's light codes, and whether the light is a point light.
+struct LightFactors {
+  struct Light {
+    std::array<double, 3> diffuse{}, specular{};
+    std::array<uint32_t, 3> device{};
+    bool point = false;
+  };
+  std::array<double, 3> ambient{};
+  std::vector<Light> lights;  // ShadeContext::lights' order
+};
+LightFactors lightFactors(const ShadeContext& ctx, const Material& m);
+
 // How a material's device-lobe requests are coded for the specular unit.
 struct DeviceCoding {
   int cos_frac_bits = 15;
