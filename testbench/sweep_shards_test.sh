@@ -2,7 +2,7 @@
 # sweep_shards_test.sh SHADESIM WORK: a sweep run whole, as 2 shards under GNU parallel, and as
 # the Slurm job array of scripts/sweep_slurm.sh (its --dry-run commands run here by a stand-in
 # for sbatch that runs each array task in turn); each merged result must equal the whole run byte
-# for byte.
+# for byte. Then the span and phong units, whole and as 2 shards.
 set -euo pipefail
 shadesim=$(realpath "$1")
 work=$2
@@ -53,3 +53,15 @@ sbatch() {
 # shellcheck disable=SC1091
 source ./slurm.sh
 same slurm/merged
+
+# The other units: sweep-merge rebuilds each from the plan's base alone.
+for unit in "--unit span --triangles 2000 --param ColourFracBits=8:12:2" "--unit phong --scene sphere --param LobeCosBits=8,12"; do
+  rm -rf whole p1 p2 merged
+  mkdir whole p1 p2 merged
+  # shellcheck disable=SC2086
+  "$shadesim" sweep $unit --quiet -o whole
+  # shellcheck disable=SC2086
+  parallel --halt now,fail=1 "$shadesim" sweep $unit --quiet --shard {}/2 -o p{} ::: 1 2
+  "$shadesim" sweep-merge p1 p2 -o merged --quiet
+  same merged
+done
