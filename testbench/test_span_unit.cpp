@@ -96,7 +96,7 @@ std::vector<SpanFragment> runMode(const std::string& m, const std::array<SetupVe
 }
 
 // Random triangles of mixed sizes and shapes around a small viewport (a stand-in until the
-// generator of raster/trigen.h covers the classes of the issue).
+// generator of raster/trigen.h covers every size class and shape).
 std::array<SetupVertex, 3> randomTriangle(std::mt19937_64& rng, int w, int h) {
   std::uniform_real_distribution<double> u(0, 1);
   const int kind = static_cast<int>(rng() % 6);
@@ -445,7 +445,7 @@ TEST(SpanUnitModel, SerialEqualsDirectEvaluationOnGeneratorClasses) {
 
 TEST(SpanUnitModel, EveryModeEqualsSerialOnGeneratorTriangles) { checkModesAgainstSerial(22, 100000, true); }
 
-// The issue's million triangles per mode, the cycle models only (slow label; the walkers are
+// A million triangles per mode, the cycle models only (slow label; the walkers are
 // checked on the 10^5 triangles above, in the release and the sanitizer run).
 TEST(SpanUnitModel, EveryModeEqualsSerialOnAMillionTriangles) { checkModesAgainstSerial(20261122, 1000000, false); }
 
