@@ -129,22 +129,10 @@ FixedPointShader::FixedPointShader(const ShadeContext& ctx, const Material& m, L
   if (cosine_ == Cosine::Device) coding_ = checkedDeviceCoding(coding, memo, "FixedPointShader");
   if (cosine_ == Cosine::NH || cosine_ == Cosine::RV) table_ = lobeTable(lobe, m.shininess);
   v_ = unitCodes(ctx.view);
-  const LightFactors f = lightFactors(ctx, m);
-  for (size_t k = 0; k < 3; ++k) ambient_[k] = factorCode(f.ambient[k]);
-  lights_.resize(ctx.lights.size());
-  for (size_t i = 0; i < ctx.lights.size(); ++i) {
-    const CameraLight& l = ctx.lights[i];
-    PerLight& pl = lights_[i];
-    pl.light = &l;
-    needs_position_ = needs_position_ || l.point;
-    if (!l.point) setDirections(pl, l.dir);
-    for (size_t k = 0; k < 3; ++k) {
-      pl.diffuse[k] = factorCode(f.lights[i].diffuse[k]);
-      pl.specular[k] = factorCode(f.lights[i].specular[k]);
-      pl.device_light[k] = f.lights[i].device[k];
-    }
-    if (cosine_ == Cosine::Device && memo_ != nullptr) pl.memo = memo_->row(coding_->shin, pl.device_light);
-  }
+  SpecResultMemo* rows = cosine_ == Cosine::Device ? memo_ : nullptr;
+  needs_position_ = codeLights(ctx, m, factorCode, rows, rows ? coding_->shin : 0, ambient_, lights_);
+  for (PerLight& pl : lights_)
+    if (!pl.light->point) setDirections(pl, pl.light->dir);
 }
 
 void FixedPointShader::setDirections(PerLight& pl, Vec3 l) const {

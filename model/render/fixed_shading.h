@@ -154,6 +154,32 @@ FixedCosine fixedCosineOf(Lobe lobe);
 // CosFracBits outside 1..30.
 DeviceCoding checkedDeviceCoding(const DeviceCoding* coding, const SpecResultMemo* memo, const char* who);
 
+// The per-light constants both phong-fixed shaders hold: each light, its factor codes (the
+// material's factors of lightFactors() in the shader's format, by `code`), its specular-unit
+// light codes and, for device lobes answered by `memo`, the memo's row; the ambient code. Returns
+// whether a light is a point light (directions per pixel). The directions of the directional
+// lights are the shader's to set.
+template <class PerLight, class Code>
+bool codeLights(const ShadeContext& ctx, const Material& m, Code code, SpecResultMemo* memo, uint32_t shin,
+                std::array<int64_t, 3>& ambient, std::vector<PerLight>& lights) {
+  const LightFactors f = lightFactors(ctx, m);
+  for (size_t k = 0; k < 3; ++k) ambient[k] = code(f.ambient[k]);
+  lights.resize(ctx.lights.size());
+  bool point = false;
+  for (size_t i = 0; i < ctx.lights.size(); ++i) {
+    PerLight& pl = lights[i];
+    pl.light = &ctx.lights[i];
+    point = point || pl.light->point;
+    for (size_t k = 0; k < 3; ++k) {
+      pl.diffuse[k] = code(f.lights[i].diffuse[k]);
+      pl.specular[k] = code(f.lights[i].specular[k]);
+      pl.device_light[k] = f.lights[i].device[k];
+    }
+    if (memo != nullptr) pl.memo = memo->row(shin, pl.device_light);
+  }
+  return point;
+}
+
 class FixedPointShader {
  public:
   // coding: the specular unit's request coding (device lobes; std::logic_error if null then).

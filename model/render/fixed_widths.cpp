@@ -87,22 +87,10 @@ FixedWidthsShader::FixedWidthsShader(const ShadeContext& ctx, const Material& m,
     if (!(x >= 0)) throw std::logic_error(fmt::format("phong-fixed: a lighting factor of {} LSB", lsb));
     return x >= factor_max ? static_cast<int64_t>(factor_max) : std::llround(x);
   };
-  const LightFactors f = lightFactors(ctx, m);
-  for (size_t k = 0; k < 3; ++k) ambient_[k] = factor(f.ambient[k]);
-  lights_.resize(ctx.lights.size());
-  for (size_t i = 0; i < ctx.lights.size(); ++i) {
-    const CameraLight& l = ctx.lights[i];
-    PerLight& pl = lights_[i];
-    pl.light = &l;
-    needs_position_ = needs_position_ || l.point;
-    if (!l.point) setDirections(pl, l.dir);
-    for (size_t k = 0; k < 3; ++k) {
-      pl.diffuse[k] = factor(f.lights[i].diffuse[k]);
-      pl.specular[k] = factor(f.lights[i].specular[k]);
-      pl.device_light[k] = f.lights[i].device[k];
-    }
-    if (cosine_ == Cosine::Device && memo_ != nullptr) pl.memo = memo_->row(coding_->shin, pl.device_light);
-  }
+  SpecResultMemo* rows = cosine_ == Cosine::Device ? memo_ : nullptr;
+  needs_position_ = codeLights(ctx, m, factor, rows, rows ? coding_->shin : 0, ambient_, lights_);
+  for (PerLight& pl : lights_)
+    if (!pl.light->point) setDirections(pl, pl.light->dir);
 }
 
 int64_t FixedWidthsShader::unitCode(double x) const { return std::llround(std::ldexp(x, w_.UnitFracBits)); }

@@ -191,6 +191,27 @@ std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt) 
   return used;
 }
 
+Image frameImage(const Framebuffer& fb) {
+  Image img(fb.width, fb.height);
+  img.rgb = fb.rgb;
+  return img;
+}
+
+PixelMask coveredPixels(const Framebuffer& fb) {
+  PixelMask m(fb.width, fb.height);
+  for (int y = 0; y < fb.height; ++y)
+    for (int x = 0; x < fb.width; ++x)
+      if (fb.covered(x, y)) m.set(x, y);
+  return m;
+}
+
+ImageF exactImage(const Framebuffer& reference) {
+  ImageF img(reference.width, reference.height);
+  img.rgb = reference.lsb;
+  for (double& v : img.rgb) v = std::clamp(v, 0.0, 255.0);
+  return img;
+}
+
 RenderResult render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& engines) {
   RenderResult res;
   render(scene, opt, span, engines, res);

@@ -40,6 +40,7 @@
 
 #include "device/prom.h"
 #include "device/spec_unit.h"
+#include "image/image.h"
 #include "raster/setup.h"
 #include "render/fixed_shading.h"
 #include "render/phong_widths.h"
@@ -167,6 +168,13 @@ struct Framebuffer {
   std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
   bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
 };
+
+// A frame as an image (its rgb), the mask of its covered pixels, and the reference method's
+// exact colour clamped to 0..255 (what a display shows: an over-exposed highlight is 255, not
+// its unclamped value), the image an error is measured against.
+Image frameImage(const Framebuffer& fb);
+PixelMask coveredPixels(const Framebuffer& fb);
+ImageF exactImage(const Framebuffer& reference);
 
 // The corrected 4.4 edge maximum of the specular cosine between unit normals na and nb for the
 // half vector h: t in (0, 1), or -1 when the edge has no interior maximum.

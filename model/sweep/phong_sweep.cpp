@@ -42,20 +42,6 @@ Scene loadNamedScene(const std::string& name, const std::string& file) {
   }
 }
 
-Image imageOf(const Framebuffer& fb) {
-  Image img(fb.width, fb.height);
-  img.rgb = fb.rgb;
-  return img;
-}
-
-PixelMask coveredBy(const Framebuffer& fb) {
-  PixelMask m(fb.width, fb.height);
-  for (int y = 0; y < fb.height; ++y)
-    for (int x = 0; x < fb.width; ++x)
-      if (fb.covered(x, y)) m.set(x, y);
-  return m;
-}
-
 RenderResult renderWith(const Scene& scene, Method method, const std::optional<PhongWidths>& widths,
                         const LobeConfigs& lobes) {
   RenderOptions o;
@@ -111,12 +97,10 @@ void PhongScenes::load() {
     const RenderResult ref = renderWith(s.scene, Method::Reference, std::nullopt, lobes_);
     const RenderResult phong = renderWith(s.scene, Method::Phong, std::nullopt, lobes_);
     const RenderResult fixed = renderWith(s.scene, Method::PhongFixed, std::nullopt, lobes_);
-    s.reference = ImageF(ref.fb.width, ref.fb.height);
-    s.reference.rgb = ref.fb.lsb;
-    for (double& v : s.reference.rgb) v = std::clamp(v, 0.0, 255.0);
-    s.phong = imageOf(phong.fb);
-    s.fixed = imageOf(fixed.fb);
-    s.covered = intersect(intersect(coveredBy(ref.fb), coveredBy(phong.fb)), coveredBy(fixed.fb));
+    s.reference = exactImage(ref.fb);
+    s.phong = frameImage(phong.fb);
+    s.fixed = frameImage(fixed.fb);
+    s.covered = intersect(intersect(coveredPixels(ref.fb), coveredPixels(phong.fb)), coveredPixels(fixed.fb));
     loaded.push_back(std::move(s));
   }
   scenes_ = std::move(loaded);
@@ -124,8 +108,8 @@ void PhongScenes::load() {
 
 // The figures of one scene at one point (the file comment of phong_sweep.h).
 nlohmann::json sceneError(const SceneImages& s, const RenderResult& res) {
-  const Image img = imageOf(res.fb);
-  const PixelMask covered = intersect(s.covered, coveredBy(res.fb));
+  const Image img = frameImage(res.fb);
+  const PixelMask covered = intersect(s.covered, coveredPixels(res.fb));
   const ImageMetrics total = imageMetrics(img, s.reference, covered);
   const ImageMetrics dp = imageMetrics(img, s.phong, covered);
   const ImageMetrics def = imageMetrics(img, s.fixed, covered);

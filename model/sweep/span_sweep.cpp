@@ -41,12 +41,6 @@ struct SpanBase {
   std::vector<std::string> scenes;
 };
 
-bool isSceneName(const std::string& name) {
-  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
-  });
-}
-
 // The names' form (the files are looked up when a scene is loaded: a merge, which evaluates
 // nothing, needs none).
 void checkSceneNames(const std::vector<std::string>& scenes) {

@@ -41,11 +41,14 @@ std::string sweepUnitHelp() {
   return help;
 }
 
-std::string sweepSceneFile(const std::string& name) {
-  const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+bool isSceneName(const std::string& name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
     return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
   });
-  if (!plain) throw std::invalid_argument(fmt::format("scene \"{}\": a bundled scene's name (lower-case letters, digits, '_')", name));
+}
+
+std::string sweepSceneFile(const std::string& name) {
+  if (!isSceneName(name)) throw std::invalid_argument(fmt::format("scene \"{}\": a bundled scene's name (lower-case letters, digits, '_')", name));
   const std::string file = findShareFile("vectors/scenes/" + name + ".json");
   if (file.empty())
     throw std::invalid_argument(fmt::format("scene {}: no such file in vectors/scenes of this installation or the source tree", name));

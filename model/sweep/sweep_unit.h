@@ -48,6 +48,9 @@ struct SweepUnit {
   std::vector<std::string> widths;
 };
 
+// A bundled scene's name: [a-z0-9_]+ (no path).
+bool isSceneName(const std::string& name);
+
 // The file of a bundled scene a sweep renders: vectors/scenes/<name>.json of the installation or
 // the source tree (findShareFile). std::invalid_argument for a name that is not [a-z0-9_]+ or
 // no such file.

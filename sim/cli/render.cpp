@@ -187,7 +187,7 @@ int RenderCmd::run(const CLI::App& app) {
   }
   // Every output is written only now, as one set (io/files.h): a failure leaves none of them.
   OutputFiles files;
-  files.add(outputs[0], encodePng(outputs[0], toImage(res.fb)));
+  files.add(outputs[0], encodePng(outputs[0], frameImage(res.fb)));
   files.add(outputs[1], encodePng(outputs[1], c.reference));
   files.add(outputs[2], encodePng(outputs[2], c.heat));
   if (!json_path_.empty()) files.add(json_path_, j.dump(2) + "\n");

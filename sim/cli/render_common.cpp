@@ -12,12 +12,6 @@ namespace fs = std::filesystem;
 
 namespace shd::cli {
 
-Image toImage(const Framebuffer& fb) {
-  Image img(fb.width, fb.height);
-  img.rgb = fb.rgb;
-  return img;
-}
-
 SpecUnitConfig lobeConfigArg(const LobeConfigs& lobes, Lobe l) {
   try {
     return lobes.load(l);
@@ -55,24 +49,18 @@ RenderResult renderReference(const Scene& sc, const RenderOptions& ro) {
 
 Comparison compareWithReference(const RenderResult& res, const RenderResult& ref, double highlight_lsb,
                                 double heat_scale) {
-  const Image img = toImage(res.fb);
-  ImageF reff(ref.fb.width, ref.fb.height), spec_ref(ref.fb.width, ref.fb.height);
-  // What a display shows: the reference clamped to the output range (an over-exposed
-  // highlight is 255, not its unclamped value).
-  reff.rgb = ref.fb.lsb;
-  for (double& v : reff.rgb) v = std::clamp(v, 0.0, 255.0);
+  const Image img = frameImage(res.fb);
+  const ImageF reff = exactImage(ref.fb);
+  ImageF spec_ref(ref.fb.width, ref.fb.height);
   spec_ref.rgb = ref.fb.spec_lsb;
-  PixelMask covered(img.width, img.height);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x)
-      if (res.fb.covered(x, y) && ref.fb.covered(x, y)) covered.set(x, y);
+  const PixelMask covered = intersect(coveredPixels(res.fb), coveredPixels(ref.fb));
   const PixelMask highlight = intersect(covered, thresholdMask(spec_ref, highlight_lsb));
   return {imageMetrics(img, reff, covered), imageMetrics(img, reff, highlight), roundToUnorm8(reff),
           errorHeatmap(img, reff, heat_scale, covered)};
 }
 
 RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderResult& hres) {
-  const Image img = toImage(res.fb), himg = toImage(hres.fb);
+  const Image img = frameImage(res.fb), himg = frameImage(hres.fb);
   RtlCheck c;
   c.mismatches = differingPixels(img, himg).count();
   if (auto d = firstDifference(img, himg)) {

@@ -20,9 +20,6 @@
 
 namespace shd::cli {
 
-// The unorm8 image of a framebuffer.
-Image toImage(const Framebuffer& fb);
-
 // The configuration of a device lobe; its std::invalid_argument an ArgError naming the option
 // (--quadratic-config or --cubic-config).
 SpecUnitConfig lobeConfigArg(const LobeConfigs& lobes, Lobe l);

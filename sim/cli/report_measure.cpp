@@ -98,7 +98,7 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const Rend
     const RenderResult res = render(sc, ro, *model.span, model.view);
     RenderResult scratch;
     const double ms = medianFrameMs(sc, ro, model, res, s.frames, scratch);
-    const Image img = toImage(res.fb);
+    const Image img = frameImage(res.fb);
     if (rows.empty()) {
       const Comparison c = compareWithReference(res, ref, s.highlight_lsb, s.heat_scale);
       CellImages files = cellImages(m, g, img, c.heat);
