@@ -792,11 +792,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    try:
-        sys.exit(main(sys.argv[1:]))
-    except InputError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
-        sys.exit(2)
-    except (YosysError, ToolError) as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
-        sys.exit(3)
+    synth.run_main(main, PROG, (YosysError, ToolError))

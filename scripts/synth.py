@@ -575,12 +575,18 @@ def main(argv):
     return 0
 
 
-if __name__ == "__main__":
+def run_main(main_fn, prog, tool_errors=(YosysError,)):
+    """Runs main_fn(argv) and exits with its status; an InputError exits 2 and a tool's error
+    (tool_errors) 3, each with one line "<prog>: error: ..." (shared with pnr.py)."""
     try:
-        sys.exit(main(sys.argv[1:]))
+        sys.exit(main_fn(sys.argv[1:]))
     except InputError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
+        print(f"{prog}: error: {e}", file=sys.stderr)
         sys.exit(2)
-    except YosysError as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr)
+    except tool_errors as e:
+        print(f"{prog}: error: {e}", file=sys.stderr)
         sys.exit(3)
+
+
+if __name__ == "__main__":
+    run_main(main, PROG)
