@@ -3,21 +3,14 @@
 
 #include <gtest/gtest.h>
 
-#include <array>
 #include <cmath>
 #include <random>
+
+#include "scene/vec.h"
 
 using namespace shd;
 
 namespace {
-
-using Vec3 = std::array<double, 3>;
-
-double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-Vec3 normalize(const Vec3& a) {
-  const double l = std::sqrt(dot(a, a));
-  return {a[0] / l, a[1] / l, a[2] / l};
-}
 
 // Composite Simpson over theta in [0, pi/2] of 2 pi * g(cos theta) * sin theta: the integral of
 // g(N.H) over the hemisphere (the phi integral of an isotropic lobe is 2 pi).
@@ -117,7 +110,7 @@ TEST(BrdfCookTorrance, ZeroBelowHorizonPositiveAboveAndReciprocal) {
     for (int k = 0; k < 20000; ++k) {
       Vec3 L = normalize({U(rng), U(rng), U(rng)});
       Vec3 V = normalize({U(rng), U(rng), U(rng)});
-      const Vec3 H = normalize({L[0] + V[0], L[1] + V[1], L[2] + V[2]});
+      const Vec3 H = normalize(L + V);
       const double nl = dot(N, L), nv = dot(N, V), nh = dot(N, H), vh = dot(V, H), lh = dot(L, H);
       const double f = cookTorrance(nl, nv, nh, vh, p);
       ASSERT_TRUE(std::isfinite(f));

@@ -445,8 +445,8 @@ TEST(SpanUnitModel, SerialEqualsDirectEvaluationOnGeneratorClasses) {
 
 TEST(SpanUnitModel, EveryModeEqualsSerialOnGeneratorTriangles) { checkModesAgainstSerial(22, 100000, true); }
 
-// A million triangles per mode, the cycle models only (slow label; the walkers are
-// checked on the 10^5 triangles above, in the release and the sanitizer run).
+// A million triangles per mode, the cycle models only (slow label, as the 10^5 above: the
+// walkers are checked there, and under the sanitizers by the walker tests below).
 TEST(SpanUnitModel, EveryModeEqualsSerialOnAMillionTriangles) { checkModesAgainstSerial(20261122, 1000000, false); }
 
 // Setup's descriptors never make a shown value wrap; other descriptors must still wrap in the

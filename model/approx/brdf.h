@@ -5,9 +5,9 @@
 // back-facing cosine (<= 0). n is the Phong/Blinn shininess exponent (n >= 0).
 #pragma once
 
-namespace shd {
+#include "scene/vec.h"  // kPi
 
-constexpr double kPi = 3.14159265358979323846;
+namespace shd {
 
 // Phong: max(0, R.V)^n.
 double phongLobe(double r_dot_v, double n);

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "scene/vec.h"  // kPi
+
 namespace shd {
 
 namespace {
-
-constexpr double kPiG = 3.14159265358979323846;
 
 // Random numbers from the raw 64-bit stream, so that a seed gives the same triangles with every
 // standard library (the std:: distributions are implementation-defined).
@@ -120,10 +120,10 @@ Tri sliverShape(std::mt19937_64& g, double area, double max_len) {
   if (r < 0.8) {
     double ang;
     if (r < 0.5) {
-      ang = uniform(g, 0, 2 * kPiG);
+      ang = uniform(g, 0, 2 * kPi);
     } else {
       const double eps = logUniform(g, 1e-6, 1e-2) * (chance(g, 0.5) ? 1 : -1);
-      const double base = (r < 0.65 ? 0.0 : 0.5 * kPiG) + (chance(g, 0.5) ? kPiG : 0.0);
+      const double base = (r < 0.65 ? 0.0 : 0.5 * kPi) + (chance(g, 0.5) ? kPi : 0.0);
       ang = base + eps;
     }
     const double c = std::cos(ang), s = std::sin(ang);
@@ -548,11 +548,11 @@ std::vector<GenTriangle> makeFanMesh(std::mt19937_64& g, const TriGenOptions& op
     throw std::invalid_argument("makeFanMesh: fan outside the guard box");
   const int winding = meshWinding(g, mopt.winding);
   const double scale = std::ldexp(1.0, opt.subpixel_bits);
-  const double step = 2 * kPiG / segments;
+  const double step = 2 * kPi / segments;
 
   // Ring angles phase + (k + e_k) step with |e_k| <= jitter; every angular gap must stay below
   // pi, i.e. step (1 + 2 jitter) < pi, which only binds for 3 segments.
-  const double jitter = std::min(mopt.jitter, 0.45 * (kPiG / step - 1));
+  const double jitter = std::min(mopt.jitter, 0.45 * (kPi / step - 1));
   GenVertex centre_v{};
   centre_v.x = cx;
   centre_v.y = cy;

@@ -40,10 +40,6 @@ namespace {
 constexpr uint64_t kImportMemoryBytes = uint64_t{4} << 30;
 constexpr int kImportSeconds = 120;
 
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
-  throw SceneError(fmt::format("{}: {}", path, what));
-}
-
 // A process's address space and resident memory in bytes (/proc/<pid>/statm, in pages); 0 if
 // it cannot be read.
 struct Memory {
@@ -173,7 +169,7 @@ std::string describeSignal(int sig) {
 }  // namespace
 
 Mesh loadMeshFile(const std::string& path) {
-  if (const std::string why = inputFileProblem(path, kMaxMeshFileBytes); !why.empty()) fail(path, why);
+  if (const std::string why = inputFileProblem(path, kMaxMeshFileBytes); !why.empty()) failMeshFile(path, why);
   noteInput(path);
   int fds[2];
   if (pipe(fds) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
@@ -212,7 +208,7 @@ Mesh loadMeshFile(const std::string& path) {
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   if (end == Wait::Deadline)
-    fail(path, fmt::format("the import took longer than {} s (the time limit of a mesh import)", kImportSeconds));
+    failMeshFile(path, fmt::format("the import took longer than {} s (the time limit of a mesh import)", kImportSeconds));
   if (end == Wait::Memory) msg = std::string(1, kMeshOutOfMemory);
   const bool no_result = msg.empty() || (msg[0] != kMeshOk && msg[0] != kMeshError && msg[0] != kMeshOutOfMemory);
   if (end == Wait::Closed && (WIFSIGNALED(status) || no_result)) {
@@ -222,14 +218,14 @@ Mesh loadMeshFile(const std::string& path) {
     if (said.find("out-of-memory") != std::string::npos || said.find("allocation-size-too-big") != std::string::npos)
       msg = std::string(1, kMeshOutOfMemory);
     else if (WIFSIGNALED(status))
-      fail(path, fmt::format("assimp crashed on it ({}{}; a malformed file)", describeSignal(WTERMSIG(status)),
+      failMeshFile(path, fmt::format("assimp crashed on it ({}{}; a malformed file)", describeSignal(WTERMSIG(status)),
                              said.empty() ? std::string() : ": " + said));
     else if (no_result)
-      fail(path, fmt::format("the import process ended without a result (exit status {}{})", WEXITSTATUS(status),
+      failMeshFile(path, fmt::format("the import process ended without a result (exit status {}{})", WEXITSTATUS(status),
                              said.empty() ? std::string() : ": " + said));
   }
   if (msg[0] == kMeshOutOfMemory)
-    fail(path, fmt::format("the import needs more than {} MB (the memory limit of a mesh import; a file that "
+    failMeshFile(path, fmt::format("the import needs more than {} MB (the memory limit of a mesh import; a file that "
                            "declares more elements than it holds?)",
                            kImportMemoryBytes >> 20));
   if (msg[0] == kMeshError) throw SceneError(msg.substr(1));
@@ -237,7 +233,7 @@ Mesh loadMeshFile(const std::string& path) {
   size_t at = 1;
   if (!readVector(msg, at, m.positions) || !readVector(msg, at, m.normals) || !readVector(msg, at, m.triangles) ||
       at != msg.size() || WEXITSTATUS(status) != 0)
-    fail(path, "the import process sent an incomplete mesh");
+    failMeshFile(path, "the import process sent an incomplete mesh");
   return m;
 }
 

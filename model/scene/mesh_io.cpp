@@ -22,11 +22,11 @@
 
 namespace shd {
 
-namespace {
-
-[[noreturn]] void fail(const std::string& path, const std::string& what) {
+void failMeshFile(const std::string& path, const std::string& what) {
   throw SceneError(fmt::format("{}: {}", path, what));
 }
+
+namespace {
 
 bool finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
@@ -52,7 +52,7 @@ void checkPlyHeader(const std::string& path) {
     while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
     if (line == "end_header") return;
   }
-  fail(path, "PLY header without end_header (truncated file)");
+  failMeshFile(path, "PLY header without end_header (truncated file)");
 }
 
 // Faces of the plain import that post-processing cannot take: no indices, or an index past
@@ -60,14 +60,14 @@ void checkPlyHeader(const std::string& path) {
 void checkFaces(const std::string& path, const aiScene* scene) {
   for (unsigned k = 0; k < scene->mNumMeshes; ++k) {
     const aiMesh* am = scene->mMeshes[k];
-    if (am->mNumVertices > 0 && am->mVertices == nullptr) fail(path, fmt::format("mesh {} has no positions", k));
+    if (am->mNumVertices > 0 && am->mVertices == nullptr) failMeshFile(path, fmt::format("mesh {} has no positions", k));
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
       const aiFace& face = am->mFaces[f];
       if (face.mNumIndices == 0 || face.mIndices == nullptr)
-        fail(path, fmt::format("mesh {} face {} has no vertex indices (truncated or malformed file)", k, f));
+        failMeshFile(path, fmt::format("mesh {} face {} has no vertex indices (truncated or malformed file)", k, f));
       for (unsigned i = 0; i < face.mNumIndices; ++i)
         if (face.mIndices[i] >= am->mNumVertices)
-          fail(path, fmt::format("mesh {} face {}: vertex index {} out of range (the mesh has {} "
+          failMeshFile(path, fmt::format("mesh {} face {}: vertex index {} out of range (the mesh has {} "
                                  "vertices; truncated or malformed file)",
                                  k, f, face.mIndices[i], am->mNumVertices));
     }
@@ -107,7 +107,7 @@ struct AssimpErrors {
 }  // namespace
 
 Mesh importMeshInProcess(const std::string& path) {
-  if (const std::string why = inputFileProblem(path, kMaxMeshFileBytes); !why.empty()) fail(path, why);
+  if (const std::string why = inputFileProblem(path, kMaxMeshFileBytes); !why.empty()) failMeshFile(path, why);
   checkPlyHeader(path);
 
   // Two stages: the plain import, a check of its faces, then the post-processing. Merging
@@ -124,7 +124,7 @@ Mesh importMeshInProcess(const std::string& path) {
     scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
     for (const std::string& m : log.messages)
       if (scene != nullptr && m.find("out of range") != std::string::npos)
-        fail(path, fmt::format("assimp reported an error: {}", m));
+        failMeshFile(path, fmt::format("assimp reported an error: {}", m));
     if (scene != nullptr) {
       checkFaces(path, scene);
       scene = importer.ApplyPostProcessing(kPostFlags);
@@ -132,11 +132,11 @@ Mesh importMeshInProcess(const std::string& path) {
   } catch (const SceneError&) {
     throw;
   } catch (const std::exception& e) {  // assimp reports through the error string; be safe
-    fail(path, fmt::format("assimp cannot read it: {}", e.what()));
+    failMeshFile(path, fmt::format("assimp cannot read it: {}", e.what()));
   }
-  if (scene == nullptr) fail(path, fmt::format("assimp cannot read it: {}", importer.GetErrorString()));
+  if (scene == nullptr) failMeshFile(path, fmt::format("assimp cannot read it: {}", importer.GetErrorString()));
   if ((scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) != 0 || scene->mNumMeshes == 0)
-    fail(path, "no triangles (the file has no meshes)");
+    failMeshFile(path, "no triangles (the file has no meshes)");
 
   // Merge: every mesh's vertices, then its triangles (points and lines are skipped), with
   // z mirrored from assimp's right-handed frame into shadesim's left-handed one (scene.h).
@@ -148,7 +148,7 @@ Mesh importMeshInProcess(const std::string& path) {
       const aiVector3D& p = am->mVertices[v];
       const Vec3 pos{p.x, p.y, -static_cast<double>(p.z)};
       if (!finite(pos))
-        fail(path, fmt::format("mesh {} vertex {}: position ({}, {}, {}) is not finite", k, v, p.x,
+        failMeshFile(path, fmt::format("mesh {} vertex {}: position ({}, {}, {}) is not finite", k, v, p.x,
                                p.y, p.z));
       raw.positions.push_back(pos);
       // NaN marks "none" (assimp leaves NaN for vertices of degenerate faces); fixed below.
@@ -167,7 +167,7 @@ Mesh importMeshInProcess(const std::string& path) {
       raw.triangles.push_back(t);
     }
   }
-  if (raw.triangles.empty()) fail(path, "no triangles (only points or lines)");
+  if (raw.triangles.empty()) failMeshFile(path, "no triangles (only points or lines)");
 
   // Drop the triangles without area and then the vertices no triangle uses: neither can ever
   // be drawn (a degenerate triangle projects to a segment), and afterwards every vertex has a
@@ -189,7 +189,7 @@ Mesh importMeshInProcess(const std::string& path) {
     }
     m.triangles.push_back(nt);
   }
-  if (m.triangles.empty()) fail(path, "no triangles with a non-zero area");
+  if (m.triangles.empty()) failMeshFile(path, "no triangles with a non-zero area");
 
   // Normals: the file's or assimp's smooth ones, normalised, checked against the faces. face_sum
   // is the area-weighted sum of the outward normals of a vertex's triangles (idx3d's vertex
@@ -216,7 +216,7 @@ Mesh importMeshInProcess(const std::string& path) {
     }
     const double flen = length(f);
     if (!(flen > 0.0) || !std::isfinite(flen))
-      fail(path, fmt::format("vertex at ({}, {}, {}) has a zero-length normal and its faces' "
+      failMeshFile(path, fmt::format("vertex at ({}, {}, {}) has a zero-length normal and its faces' "
                              "normals cancel",
                              m.positions[v].x, m.positions[v].y, -m.positions[v].z));
     m.normals[v] = (1.0 / flen) * f;

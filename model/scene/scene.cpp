@@ -26,8 +26,6 @@ namespace shd {
 
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
-
 // sin and cos of 2 pi k / n, exact where the angle is a multiple of 90 degrees (so a torus
 // has exact extreme points and symmetric rings, as idx3dSphere's poles and equator).
 void sinCosTurn(int k, int n, double& s, double& c) {
@@ -38,7 +36,7 @@ void sinCosTurn(int k, int n, double& s, double& c) {
     c = kC[4 * k / n];
     return;
   }
-  const double a = 2.0 * kPiD * k / n;
+  const double a = 2.0 * kPi * k / n;
   s = std::sin(a);
   c = std::cos(a);
 }
@@ -76,7 +74,7 @@ Mat4 Mat4::rotateDeg(Vec3 xyz) {
       c = kC[k];
       return;
     }
-    const double a = deg * kPiD / 180.0;
+    const double a = deg * kPi / 180.0;
     s = std::sin(a);
     c = std::cos(a);
   };

@@ -176,6 +176,8 @@ constexpr uint64_t kMaxMeshFileBytes = uint64_t{1} << 30;
 struct SceneError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+// Throws SceneError "<path>: <what>" (a mesh file's errors).
+[[noreturn]] void failMeshFile(const std::string& path, const std::string& what);
 
 // "builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials", a JSON scene file, or
 // a mesh file of any format assimp reads (e.g. teapots.DAE): then the mesh alone, with

@@ -8,8 +8,6 @@ namespace shd {
 
 namespace {
 
-constexpr double kPiD = 3.14159265358979323846;
-
 // Profile node i of idx3d's SPHERE path: (x, y) in the x-y plane, latitude pi (1/2 - i/(s-2)).
 // Evaluated from the nearer pole so that the two hemispheres mirror exactly, with the poles,
 // the duplicate south pole (i = s-1) and the equator (i = (s-2)/2) exact.
@@ -23,7 +21,7 @@ ProfileNode profileNode(double r, int s, int i) {
   if (2 * i == last) return {r, 0.0};           // equator (s even)
   const bool south = 2 * i > last;
   const int k = south ? last - i : i;           // steps from the nearer pole
-  const double theta = kPiD * k / last;         // angle from that pole
+  const double theta = kPi * k / last;         // angle from that pole
   const double y = r * std::cos(theta);
   return {r * std::sin(theta), south ? -y : y};
 }
@@ -43,7 +41,7 @@ Mesh idx3dSphere(double radius, int segments) {
   m.positions.reserve(static_cast<size_t>(idx3dSphereVertexCount(s)));
   for (int j = 0; j < columns; ++j) {
     const int jj = j % s;  // column s has column 0's positions exactly
-    const double beta = 2.0 * kPiD * jj / s;
+    const double beta = 2.0 * kPi * jj / s;
     const double cb = std::cos(beta), sb = std::sin(beta);
     for (int i = 0; i < nodes; ++i) {
       const ProfileNode p = profileNode(radius, s, i);

@@ -6,6 +6,8 @@
 
 namespace shd {
 
+constexpr double kPi = 3.14159265358979323846;
+
 struct Vec3 {
   double x, y, z;
 };
