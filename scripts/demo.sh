@@ -62,17 +62,18 @@ for j in rows:
 PY
 cat "$out/render/summary.txt"
 
-echo "== 7. report of builtin:sphere: every method, lobe and lane mode (out/report/, docs/report.md)"
-mkdir -p "$out/synth-cache"
-"$S" report --scene builtin:sphere --synth-cache "$out/synth-cache" --quiet -o "$out/report"
+echo "== 7. report of builtin:sphere: every method and lobe in lane mode serial, with area and place and route (out/report/, docs/report.md)"
+# Area (yosys) and place and route (nextpnr) of each unit, kept in out/hardware-cache/.
+"$S" report --scene builtin:sphere --modes serial --hardware-cache "$out/hardware-cache" --quiet -o "$out/report"
 python3 - "$out/report/report.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
 rows = [r for r in j["rows"] if r["mode"] == "serial" and r["lobe"] in ("blinn", "quadratic")]
-print(f"   {'method':<18} {'lobe':<10} {'max LSB':>8} {'RMSE':>7} {'cycles':>8} {'spec cyc':>9} {'model ms':>8}")
+us = lambda r: "-" if r.get("time_us", {}).get("up5k") is None else f"{r['time_us']['up5k']:.0f}"
+print(f"   {'method':<18} {'lobe':<10} {'max LSB':>8} {'RMSE':>7} {'cycles':>8} {'spec cyc':>9} {'UP5K us':>8} {'model ms':>8}")
 for r in rows:
     print(f"   {r['method']:<18} {r['lobe']:<10} {r['metrics']['max_abs_lsb']:>8.2f} {r['metrics']['rmse_lsb']:>7.3f} "
-          f"{r['counts']['cycles']:>8} {r['counts']['spec_cycles']:>9} {r['ms']:>8.2f}")
+          f"{r['counts']['cycles']:>8} {r['counts']['spec_cycles']:>9} {us(r):>8} {r['ms']:>8.2f}")
 PY
 
 echo "== results in $out"

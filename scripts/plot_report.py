@@ -10,7 +10,11 @@ data it plots beside it (the same text is also stored in the PNG, in a tEXt chun
                             front of each panel (least cycles, least error) ringed and joined;
                             each point labelled method/lobe, coloured by lane mode, a triangle
                             where the specular unit evaluates the lobe (quadratic, cubic).
-  error_vs_area.png/.csv    when the report has area (shadesim report --synth-cache): max abs
+  error_vs_time.png/.csv    when the report has place and route: max abs LSB against the time
+                            per frame in microseconds at the units' fmax, one panel per iCE40
+                            device where some row has a time, the front of each marked; a row
+                            whose units do not fit a device has an empty cell there.
+  error_vs_area.png/.csv    when the report has area (shadesim report without --no-hardware): max abs
                             LSB against the LUTs of the row's units (span + specular) per target,
                             one panel per target, the front of each marked.
 
@@ -85,6 +89,21 @@ def area_data(report, targets):
     return header, table
 
 
+def time_data(report, devices):
+    rows = [r for r in report["rows"] if any((r.get("time_us") or {}).get(d) is not None for d in devices)]
+    fronts = {}
+    for d in devices:
+        idx = [i for i, r in enumerate(rows) if r["time_us"][d] is not None]
+        fronts[d] = {idx[k] for k in pareto([(rows[i]["time_us"][d], rows[i]["metrics"]["max_abs_lsb"]) for i in idx])}
+    cell = lambda v: "" if v is None else repr(v)
+    table = [[label(r), r["method"], r["lobe"], r["mode"], uses_spec(r), *[cell(r["time_us"][d]) for d in devices],
+              repr(r["metrics"]["max_abs_lsb"]), *[int(i in fronts[d]) for d in devices]]
+             for i, r in enumerate(rows)]
+    header = ["label", "method", "lobe", "mode", "spec_unit", *[f"{d}_us" for d in devices], "max_abs_lsb",
+              *[f"front_{d}" for d in devices]]
+    return header, table
+
+
 MARKERS = {0: ("o", "exact lobe (no specular unit)"), 1: ("^", "device lobe (specular unit)")}
 
 
@@ -139,6 +158,34 @@ def plot_cycles(plt, report, outdir, colours):
     return ["error_vs_cycles.png", "error_vs_cycles.csv"]
 
 
+def plot_time(plt, report, outdir, colours):
+    devices = [d["name"] for d in report.get("options", {}).get("pnr_devices") or []]
+    header, table = time_data(report, devices)
+    devices = [d for k, d in enumerate(devices) if any(r[5 + k] != "" for r in table)]
+    if not table:
+        return []
+    data = csv_text(header, table)
+    names = [d["name"] for d in report["options"]["pnr_devices"]]
+    fig, axes = plt.subplots(1, len(devices), figsize=(8 * len(devices), 8), squeeze=False)
+    for k, d in enumerate(devices):
+        col = 5 + names.index(d)
+        idx = [i for i, r in enumerate(table) if r[col] != ""]
+        sub = [table[i] for i in idx]
+        xs = [float(r[col]) for r in sub]
+        ys = [float(r[5 + len(names)]) for r in sub]
+        front = [j for j, r in enumerate(sub) if r[6 + len(names) + names.index(d)] == 1]
+        title = next(e["title"] for e in report["options"]["pnr_devices"] if e["name"] == d)
+        panel(axes[0][k], xs, ys, sub, front, f"time per frame on the {title} (µs, units at their fmax)",
+              "max abs error (LSB)", colours)
+    fig.suptitle(f"{report['scene']['name']}: error against hardware time per frame (each point method/lobe)")
+    fig.tight_layout()
+    save(fig, os.path.join(outdir, "error_vs_time.png"), data)
+    plt.close(fig)
+    with open(os.path.join(outdir, "error_vs_time.csv"), "w") as f:
+        f.write(data)
+    return ["error_vs_time.png", "error_vs_time.csv"]
+
+
 def plot_area(plt, report, outdir, colours):
     targets = report.get("options", {}).get("synth_targets") or []
     header, table = area_data(report, targets)
@@ -184,7 +231,8 @@ def main():
         fail(f"matplotlib is missing ({e}); Debian: apt-get install python3-matplotlib")
     cmap = plt.get_cmap("tab10")
     colours = {m: cmap(i % 10) for i, m in enumerate(report["options"]["modes"])}
-    written = plot_cycles(plt, report, outdir, colours) + plot_area(plt, report, outdir, colours)
+    written = (plot_cycles(plt, report, outdir, colours) + plot_time(plt, report, outdir, colours)
+               + plot_area(plt, report, outdir, colours))
     for w in written:
         print(os.path.join(outdir, w))
     return 0

@@ -107,6 +107,8 @@ LOBE_COLUMNS = {
 for t, name in (("ice40", "iCE40"), ("xc7", "xc7")):
     LOBE_COLUMNS[f"{name} LUT"] = (("area", t, "luts"), 0, 1, False)
     LOBE_COLUMNS[f"{name} DSP"] = (("area", t, "dsps"), 0, 1, False)
+for d, name in (("up5k", "UP5K"), ("hx8k", "HX8K")):
+    LOBE_COLUMNS[f"{name} µs"] = (("time_us", d), 1, 1, False)
 
 
 def tables(md):
@@ -175,6 +177,21 @@ def check_units_table(report, header, body):
         check(cells[2:] == want, f"report.md units {unit} {name}: {cells[2:]} != {want}")
 
 
+def check_pnr_table(report, body):
+    titles = {"UP5K": "up5k", "HX8K": "hx8k"}
+    want = 0
+    for cells in body:
+        unit, name, dev = cells[0], cells[1].strip("`"), titles[cells[2]]
+        p = report["units"][unit][name]["pnr"][dev]
+        used = [f"{p[f]} / {p[f + '_total']}" for f in ("luts", "dsps", "brams")]
+        result = "fmax " + p["fmax_kind"] if p["fits"] else p["why_not"]
+        exp = [f"`{p['flow']}`", fmt(p["fmax_mhz"], 2)] + used + [result]
+        check(cells[3:] == exp, f"report.md place and route {unit} {name} {dev}: {cells[3:]} != {exp}")
+    for unit in ("span", "spec"):
+        want += sum(len(u.get("pnr", {})) for u in report["units"][unit].values())
+    check(len(body) == want, f"report.md place and route: {len(body)} lines for {want} unit placements")
+
+
 def check_markdown(d, report):
     md = open(os.path.join(d, "report.md"), encoding="utf-8").read()
     sheet = report["contact_sheet"]
@@ -185,6 +202,8 @@ def check_markdown(d, report):
             seen += 1
         elif heading == "Units":
             check_units_table(report, header, body)
+        elif heading == "Place and route":
+            check_pnr_table(report, body)
         elif heading == "Contact sheet":
             key = "rows" if header[1] == "lobe" else "columns"
             prefix = "row" if key == "rows" else "column"
@@ -221,9 +240,11 @@ def check_csv(d, report):
                 v = r["metrics"][k]
             elif k.startswith("rtl_"):
                 v = r["rtl"][k[4:]]
+            elif k.startswith("time_us_"):
+                v = get(r, ("time_us", k[len("time_us_"):]))
             elif re.match(r"^(ice40|xc7)_", k):
                 t, f = k.split("_", 1)
-                v = r["area"][t][f]
+                v = get(r, ("area", t, f))
             else:
                 v = r[k]
             check(same_number(text, v), f"report.csv {r['method']}/{r['lobe']}/{r['mode']} {k}: {text!r} != {v!r}")
@@ -262,6 +283,26 @@ def check_plots(d, report):
         for k in ("max_abs_lsb", "rmse_lsb"):
             check(float(g[k]) == r["metrics"][k], f"error_vs_cycles.csv point {i} {k}: {g[k]} != {r['metrics'][k]}")
     check(any(fronts["max_abs_lsb"]), "no Pareto front")
+    check_time_plot(d, report)
+
+
+def check_time_plot(d, report):
+    """error_vs_time.csv from report.json: a point per row with a time on some device, its
+    fronts computed here; made exactly when some row has a time."""
+    devices = [e["name"] for e in report["options"].get("pnr_devices") or []]
+    rows = [r for r in report["rows"] if any((r.get("time_us") or {}).get(dv) is not None for dv in devices)]
+    made = "error_vs_time.csv" in report["plots"]["files"]
+    check(made == bool(rows), f"error_vs_time: made {made}, {len(rows)} rows with a time")
+    if not made:
+        return
+    got = list(csv.DictReader(open(os.path.join(d, "error_vs_time.csv"))))
+    check(len(got) == len(rows), f"error_vs_time.csv: {len(got)} points for {len(rows)} rows with a time")
+    for dv in devices:
+        idx = [i for i, r in enumerate(rows) if r["time_us"][dv] is not None]
+        front = {idx[k] for k in pareto([(rows[i]["time_us"][dv], rows[i]["metrics"]["max_abs_lsb"]) for i in idx])}
+        for i, (g, r) in enumerate(zip(got, rows)):
+            check(same_number(g[f"{dv}_us"], r["time_us"][dv]), f"error_vs_time.csv point {i} {dv}_us: {g[f'{dv}_us']!r}")
+            check(g[f"front_{dv}"] == str(int(i in front)), f"error_vs_time.csv point {i} front_{dv}")
 
 
 # --- images and sample rows ------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <stdexcept>
 #include <vector>
 
@@ -31,7 +32,9 @@ std::string run(const std::vector<std::string>& argv, const std::string& what) {
   if (rc == 0) return out;
   std::string said = out + err;
   if (said.size() > 600) said = "..." + said.substr(said.size() - 600);
-  throw std::runtime_error(fmt::format("{} failed ({}):\n{}", what, rc < 0 ? error : fmt::format("exit {}", rc), said));
+  while (!said.empty() && (said.back() == '\n' || said.back() == '\r')) said.pop_back();
+  throw std::runtime_error(fmt::format("{} failed ({}){}{}", what, rc < 0 ? error : fmt::format("exit {}", rc),
+                                       said.empty() ? "" : ":\n", said));
 }
 
 // The figures of one target from synth.py's summary (no timings: a cached result is the same on
@@ -66,7 +69,7 @@ class PrivateDir {
 }  // namespace
 
 std::string synthToolVersion(const std::string& script) {
-  std::string v = run({"yosys", "-V"}, "--area: yosys -V");
+  std::string v = run({"yosys", "-V"}, "yosys -V");
   while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
   // The flow and the RTL it synthesises (rtl/ beside scripts/).
   std::string sources = readInputFile(script, kMaxAreaFileBytes);
@@ -94,24 +97,33 @@ std::string findShareFile(const std::string& relative) {
   return "";
 }
 
-nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
-                             const nlohmann::json& prom_desc, const SynthTool& tool) {
-  const std::string key = textHash(fmt::format("{} {} {} {} {}", unit, rtl.dump(), tool.targets, tool.version, prom));
-  const fs::path cached = fs::path(tool.cache_dir) / fmt::format("{}-{}.json", unit, key);
+namespace {
+
+// A unit configuration's figures by one of the scripts (synth.py, pnr.py), cached in cache_dir as
+// <stem>-<key>.json {"key", "tools", "rtl", member: figures}, key a hash of the unit, its
+// parameters, the PROM, `tools` and `what`. Otherwise `produce(argv, tmp)` computes them, argv
+// being "python3 <script> <configuration file> --unit <unit> [--prom <file>]" in a private
+// directory `tmp` of the cache (removed after).
+nlohmann::json cachedUnitRun(const std::string& stem, const std::string& member, const std::string& unit,
+                             const nlohmann::json& rtl, const std::string& prom, const nlohmann::json& prom_desc,
+                             const std::string& script, const std::string& cache_dir, const std::string& tools,
+                             const std::string& what,
+                             const std::function<nlohmann::json(std::vector<std::string>, const fs::path&)>& produce) {
+  const std::string key = textHash(fmt::format("{} {} {} {} {}", unit, rtl.dump(), what, tools, prom));
+  const fs::path cached = fs::path(cache_dir) / fmt::format("{}-{}.json", stem, key);
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
     try {
-      return parseJsonStrict(readInputFile(cached.string(), kMaxAreaFileBytes)).at("area");
+      return parseJsonStrict(readInputFile(cached.string(), kMaxAreaFileBytes)).at(member);
     } catch (const std::exception& e) {
-      throw std::runtime_error(fmt::format("{}: not a cached area ({}); remove it", cached.string(), e.what()));
+      throw std::runtime_error(fmt::format("{}: not a cached {} ({}); remove it", cached.string(), member, e.what()));
     }
   }
-  // A private directory in the cache for the inputs and yosys's output.
-  const PrivateDir dir(tool.cache_dir, fmt::format("{}-{}", unit, key));
+  const PrivateDir dir(cache_dir, fmt::format("{}-{}", stem, key));
   const fs::path& tmp = dir.path();
   nlohmann::json cfg = {{"name", "sweep"}, {"description", "a point of a shadesim sweep"}, {"rtl", rtl}};
   const std::string cfg_file = (tmp / (unit + "_sweep.json")).string();
-  std::vector<std::string> argv = {"python3", tool.script, cfg_file, "--unit", unit};
+  std::vector<std::string> argv = {"python3", script, cfg_file, "--unit", unit};
   if (unit == "spec") {
     cfg["prom"] = prom_desc;
     const std::string hex = (tmp / "spec_sweep.hex").string();
@@ -119,15 +131,80 @@ nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl,
     argv.insert(argv.end(), {"--prom", hex});
   }
   writeFileAtomic(cfg_file, cfg.dump(2) + "\n");
-  argv.insert(argv.end(), {"--out", (tmp / "out").string(), "--target", tool.targets});
-  run(argv, fmt::format("synthesis of point {} ({})", key, tool.script));
-  const nlohmann::json summary =
-      parseJsonStrict(readInputFile((tmp / "out" / "summary.json").string(), kMaxAreaFileBytes));
-  nlohmann::json area = nlohmann::json::object();
-  for (const auto& item : summary.at("targets").items()) area[item.key()] = targetFigures(item.value());
+  nlohmann::json figures;
+  try {
+    figures = produce(std::move(argv), tmp);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error(fmt::format("configuration {}: {}", key, e.what()));
+  }
   writeFileAtomic(cached.string(),
-                  nlohmann::json{{"key", key}, {"tools", tool.version}, {"rtl", rtl}, {"area", area}}.dump(1) + "\n");
-  return area;
+                  nlohmann::json{{"key", key}, {"tools", tools}, {"rtl", rtl}, {member, figures}}.dump(1) + "\n");
+  return figures;
+}
+
+// The figures of one device from pnr.py's summary (no timings, as targetFigures).
+nlohmann::json deviceFigures(const nlohmann::json& d, const std::string& flow) {
+  nlohmann::json r = {{"flow", flow},           {"fits", d.at("fits")},     {"fmax_mhz", d.at("fmax_mhz")},
+                      {"luts", d.at("luts")},   {"luts_total", d.at("luts_total")}, {"dsps", d.at("dsps")},
+                      {"dsps_total", d.at("dsps_total")}, {"brams", d.at("brams")},
+                      {"brams_total", d.at("brams_total")}, {"util_percent", d.at("util_percent")},
+                      {"seed", d.at("seed")}};
+  r["fmax_kind"] = d.value("fmax_kind", nlohmann::json());
+  r["why_not"] = d.value("why_not", nlohmann::json());
+  return r;
+}
+
+}  // namespace
+
+nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+                             const nlohmann::json& prom_desc, const SynthTool& tool) {
+  // The stem and key as before the place and route was added: existing caches stay valid.
+  return cachedUnitRun(unit, "area", unit, rtl, prom, prom_desc, tool.script, tool.cache_dir, tool.version,
+                       tool.targets, [&](std::vector<std::string> argv, const fs::path& tmp) {
+                         argv.insert(argv.end(), {"--out", (tmp / "out").string(), "--target", tool.targets});
+                         run(argv, fmt::format("synthesis of {} ({})", unit, tool.script));
+                         const nlohmann::json summary = parseJsonStrict(
+                             readInputFile((tmp / "out" / "summary.json").string(), kMaxAreaFileBytes));
+                         nlohmann::json area = nlohmann::json::object();
+                         for (const auto& item : summary.at("targets").items())
+                           area[item.key()] = targetFigures(item.value());
+                         return area;
+                       });
+}
+
+std::string pnrToolVersion(const std::string& script) {
+  std::string out, err, error;
+  if (runProcess({"nextpnr-ice40", "--version"}, out, err, error) != 0)
+    throw std::runtime_error(fmt::format("nextpnr-ice40 --version failed{}{} (apt-get install nextpnr-ice40)",
+                                         error.empty() ? "" : ": ", error));
+  std::string v = out + err;
+  while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
+  const std::string synth = (fs::path(script).parent_path() / "synth.py").string();
+  return synthToolVersion(synth) + " " + v + " pnr " + textHash(readInputFile(script, kMaxAreaFileBytes));
+}
+
+nlohmann::json unitPointPnr(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+                            const nlohmann::json& prom_desc, const PnrTool& tool) {
+  return cachedUnitRun(
+      unit + "-pnr", "pnr", unit, rtl, prom, prom_desc, tool.script, tool.cache_dir, tool.version, "up5k hx8k-nodsp",
+      [&](const std::vector<std::string>& argv, const fs::path& tmp) {
+        nlohmann::json devices = nlohmann::json::object();
+        for (const PnrDevice& d : pnrDevices()) {
+          std::vector<std::string> a = argv;
+          a.insert(a.end(), {"--device", d.name, "--out", (tmp / d.name).string()});
+          if (!d.dsps) a.push_back("--no-dsp");
+          run(a, fmt::format("place and route of {} on the {} ({})", unit, d.name, tool.script));
+          const nlohmann::json summary =
+              parseJsonStrict(readInputFile((tmp / d.name / "summary.json").string(), kMaxAreaFileBytes));
+          devices[d.name] = deviceFigures(summary.at("devices").at(d.name), summary.at("flow").get<std::string>());
+        }
+        return devices;
+      });
+}
+
+const std::vector<PnrDevice>& pnrDevices() {
+  static const std::vector<PnrDevice> devices = {{"up5k", "iCE40UP5K", true}, {"hx8k", "iCE40HX8K", false}};
+  return devices;
 }
 
 std::vector<std::string> dspClasses(const std::string& unit, const std::vector<nlohmann::json>& rtl,
@@ -149,10 +226,18 @@ std::vector<std::string> dspClasses(const std::string& unit, const std::vector<n
   return classes;
 }
 
+namespace {
+nlohmann::json promDesc(const PromTable& table) {
+  return {{"fit", toString(table.request.fit)}, {"level", table.request.level}, {"n", table.request.n.text}};
+}
+}  // namespace
+
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
-  return unitPointArea("spec", table.unit.toJson(), renderProm(table, PromFormat::Hex),
-                       {{"fit", toString(table.request.fit)}, {"level", table.request.level}, {"n", table.request.n.text}},
-                       tool);
+  return unitPointArea("spec", table.unit.toJson(), renderProm(table, PromFormat::Hex), promDesc(table), tool);
+}
+
+nlohmann::json specPointPnr(const PromTable& table, const PnrTool& tool) {
+  return unitPointPnr("spec", table.unit.toJson(), renderProm(table, PromFormat::Hex), promDesc(table), tool);
 }
 
 }  // namespace shd

@@ -1,11 +1,17 @@
 // shadesim report: what each shading choice costs and buys on one scene. Every method with every
 // lobe that applies, in every lane mode asked: the error against the double-precision reference,
 // the model's time per frame, the span and specular units' cycles per frame (with --rtl checked
-// on the verilated units), with --synth-cache the yosys area of the units each row uses; written
-// as report.json, report.csv, report.md, the images, a contact sheet and the plots of
+// on the verilated units), the yosys area of the units each row uses and, from their place and
+// route on iCE40 (scripts/pnr.py), the time per frame at the clock each unit reaches; written as
+// report.json, report.csv, report.md, the images, a contact sheet and the plots of
 // scripts/plot_report.py into one directory (docs/report.md).
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <memory>
+#include <thread>
+#include <cstdlib>
+#include <functional>
 #include <filesystem>
 #include <map>
 #include <optional>
@@ -32,8 +38,19 @@ namespace {
 
 // The files of a report besides the images and the plots.
 const std::vector<std::string> kReportFiles = {"report.json", "report.csv", "report.md", "contact_sheet.png"};
-const std::vector<std::string> kPlotFiles = {"error_vs_cycles.png", "error_vs_cycles.csv", "error_vs_area.png",
-                                             "error_vs_area.csv"};
+
+// The tools of the hardware figures (area by yosys, fmax by nextpnr) and why a figure is absent.
+struct Hardware {
+  std::optional<SynthTool> synth;
+  std::optional<PnrTool> pnr;
+  std::string cache;
+  json absent = json::array();  // [{"figures", "why"}]: a tool missing or a run failed
+  bool failed = false;          // a figure is absent for a reason other than --no-hardware
+  void absentBecause(const std::string& figures, const std::string& why, bool failure) {
+    absent.push_back({{"figures", figures}, {"why", why}});
+    failed = failed || failure;
+  }
+};
 
 class ReportCmd final : public Command {
  public:
@@ -41,10 +58,10 @@ class ReportCmd final : public Command {
   int run(const CLI::App& app) override;
 
  private:
-  std::string scene_ = "builtin:sphere", dir_, synth_cache_;
+  std::string scene_ = "builtin:sphere", dir_, hardware_cache_;
   std::vector<std::string> modes_;
   size_t bench_ = 5;
-  bool rtl_ = false, quiet_ = false;
+  bool rtl_ = false, quiet_ = false, no_hardware_ = false;
   double heat_scale_ = 8, highlight_lsb_ = 32;
 
   void say(const std::string& m) const {
@@ -58,12 +75,15 @@ class ReportCmd final : public Command {
   // -o: an existing directory whose report files may be replaced, or a new one in an existing
   // directory (made only when the report is written). ArgError otherwise.
   void checkOutputDir() const;
+  // --hardware-cache: an existing directory or a new one whose parent exists. ArgError otherwise.
+  void checkHardwareCache() const;
   std::vector<SpanUnitConfig> modeConfigs() const;
   void requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const;
+  Hardware hardwareTools() const;
   json unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
-                 const SynthTool* synth) const;
+                 Hardware& hw) const;
   json reportJson(const Scene& sc, const std::vector<SpanUnitConfig>& modes, const Measured& m, json units,
-                  bool with_area) const;
+                  const Hardware& hw) const;
   void write(const Measured& m, json report, const fs::path& tmp) const;
 };
 
@@ -80,9 +100,12 @@ void ReportCmd::add(CLI::App& app) {
       ->default_val(bench_);
   app.add_flag("--rtl", rtl_, "also render every row with the verilated span and specular units: images and cycles "
                               "must be equal");
-  app.add_option("--synth-cache", synth_cache_,
-                 "an existing directory of synthesised areas (shared with sweep): the yosys area (iCE40, xc7) of each "
-                 "unit configuration, synthesised once");
+  app.add_option("--hardware-cache", hardware_cache_,
+                 "the directory (made if missing; its parent must exist) where each unit configuration's yosys area "
+                 "and nextpnr place and route are kept, computed once (shared with sweep --synth-cache); default "
+                 "$XDG_CACHE_HOME/shadesim or ~/.cache/shadesim");
+  app.add_flag("--no-hardware", no_hardware_, "no area and no place and route: the report without yosys and nextpnr")
+      ->excludes("--hardware-cache");
   app.add_option("--heat-scale", heat_scale_, "error (LSB) shown white in the heat maps")
       ->check(realIn(0, 255, Ends::OpenLow))
       ->default_val(heat_scale_);
@@ -90,6 +113,17 @@ void ReportCmd::add(CLI::App& app) {
       ->check(realIn(0, 255))
       ->default_val(highlight_lsb_);
   app.add_flag("--quiet", quiet_, "no progress on stderr");
+}
+
+void ReportCmd::checkHardwareCache() const {
+  std::error_code ec;
+  const fs::path parent = fs::path(hardware_cache_).parent_path();
+  if (!hardware_cache_.empty() && !fs::is_directory(hardware_cache_, ec) && !parent.empty() &&
+      !fs::is_directory(parent, ec))
+    throw ArgError(fmt::format("--hardware-cache {}: no such directory, and its parent {} is none either",
+                               hardware_cache_, parent.string()));
+  if (fs::exists(hardware_cache_, ec) && !fs::is_directory(hardware_cache_, ec))
+    throw ArgError(fmt::format("--hardware-cache {}: not a directory", hardware_cache_));
 }
 
 void ReportCmd::checkOutputDir() const {
@@ -146,41 +180,134 @@ void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeC
   }
 }
 
-// Per unit configuration its parameters and, with synth, its area (synthesised once, cached).
-json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
-                          const SynthTool* synth) const {
-  json units = {{"span", json::object()}, {"spec", json::object()}};
-  for (const SpanUnitConfig& c : modes) {
-    json u = {{"description", c.description}, {"rtl", c.rtl.toJson()}, {"lanes", c.rtl.lanes()}};
-    if (synth) {
-      say(fmt::format("area of span configuration {} (yosys, or the cache)", c.name));
-      u["area"] = unitPointArea("span", c.rtl.toJson(), "", json::object(), *synth);
+// The hardware tools, or why there are none: --no-hardware, a cache directory that cannot be
+// made, yosys or nextpnr missing. Only a bad --hardware-cache is an argument error.
+Hardware ReportCmd::hardwareTools() const {
+  Hardware hw;
+  if (no_hardware_) {
+    hw.absentBecause("area, fmax, time", "not measured: --no-hardware", false);
+    return hw;
+  }
+  std::error_code ec;
+  if (!hardware_cache_.empty()) {
+    hw.cache = hardware_cache_;
+  } else {
+    const char* xdg = std::getenv("XDG_CACHE_HOME");
+    const char* home = std::getenv("HOME");
+    if (xdg && *xdg)
+      hw.cache = (fs::path(xdg) / "shadesim").string();
+    else if (home && *home)
+      hw.cache = (fs::path(home) / ".cache" / "shadesim").string();
+  }
+  if (hw.cache.empty()) {
+    hw.absentBecause("area, fmax, time", "no cache directory: give --hardware-cache DIR (neither XDG_CACHE_HOME nor HOME is set)", true);
+    return hw;
+  }
+  if (!fs::is_directory(hw.cache, ec)) fs::create_directories(hw.cache, ec);
+  if (!fs::is_directory(hw.cache, ec)) {
+    hw.absentBecause("area, fmax, time", fmt::format("cannot make the cache directory {}: {}", hw.cache, ec.message()), true);
+    return hw;
+  }
+  const std::string synth = findShareFile("scripts/synth.py"), pnr = findShareFile("scripts/pnr.py");
+  try {
+    if (synth.empty()) throw std::runtime_error("scripts/synth.py is neither in this installation nor in the source tree");
+    hw.synth = SynthTool{synth, hw.cache, "both", synthToolVersion(synth)};
+  } catch (const std::exception& e) {
+    hw.absentBecause("area", fmt::format("yosys: {}", e.what()), true);
+  }
+  try {
+    if (pnr.empty()) throw std::runtime_error("scripts/pnr.py is neither in this installation nor in the source tree");
+    hw.pnr = PnrTool{pnr, hw.cache, pnrToolVersion(pnr)};
+  } catch (const std::exception& e) {
+    hw.absentBecause("fmax, time", fmt::format("place and route: {}", e.what()), true);
+  }
+  return hw;
+}
+
+// One hardware figure of one unit configuration: `member` ("area" or "pnr") of units[unit][name].
+struct HardwareJob {
+  std::string unit, name, member, what;
+  std::function<json()> run;
+};
+
+// The jobs on as many threads as the machine has cores (each job runs yosys or nextpnr in
+// processes of its own); their figures into `units`, in job order, and a failed job's reason into
+// hw.absent, in job order too, so the report does not depend on which job ended first.
+void runHardwareJobs(const std::vector<HardwareJob>& jobs, json& units, Hardware& hw,
+                     const std::function<void(const std::string&)>& say) {
+  std::vector<json> figures(jobs.size());
+  std::vector<std::string> errors(jobs.size());
+  std::atomic<size_t> next{0};
+  auto worker = [&] {
+    for (size_t i; (i = next++) < jobs.size();) {
+      say(fmt::format("{} (or the cache)", jobs[i].what));
+      try {
+        figures[i] = jobs[i].run();
+      } catch (const std::exception& e) {
+        errors[i] = e.what();
+      }
     }
-    units["span"][c.name] = u;
+  };
+  std::vector<std::thread> threads(std::min<size_t>(jobs.size(), std::max(1u, std::thread::hardware_concurrency())));
+  for (std::thread& t : threads) t = std::thread(worker);
+  for (std::thread& t : threads) t.join();
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    if (errors[i].empty())
+      units[jobs[i].unit][jobs[i].name][jobs[i].member] = figures[i];
+    else
+      hw.absentBecause(jobs[i].member, fmt::format("{}: {}", jobs[i].what, errors[i]), true);
+  }
+}
+
+// Per unit configuration its parameters and, with the tools, its area and place and route (each
+// computed once, cached). A failed run leaves that figure out and says why.
+json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
+                          Hardware& hw) const {
+  json units = {{"span", json::object()}, {"spec", json::object()}};
+  std::vector<HardwareJob> jobs, area_jobs;  // the place and route first: the longest jobs
+  for (const SpanUnitConfig& c : modes) {
+    units["span"][c.name] = {{"description", c.description}, {"rtl", c.rtl.toJson()}, {"lanes", c.rtl.lanes()}};
+    const std::string what = fmt::format("span configuration {}", c.name);
+    const json rtl = c.rtl.toJson();
+    if (hw.synth)
+      area_jobs.push_back({"span", c.name, "area", "area of " + what,
+                      [rtl, t = *hw.synth] { return unitPointArea("span", rtl, "", json::object(), t); }});
+    if (hw.pnr)
+      jobs.push_back({"span", c.name, "pnr", "place and route of " + what,
+                      [rtl, t = *hw.pnr] { return unitPointPnr("span", rtl, "", json::object(), t); }});
   }
   for (const std::string& name : m.spec_configs) {
     const Lobe l = name == lobes.cubic ? Lobe::Cubic : Lobe::Quadratic;
     const SpecUnitConfig c = lobes.load(l);
-    json u = {{"description", c.description},
-              {"rtl", c.rtl.toJson()},
-              {"degree", c.rtl.Degree},
-              {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}}};
-    if (synth) {
-      say(fmt::format("area of specular configuration {} (yosys, or the cache)", c.name));
-      u["area"] = specPointArea(buildPromTable(PromRequest::fromContent(c.prom), c.rtl), *synth);
-    }
-    units["spec"][c.name] = u;
+    units["spec"][c.name] = {{"description", c.description},
+                             {"rtl", c.rtl.toJson()},
+                             {"degree", c.rtl.Degree},
+                             {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}}};
+    const std::string what = fmt::format("specular configuration {}", c.name);
+    const auto table = std::make_shared<const PromTable>(buildPromTable(PromRequest::fromContent(c.prom), c.rtl));
+    if (hw.synth)
+      area_jobs.push_back({"spec", c.name, "area", "area of " + what, [table, t = *hw.synth] { return specPointArea(*table, t); }});
+    if (hw.pnr)
+      jobs.push_back({"spec", c.name, "pnr", "place and route of " + what,
+                      [table, t = *hw.pnr] { return specPointPnr(*table, t); }});
   }
+  jobs.insert(jobs.end(), area_jobs.begin(), area_jobs.end());
+  runHardwareJobs(jobs, units, hw, [this](const std::string& s) { say(s); });
   return units;
 }
 
 // A row's area: per target, each figure summed over the span configuration and the specular
-// configurations it uses. The exact methods (no span cycles) have none.
+// configurations it uses. The exact methods (no span cycles) have none, nor a row whose units
+// lack one.
 json rowArea(const json& row, const json& units) {
   if (row["span_cycles"].is_null()) return json();
-  json sum = units["span"][row["span_config"].get<std::string>()]["area"];
+  const json& span = units["span"][row["span_config"].get<std::string>()];
+  if (!span.contains("area")) return json();
+  json sum = span["area"];
   for (const json& s : row["spec_configs"]) {
-    const json& spec = units["spec"][s.get<std::string>()]["area"];
+    const json& unit = units["spec"][s.get<std::string>()];
+    if (!unit.contains("area")) return json();
+    const json& spec = unit["area"];
     for (auto& [target, figures] : sum.items())
       for (auto& [k, v] : figures.items()) {
         const json& w = spec[target][k];
@@ -191,8 +318,36 @@ json rowArea(const json& row, const json& units) {
   return sum;
 }
 
+// A row's time per frame in microseconds on each device of pnrDevices(): the span unit's cycles
+// at its fmax plus the specular unit's cycles at the least fmax of the configurations it uses
+// (each unit placed alone at its own clock; not overlapped, as total_cycles). null where the row
+// has no cycles, a unit was not placed, or one does not fit the device.
+json rowTime(const json& row, const json& units) {
+  if (row["span_cycles"].is_null()) return json();
+  json t = json::object();
+  for (const PnrDevice& d : pnrDevices()) {
+    auto fmax = [&](const json& u) -> double {
+      const json& f = u.contains("pnr") ? u["pnr"][d.name]["fmax_mhz"] : json();
+      return f.is_number() ? f.get<double>() : 0.0;
+    };
+    const double span = fmax(units["span"][row["span_config"].get<std::string>()]);
+    bool placed = span > 0;
+    double spec = 0;  // the least fmax of the specular configurations
+    for (const json& s : row["spec_configs"]) {
+      const double f = fmax(units["spec"][s.get<std::string>()]);
+      placed = placed && f > 0;
+      spec = spec == 0 ? f : std::min(spec, f);
+    }
+    double us = placed ? row["span_cycles"].get<double>() / span : 0;
+    if (placed && spec > 0) us += row["spec_cycles"].get<double>() / spec;
+    t[d.name] = placed ? json(us) : json();
+  }
+  return t;
+}
+
 json ReportCmd::reportJson(const Scene& sc, const std::vector<SpanUnitConfig>& modes, const Measured& m, json units,
-                           bool with_area) const {
+                           const Hardware& hw) const {
+  const bool with_area = hw.synth.has_value(), with_pnr = hw.pnr.has_value();
   uint64_t triangles = 0;
   for (const SceneObject& o : sc.objects) triangles += o.mesh.triangles.size();
   std::vector<std::string> mode_names, lobe_names, method_names;
@@ -202,6 +357,11 @@ json ReportCmd::reportJson(const Scene& sc, const std::vector<SpanUnitConfig>& m
   json rows = m.rows;
   if (with_area)
     for (json& r : rows) r["area"] = rowArea(r, units);
+  if (with_pnr)
+    for (json& r : rows) r["time_us"] = rowTime(r, units);
+  json devices = json::array();
+  if (with_pnr)
+    for (const PnrDevice& d : pnrDevices()) devices.push_back({{"name", d.name}, {"title", d.title}, {"dsps", d.dsps}});
   bool rtl_equal = true;
   for (const json& r : rows) rtl_equal = rtl_equal && (!r.contains("rtl") || (r["rtl"]["pixel_mismatches"] == 0 && r["rtl"]["cycles_equal"] == true));
   bool modes_equal = true;
@@ -215,7 +375,9 @@ json ReportCmd::reportJson(const Scene& sc, const std::vector<SpanUnitConfig>& m
                  {"lights", sc.lights.size()}}},
       {"options", {{"modes", mode_names}, {"frames", bench_}, {"rtl", rtl_}, {"highlight_lsb", highlight_lsb_},
                    {"heat_scale_lsb", heat_scale_},
-                   {"synth_targets", with_area ? json({"ice40", "xc7"}) : json()}}},
+                   {"synth_targets", with_area ? json({"ice40", "xc7"}) : json()},
+                   {"pnr_devices", devices}}},
+      {"hardware", {{"cache", hw.cache.empty() ? json() : json(hw.cache)}, {"absent", hw.absent}}},
       {"methods", method_names},
       {"lobes", lobe_names},
       {"units", std::move(units)},
@@ -266,20 +428,13 @@ void ReportCmd::write(const Measured& m, json report, const fs::path& tmp) const
   }
 }
 
-int ReportCmd::run(const CLI::App& app) {
+int ReportCmd::run(const CLI::App&) {
   checkOutputDir();
+  checkHardwareCache();
   const Scene sc = loadScene(scene_);
   const std::vector<SpanUnitConfig> modes = modeConfigs();
   const LobeConfigs lobes;
   if (rtl_) requireRtl(modes, lobes);
-  std::optional<SynthTool> synth;
-  if (app.count("--synth-cache") > 0) {
-    requireDirectoryArg("--synth-cache", synth_cache_);
-    synth = SynthTool{findShareFile("scripts/synth.py"), synth_cache_, "both", ""};
-    if (synth->script.empty())
-      throw ArgError("--synth-cache: scripts/synth.py is neither in this installation nor in the source tree");
-    synth->version = synthToolVersion(synth->script);
-  }
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-report-{}", getpid());
   struct RemoveTmp {
     fs::path p;
@@ -306,16 +461,21 @@ int ReportCmd::run(const CLI::App& app) {
                   reportLobeGroups().size(), modes.size(), bench_, rtl_ ? ", and with the verilated units" : ""));
   const Measured m = measureReport(setup);
   for (const std::string& w : m.warnings) std::fprintf(stderr, "report: warning: %s\n", w.c_str());
-  json units = unitsJson(modes, m, lobes, synth ? &*synth : nullptr);
-  const json report = reportJson(sc, modes, m, std::move(units), synth.has_value());
+  Hardware hw = hardwareTools();
+  json units = unitsJson(modes, m, lobes, hw);
+  const json report = reportJson(sc, modes, m, std::move(units), hw);
   write(m, report, tmp);
   std::printf("report %s: %zu rows (%zu methods x lobes, %zu skipped) in %zu lane modes into %s; images across modes %s%s\n",
               sc.name.c_str(), report["rows"].size(), m.images.size(), m.skipped.size(), modes.size(), dir_.c_str(),
               report["checks"]["images_equal_across_modes"].get<bool>() ? "equal" : "DIFFERENT",
               rtl_ ? (report["checks"]["rtl"].get<bool>() ? ", RTL equal" : ", RTL DIFFERENT") : "");
-  if (m.failures.empty()) return kExitOk;
+  for (const json& a : hw.absent)
+    if (hw.failed)
+      std::fprintf(stderr, "report: %s absent: %s\n", a["figures"].get<std::string>().c_str(),
+                   a["why"].get<std::string>().c_str());
   for (const std::string& f : m.failures) std::fprintf(stderr, "MISMATCH: %s\n", f.c_str());
-  return kExitFailed;
+  if (hw.failed) std::fprintf(stderr, "report: hardware figures absent (--no-hardware leaves them out on purpose)\n");
+  return m.failures.empty() && !hw.failed ? kExitOk : kExitFailed;
 }
 
 }  // namespace

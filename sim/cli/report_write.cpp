@@ -19,6 +19,9 @@ using nlohmann::json;
 
 namespace shd::cli {
 
+const std::vector<std::string> kPlotFiles = {"error_vs_cycles.png", "error_vs_cycles.csv", "error_vs_time.png",
+                                             "error_vs_time.csv",   "error_vs_area.png",   "error_vs_area.csv"};
+
 namespace {
 
 constexpr const char* kNotApplicable = "—";
@@ -58,6 +61,19 @@ std::string csvCell(const json& v) {
 std::vector<std::string> targetsOf(const json& report) {
   const json& t = at(report, {"options", "synth_targets"});
   return t.is_array() ? t.get<std::vector<std::string>>() : std::vector<std::string>{};
+}
+
+// The place-and-route devices: (name, "UP5K"), empty when nothing was placed.
+std::vector<std::pair<std::string, std::string>> devicesOf(const json& report) {
+  std::vector<std::pair<std::string, std::string>> v;
+  const json& d = at(report, {"options", "pnr_devices"});
+  if (d.is_array())
+    for (const json& e : d) {
+      std::string title = e["title"].get<std::string>();
+      if (title.rfind("iCE40", 0) == 0) title = title.substr(5);
+      v.push_back({e["name"].get<std::string>(), title});
+    }
+  return v;
 }
 
 // The distinct values of a key over the rows that pass `keep`, in row order.
@@ -118,6 +134,7 @@ std::vector<MdColumn> lobeColumns(const json& report) {
                  }});
     c.push_back({"RTL ms", val({"rtl", "ms"}, 1)});
   }
+  for (const auto& [d, title] : devicesOf(report)) c.push_back({title + " µs", val({"time_us", d}, 1)});
   for (const std::string& t : targetsOf(report))
     for (const std::string f : {"luts", "dsps"})
       c.push_back({fmt::format("{} {}", t == "ice40" ? "iCE40" : t, f == "luts" ? "LUT" : "DSP"),
@@ -157,6 +174,23 @@ std::string unitsTable(const json& report) {
         for (const std::string& f : kAreaFigures) cells.push_back(num(at(u, {"area", t, f}), 0));
       md += mdRow(cells);
     }
+  return md;
+}
+
+// Each unit's place and route per device: its fmax, or that it does not fit, with its utilisation.
+std::string pnrTable(const json& report) {
+  std::string md = mdHeader({"unit", "configuration", "device", "flow", "fmax MHz", "logic cells", "DSP", "BRAM", "result"});
+  for (const char* unit : {"span", "spec"})
+    for (const auto& [name, u] : report["units"][unit].items())
+      for (const auto& [d, title] : devicesOf(report)) {
+        const json& p = at(u, {"pnr", d});
+        if (p.is_null()) continue;
+        auto used = [&](const char* f) { return fmt::format("{} / {}", p[f].dump(), p[std::string(f) + "_total"].dump()); };
+        const std::string result = p["fits"].get<bool>() ? "fmax " + p["fmax_kind"].get<std::string>()
+                                                         : p["why_not"].get<std::string>();
+        md += mdRow({unit, "`" + name + "`", title, "`" + p["flow"].get<std::string>() + "`", num(p["fmax_mhz"], 2),
+                     used("luts"), used("dsps"), used("brams"), result});
+      }
   return md;
 }
 
@@ -204,7 +238,7 @@ json notApplicable(const json& report) {
   const std::vector<std::string> no_hw =
       distinct(rows, "method", [](const json& r) { return r["span_cycles"].is_null(); });
   if (!no_hw.empty())
-    add({"span_cycles", "spec_cycles", "total_cycles", "area"}, fmt::format("methods {}", fmt::join(no_hw, ", ")),
+    add({"span_cycles", "spec_cycles", "total_cycles", "time_us", "area"}, fmt::format("methods {}", fmt::join(no_hw, ", ")),
         "computed per pixel in double precision, by neither unit: no hardware time and no area");
   const std::vector<std::string> no_spec = distinct(
       rows, "lobe", [](const json& r) { return !r["span_cycles"].is_null() && r["spec_cycles"].is_null(); });
@@ -220,8 +254,16 @@ json notApplicable(const json& report) {
                     at(report, {"options", "highlight_lsb"}).get<double>()));
   if (!at(report, {"options", "rtl"}).get<bool>())
     add({"rtl"}, "every row", "not run: give --rtl to render every row with the verilated units as well");
-  if (targetsOf(report).empty())
-    add({"area"}, "every row", "not measured: give --synth-cache DIR for the yosys area of each unit configuration");
+  for (const json& a : at(report, {"hardware", "absent"}))
+    add({a["figures"].get<std::string>()}, "every row", a["why"].get<std::string>());
+  for (const auto& [d, title] : devicesOf(report)) {
+    const std::vector<std::string> none = distinct(rows, "mode", [&](const json& r) {
+      return !r["span_cycles"].is_null() && at(r, {"time_us", d}).is_null();
+    });
+    if (!none.empty())
+      add({"time_us." + d}, fmt::format("lane modes {}", fmt::join(none, ", ")),
+          fmt::format("a unit of the row does not fit the {} or was not placed (Place and route, Hardware)", title));
+  }
   return na;
 }
 
@@ -239,6 +281,7 @@ std::string reportCsv(const json& report) {
     cols.push_back({f, {f}});
   if (rtl)
     for (const char* f : {"pixel_mismatches", "cycles_equal", "ms"}) cols.push_back({fmt::format("rtl_{}", f), {"rtl", f}});
+  for (const auto& [d, title] : devicesOf(report)) cols.push_back({"time_us_" + d, {"time_us", d}});
   std::string csv;
   for (size_t i = 0; i < cols.size(); ++i) csv += (i ? "," : "") + cols[i].first;
   for (const std::string& t : targets)
@@ -275,6 +318,12 @@ std::string reportMarkdown(const json& report) {
     md += lobeTable(report, name) + "\n";
   }
   md += "## Units\n\n" + unitsTable(report) + "\n";
+  if (!devicesOf(report).empty())
+    md += "## Place and route\n\nEach unit alone on iCE40 by nextpnr (scripts/pnr.py): the UP5K with its DSPs (fmax an "
+          "upper bound: the DSPs' own delays are not in it), the HX8K without (every multiplier in logic cells; fmax "
+          "exact). A row's time per frame (µs) is its span cycles at the span unit's fmax plus its specular cycles "
+          "at the specular unit's.\n\n" +
+          pnrTable(report) + "\n";
   md += "## Columns that do not apply\n\n";
   for (const json& n : report["not_applicable"])
     md += fmt::format("- {} ({}): {}.\n", fmt::join(n["columns"].get<std::vector<std::string>>(), ", "),
@@ -367,7 +416,7 @@ Plots makePlots(const json& report, const fs::path& tmp) {
     return p;
   }
   json files = json::array();
-  for (const char* f : {"error_vs_cycles.png", "error_vs_cycles.csv", "error_vs_area.png", "error_vs_area.csv"}) {
+  for (const std::string& f : kPlotFiles) {
     std::error_code ec;
     if (!fs::is_regular_file(tmp / f, ec)) continue;
     std::ifstream in_file(tmp / f, std::ios::binary);

@@ -35,6 +35,9 @@ struct ContactSheet {
 };
 ContactSheet contactSheet(const Measured& m);
 
+// The files scripts/plot_report.py may write.
+extern const std::vector<std::string> kPlotFiles;
+
 // scripts/plot_report.py run on the report (written into `tmp`, which is made and left for the
 // caller to remove): its files (name, bytes) if a python3 with matplotlib was found and it
 // succeeded, else why not. `json` is report.json's "plots".
