@@ -133,8 +133,15 @@ def panel(ax, xs, ys, table, front, xlabel, ylabel, colours):
     ax.legend(fontsize=7, loc="upper right")
 
 
-def save(fig, path, data):
-    fig.savefig(path, dpi=150, metadata={DATA_KEY: data})
+def finish(plt, fig, outdir, stem, data, title):
+    """Titles and writes the figure as <stem>.png (its data in a tEXt chunk) and <stem>.csv."""
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(os.path.join(outdir, stem + ".png"), dpi=150, metadata={DATA_KEY: data})
+    plt.close(fig)
+    with open(os.path.join(outdir, stem + ".csv"), "w") as f:
+        f.write(data)
+    return [stem + ".png", stem + ".csv"]
 
 
 def plot_cycles(plt, report, outdir, colours):
@@ -148,14 +155,8 @@ def plot_cycles(plt, report, outdir, colours):
         ys = [float(r[col]) for r in table]
         front = [i for i, r in enumerate(table) if r[front_col] == 1]
         panel(ax, xs, ys, table, front, "span + specular-unit cycles per frame", name, colours)
-    fig.suptitle(f"{report['scene']['name']}: error against cycles per frame (each point method/lobe)")
-    fig.tight_layout()
-    png = os.path.join(outdir, "error_vs_cycles.png")
-    save(fig, png, data)
-    plt.close(fig)
-    with open(os.path.join(outdir, "error_vs_cycles.csv"), "w") as f:
-        f.write(data)
-    return ["error_vs_cycles.png", "error_vs_cycles.csv"]
+    return finish(plt, fig, outdir, "error_vs_cycles", data,
+                  f"{report['scene']['name']}: error against cycles per frame (each point method/lobe)")
 
 
 def plot_time(plt, report, outdir, colours):
@@ -177,13 +178,8 @@ def plot_time(plt, report, outdir, colours):
         title = next(e["title"] for e in report["options"]["pnr_devices"] if e["name"] == d)
         panel(axes[0][k], xs, ys, sub, front, f"time per frame on the {title} (µs, units at their fmax)",
               "max abs error (LSB)", colours)
-    fig.suptitle(f"{report['scene']['name']}: error against hardware time per frame (each point method/lobe)")
-    fig.tight_layout()
-    save(fig, os.path.join(outdir, "error_vs_time.png"), data)
-    plt.close(fig)
-    with open(os.path.join(outdir, "error_vs_time.csv"), "w") as f:
-        f.write(data)
-    return ["error_vs_time.png", "error_vs_time.csv"]
+    return finish(plt, fig, outdir, "error_vs_time", data,
+                  f"{report['scene']['name']}: error against hardware time per frame (each point method/lobe)")
 
 
 def plot_area(plt, report, outdir, colours):
@@ -199,13 +195,8 @@ def plot_area(plt, report, outdir, colours):
         front = [i for i, r in enumerate(table) if r[6 + len(targets) + k] == 1]
         panel(axes[0][k], xs, ys, table, front, f"{t} LUTs (span + specular units)", "max abs error (LSB)",
               colours)
-    fig.suptitle(f"{report['scene']['name']}: error against area (each point method/lobe)")
-    fig.tight_layout()
-    save(fig, os.path.join(outdir, "error_vs_area.png"), data)
-    plt.close(fig)
-    with open(os.path.join(outdir, "error_vs_area.csv"), "w") as f:
-        f.write(data)
-    return ["error_vs_area.png", "error_vs_area.csv"]
+    return finish(plt, fig, outdir, "error_vs_area", data,
+                  f"{report['scene']['name']}: error against area (each point method/lobe)")
 
 
 def main():
