@@ -69,7 +69,7 @@ python3 - "$out/report/report.json" <<'PY'
 import json, sys
 j = json.load(open(sys.argv[1]))
 rows = [r for r in j["rows"] if r["mode"] == "serial" and r["lobe"] in ("blinn", "quadratic")]
-us = lambda r: "-" if r.get("time_us", {}).get("up5k") is None else f"{r['time_us']['up5k']:.0f}"
+us = lambda r: "-" if (r.get("time_us") or {}).get("up5k") is None else f"{r['time_us']['up5k']:.0f}"
 print(f"   {'method':<18} {'lobe':<10} {'max LSB':>8} {'RMSE':>7} {'cycles':>8} {'spec cyc':>9} {'UP5K us':>8} {'model ms':>8}")
 for r in rows:
     print(f"   {r['method']:<18} {r['lobe']:<10} {r['metrics']['max_abs_lsb']:>8.2f} {r['metrics']['rmse_lsb']:>7.3f} "
