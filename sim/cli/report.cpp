@@ -426,6 +426,15 @@ void ReportCmd::write(const Measured& m, json report, const fs::path& tmp) const
     for (auto d = made.rbegin(); d != made.rend(); ++d) fs::remove(*d, ec);  // empty: the set wrote nothing
     throw;
   }
+  // A plot this report has not (no area, no place and route) is an earlier report's: removed, so
+  // that the directory holds one report.
+  for (const std::string& f : kPlotFiles) {
+    if (std::any_of(plots.files.begin(), plots.files.end(), [&](const auto& p) { return p.first == f; })) continue;
+    std::error_code ec;
+    if (fs::is_regular_file(dir / f, ec) && !fs::remove(dir / f, ec))
+      std::fprintf(stderr, "report: warning: cannot remove the earlier report's %s: %s\n", (dir / f).c_str(),
+                   ec.message().c_str());
+  }
 }
 
 int ReportCmd::run(const CLI::App&) {
