@@ -127,7 +127,7 @@ TEST(FixedShading, SpecResultMemoEqualsTheUnitsModel) {
   EXPECT_EQ(memo.row(shin, light), row);
   for (uint32_t cos = 0; cos <= static_cast<uint32_t>(unit.params().cosOne()); ++cos) {
     ASSERT_EQ(row[cos], 0u);
-    const uint64_t e = memo.fill(row, shin, cos, light);
+    const uint64_t e = memo.result(row, shin, cos, light);
     ASSERT_EQ(row[cos], e);
     const SpecOut want = unit.evaluate(shin, cos, light);
     ASSERT_NE(e & SpecResultMemo::kValid, 0u);

@@ -106,8 +106,12 @@ class SpecResultMemo {
   uint64_t* row(uint32_t shin, const std::array<uint32_t, 3>& light);
   // The unit's result as one word: kValid | r | g << 20 | b << 40.
   uint64_t evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const;
-  uint64_t fill(uint64_t* row, uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
-    return row[cos] = evaluate(shin, cos, light);
+  // The same from `row` (row(shin, light)), evaluated and stored there on first use; evaluated
+  // each time when the row is null.
+  uint64_t result(uint64_t* row, uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
+    if (row == nullptr) return evaluate(shin, cos, light);
+    const uint64_t e = row[cos];
+    return __builtin_expect(e == 0, 0) ? (row[cos] = evaluate(shin, cos, light)) : e;
   }
   static constexpr uint64_t kValid = uint64_t{1} << 60;
   static constexpr int kMaxCosFracBits = 20;
@@ -117,6 +121,20 @@ class SpecResultMemo {
   const SpecUnitModel& model_;
   std::map<std::array<uint32_t, 4>, std::vector<uint64_t>> rows_;
 };
+
+// One request of a shader to the specular unit: queued in `requests` when there is no memo (the
+// batch path), else the memo's result (its row `row`) added to s.device at once.
+inline void deviceRequest(FixedShade& s, SpecResultMemo* memo, uint64_t* row, uint32_t shin, uint32_t cos,
+                          const std::array<uint32_t, 3>& light, std::vector<SpecRequest>* requests) {
+  if (memo == nullptr) {
+    if (requests == nullptr) throw std::logic_error("a shader's device requests need a list");
+    requests->push_back(SpecRequest{shin, cos, light});
+  } else {
+    const uint64_t r = memo->result(row, shin, cos, light);
+    for (size_t c = 0; c < 3; ++c) s.device[c] += static_cast<uint32_t>(r >> (20 * c)) & 0xFFFFFu;
+  }
+  ++s.device_requests;
+}
 
 // The per-pixel arithmetic (inline: it runs once per fragment).
 namespace fixed_detail {
@@ -333,7 +351,6 @@ class FixedPointShader {
   }
   void setDirections(PerLight& pl, Vec3 l) const;
   uint32_t cookTorranceCode(int64_t nl, int64_t nv, int64_t nh, const PerLight& pl) const;
-  uint64_t deviceResult(const PerLight& pl, uint32_t cos) const;  // the memo entry, evaluated on first use
 
   const ShadeContext& ctx_;
   const Material& m_;
@@ -392,14 +409,7 @@ inline FixedShade FixedPointShader::shadeDots(const Consts& k, uint64_t sqnorm, 
     const int64_t nh = scaleCosine(nh_of(li, pl), sc);
     if constexpr (C == Cosine::Device) {
       const uint32_t cos = cosCode(nh, coding_->cos_frac_bits);
-      if (memo_ == nullptr) {
-        if (requests == nullptr) throw std::logic_error("FixedPointShader: device requests need a list");
-        requests->push_back(SpecRequest{coding_->shin, cos, pl.device_light});
-      } else {
-        const uint64_t r = deviceResult(pl, cos);
-        for (size_t c = 0; c < 3; ++c) s.device[c] += static_cast<uint32_t>(r >> (20 * c)) & 0xFFFFFu;
-      }
-      ++s.device_requests;
+      deviceRequest(s, memo_, pl.memo, coding_->shin, cos, pl.device_light, requests);
     } else {
       uint32_t f = 0;
       if constexpr (C == Cosine::NH) {
@@ -440,12 +450,6 @@ inline void FixedPointShader::withRunKernel(F&& f) {
     case Cosine::CookTorrance: withLightCount<Cosine::CookTorrance>(f); break;
     case Cosine::Device: withLightCount<Cosine::Device>(f); break;
   }
-}
-
-inline uint64_t FixedPointShader::deviceResult(const PerLight& pl, uint32_t cos) const {
-  if (pl.memo == nullptr) return memo_->evaluate(coding_->shin, cos, pl.device_light);
-  const uint64_t e = pl.memo[cos];
-  return __builtin_expect(e == 0, 0) ? memo_->fill(pl.memo, coding_->shin, cos, pl.device_light) : e;
 }
 
 }  // namespace shd

@@ -151,14 +151,7 @@ void FixedWidthsShader::addSpecular(FixedShade& s, PerLight& pl, int64_t nl, int
     const int cf = coding_->cos_frac_bits;
     const uint32_t cos = static_cast<uint32_t>(
         std::clamp<i128>(rescale(nh, w_.CosFracBits, cf), 0, i128{1} << cf));
-    if (memo_ == nullptr) {
-      if (requests == nullptr) throw std::logic_error("FixedWidthsShader: device requests need a list");
-      requests->push_back(SpecRequest{coding_->shin, cos, pl.device_light});
-    } else {
-      const uint64_t r = deviceResult(pl, cos);
-      for (size_t c = 0; c < 3; ++c) s.device[c] += static_cast<uint32_t>(r >> (20 * c)) & 0xFFFFFu;
-    }
-    ++s.device_requests;
+    deviceRequest(s, memo_, pl.memo, coding_->shin, cos, pl.device_light, requests);
     return;
   }
   uint32_t f = 0;
@@ -176,12 +169,6 @@ void FixedWidthsShader::addSpecular(FixedShade& s, PerLight& pl, int64_t nl, int
   }
   for (size_t c = 0; c < 3; ++c)
     s.code[c] += static_cast<int64_t>(roundShift(i128{pl.specular[c]} * f, w_.LobeCodeBits));
-}
-
-uint64_t FixedWidthsShader::deviceResult(const PerLight& pl, uint32_t cos) const {
-  if (pl.memo == nullptr) return memo_->evaluate(coding_->shin, cos, pl.device_light);
-  const uint64_t e = pl.memo[cos];
-  return e == 0 ? memo_->fill(pl.memo, coding_->shin, cos, pl.device_light) : e;
 }
 
 std::array<uint8_t, 3> FixedWidthsShader::colour(const FixedShade& s) const {

@@ -78,7 +78,6 @@ class FixedWidthsShader {
   void setDirections(PerLight& pl, Vec3 l) const;
   void addSpecular(FixedShade& s, PerLight& pl, int64_t nl, int64_t nv, int64_t nh,
                    std::vector<SpecRequest>* requests) const;
-  uint64_t deviceResult(const PerLight& pl, uint32_t cos) const;
 
   const ShadeContext& ctx_;
   const Material& m_;

@@ -115,28 +115,27 @@ void ReportCmd::add(CLI::App& app) {
   app.add_flag("--quiet", quiet_, "no progress on stderr");
 }
 
-void ReportCmd::checkHardwareCache() const {
+// The directory `dir` that `option` `arg` names: true if it exists, false if it is new and its
+// parent exists (it is made later). ArgError otherwise; `why` follows "not a directory".
+bool existingOrNewDir(const char* option, const std::string& arg, const fs::path& dir, const char* why) {
   std::error_code ec;
-  const fs::path parent = fs::path(hardware_cache_).parent_path();
-  if (!hardware_cache_.empty() && !fs::is_directory(hardware_cache_, ec) && !parent.empty() &&
-      !fs::is_directory(parent, ec))
-    throw ArgError(fmt::format("--hardware-cache {}: no such directory, and its parent {} is none either",
-                               hardware_cache_, parent.string()));
-  if (fs::exists(hardware_cache_, ec) && !fs::is_directory(hardware_cache_, ec))
-    throw ArgError(fmt::format("--hardware-cache {}: not a directory", hardware_cache_));
+  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+    throw ArgError(fmt::format("{} {}: not a directory{}", option, arg, why));
+  if (fs::exists(dir, ec)) return true;
+  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent, ec))
+    throw ArgError(fmt::format("{} {}: no such directory, and its parent {} is none either", option, arg, parent.string()));
+  return false;
+}
+
+void ReportCmd::checkHardwareCache() const {
+  if (!hardware_cache_.empty()) existingOrNewDir("--hardware-cache", hardware_cache_, hardware_cache_, "");
 }
 
 void ReportCmd::checkOutputDir() const {
   std::error_code ec;
   const fs::path dir = this->dir();
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw ArgError(fmt::format("-o {}: not a directory (the report is a directory of files)", dir_));
-  if (!fs::exists(dir, ec)) {
-    const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-    if (!fs::is_directory(parent, ec))
-      throw ArgError(fmt::format("-o {}: no such directory, and its parent {} is none either", dir_, parent.string()));
-    return;
-  }
+  if (!existingOrNewDir("-o", dir_, dir, " (the report is a directory of files)")) return;
   if (fs::exists(dir / "images", ec) && !fs::is_directory(dir / "images", ec))
     throw ArgError(fmt::format("-o {}: {} is not a directory (the report's images go there)", dir_,
                                (dir / "images").string()));
