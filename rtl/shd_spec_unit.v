@@ -1,26 +1,44 @@
-// shd_spec_unit: specular term ks*L * f(N.H), f from a coefficient PROM (paper Fig. 11).
-// Why:      f(c) = a*(c^2 - c) + c = a c^2 + (1-a) c needs two multipliers and no pow; a(n) comes
-//           from a PROM indexed by the shininess code. Degree 3 is the same structure with a
-//           Horner step: f = c + (c^2 - c)*(u*c + v), u = a1, v = a1 + b1, and a cut-off code.
+// shd_spec_unit: specular term ks*L * f(N.H), f from a PROM indexed by the shininess code (paper
+// Fig. 11), by one of three datapaths chosen by the parameter Kind; ports and back end are common.
+// Why:      Kind 0, poly (rtl/shd_spec_poly.v, the paper's device): f(c) = a*(c^2 - c) + c =
+//           a c^2 + (1-a) c needs two multipliers and no pow; a(n) comes from the PROM. Degree 3 is
+//           the same structure with a Horner step: f = c + (c^2 - c)*(u*c + v), u = a1,
+//           v = a1 + b1, and a cut-off code.
+//           Kind 1, table: f = c^n read from the PROM at {shininess code, top T = TableBits bits of
+//           c}: no arithmetic before MUL3..MUL5, but 2^T PROM words per shininess code.
+//           Kind 2, schlick (rtl/shd_spec_schlick.v): Schlick's rational c / (n - n c + c) =
+//           c / ((n-1)(1-c) + 1), m = n - 1 from the PROM, one multiplier and a restoring divider.
+//           Every kind ends in the same stage D (MUL3..MUL5) and output registers.
 // Latency:  2 + PipeStages cycles valid_i -> valid_o; one result per cycle, no stalls.
-//           Cycle 1: RG1..RG5 (the PROM's address register is RG1). Optional registers, enabled
-//           in this order as PipeStages grows: B after MUL2+rounding, A after Sm1 (and Horner),
-//           C after Sm2+clamp. Output registers load only while their stage is valid, so the
-//           outputs hold the last result; valid and outputs reset to 0 (rst_ni, asynchronous).
+//           Cycle 1: RG1..RG5 (the PROM's address register is RG1). Optional registers:
+//           Kind 0 (PipeStages 0..3): enabled in this order as PipeStages grows: B after
+//             MUL2+rounding, A after Sm1 (and Horner), C after Sm2+clamp.
+//           Kind 1 (PipeStages 0..1): T between the PROM output and stage D.
+//           Kind 2 (PipeStages 0..Wf+1): that many ranks spread evenly over the Wf+1 divider steps
+//             (rank j after step floor(j*(Wf+1)/(PipeStages+1)), step 0 being the den multiply).
+//           Output registers load only while their stage is valid, so the outputs hold the last
+//           result; valid and outputs reset to 0 (rst_ni, asynchronous).
 // Formats:  cos_i uQ1.Wc (codes above 1.0 saturate to 1.0: an upstream N.H may overshoot);
-//           coefficient uQCi.Cf (degree 2) or sQCi.Cf (degree 3); spec_o = f in uQ1.Wf;
+//           PROM word: Kind 0 the coefficient uQCi.Cf (degree 2) or {cut-off uQ1.Wc, v, u} in
+//           sQCi.Cf (degree 3); Kind 1 f itself, uQ1.Wf; Kind 2 m = n - 1, uQCi.Cf (unsigned; the
+//           padding words are 0, giving f = c). spec_o = f in uQ1.Wf, in [0, 1];
 //           light_*_i and spec_*_o unorm LightBits (code/(2^LightBits-1)), spec_x = round(f*L_x).
-// Widths:   c^2 <= 1 and c^2 - c lies in [-1/4, 0], so bits [2Wc-2:0] of Sm1 hold it exactly as
-//           a signed number; after dropping 2Wc-Df LSBs (floor) dt lies in [-2^(Df-2), 0] and
-//           needs Df-1 bits. Degree 2: |a*dt| <= (2^KW - 1)*2^(Df-2) < 2^(KW+Df-2), so the
-//           product needs KW+Df-1 = KW+DTW bits signed. Degree 3: |u*c| <= 2^(KW-1+Wc) and
-//           |v*2^Wc| < 2^(KW-1+Wc), so g needs KW+Wc+1 bits, exactly Ci+1+Hf after the shift;
-//           |dt*gt| <= 2^(Df-2) * 2^(GTW-1) needs DTW+GTW bits signed (the product can be
-//           positive). Each width is the derivation above, not a guess; the model asserts them
-//           (Overflow::Error) at every conversion.
-// Rounding: Trunc (floor) of c^2 - c to Df bits and of g to Hf bits; RoundHalfUp of the MUL2
-//           product to Wf bits and of MUL3..MUL5 to integers. Sm2 saturates f to [0, 1]; for
-//           degree 2 only the lower clamp can act (a >= 0 and c^2 - c <= 0 give f <= c <= 1).
+// Widths:   PROM address: ShinBits; Kind 1 ShinBits + T, {shin_i, idx} with
+//           idx = min(c >> (Wc - T), 2^T - 1) (c >> (Wc - T) <= 2^T, equal only for c = 1.0), formed
+//           from the input ports so that the PROM's address register is the cycle-1 register.
+//           PROM word: Kind 0 KW = Ci + Cf (degree 2) or 2*KW + Wc + 1 (degree 3); Kind 1 Wf + 1;
+//           Kind 2 KW. The datapaths' widths are derived in their files (Kind 0: c^2 - c in
+//           [-1/4, 0] gives dt Df-1 bits, MUL2 KW+DTW or DTW+GTW bits signed, g KW+Wc+1 bits;
+//           Kind 2: den KW+Wc+1 bits, f <= 1). Stage D: f <= 1, so f*L_x <= L_x * 2^Wf and the
+//           rounded result fits LightBits (see there).
+// Rounding: Kind 0: Trunc (floor) of c^2 - c to Df bits and of g to Hf bits; RoundHalfUp of the
+//           MUL2 product to Wf bits; Sm2 saturates f to [0, 1] (degree 2: only the lower clamp can
+//           act). Kind 1: none in the unit (the table words are f as `shadesim prom` rounded them).
+//           Kind 2: Trunc (floor) of the quotient to Wf bits. All: RoundHalfUp of MUL3..MUL5 to
+//           integers.
+// Checks:   a Kind outside 0..2, a Degree other than 2 or 3 (Kind 0), PipeStages outside its kind's
+//           range or TableBits outside 1..Wc (Kind 1) instantiate the module
+//           shd_spec_unit_bad_parameter, which does not exist: every tool stops at elaboration.
 // Model:    model/device/spec_unit.h SpecUnitModel, bit-exact and cycle-accurate.
 module shd_spec_unit #(
   parameter integer Degree         = 2,
@@ -33,6 +51,8 @@ module shd_spec_unit #(
   parameter integer SpecFracBits   = 16,
   parameter integer LightBits      = 8,
   parameter integer PipeStages     = 1,
+  parameter integer Kind           = 0,
+  parameter integer TableBits      = 8,
   parameter         RomFile        = ""
 ) (
   input  wire                 clk_i,
@@ -53,35 +73,52 @@ module shd_spec_unit #(
   localparam integer WC    = CosFracBits;
   localparam integer CW    = WC + 1;                        // c, uQ1.Wc
   localparam integer KW    = CoefIntBits + CoefFracBits;     // one coefficient
-  localparam integer WORD  = (Degree == 2) ? KW : 2 * KW + CW;
-  localparam integer LW    = 3 * LightBits;
-  localparam integer DTW   = DiffFracBits - 1;              // dt, sQ(-1).Df
-  localparam integer GTW   = CoefIntBits + 1 + HornerFracBits;  // gt, sQ(Ci+1).Hf
-  localparam integer MW    = (Degree == 2) ? KW : GTW;        // MUL2 operand beside dt
-  localparam integer PW    = MW + DTW;                        // MUL2 product
-  localparam integer PFRAC = DiffFracBits + ((Degree == 2) ? CoefFracBits : HornerFracBits);
-  localparam integer SH    = PFRAC - SpecFracBits;           // LSBs rounded away, >= 0
-  localparam integer PRW   = PW - SH;                        // rounded product
   localparam integer WF    = SpecFracBits;
   localparam integer FW    = WF + 1;                         // f, uQ1.Wf
-  localparam integer FSW   = ((PRW > WF + 2) ? PRW : WF + 2) + 1;  // Sm2 sum, signed
-  localparam [CW-1:0] COS_ONE  = {1'b1, {WC{1'b0}}};
-  localparam [FW-1:0] SPEC_ONE = {1'b1, {WF{1'b0}}};
+  localparam integer LW    = 3 * LightBits;
+  localparam integer AB    = (Kind == 1) ? ShinBits + TableBits : ShinBits;  // PROM address
+  localparam integer WORD  = (Kind == 1) ? FW                                // PROM word
+                           : (Kind == 2) ? KW
+                           : (Degree == 2) ? KW : 2 * KW + CW;
+  localparam integer PMAX  = (Kind == 1) ? 1 : (Kind == 2) ? WF + 1 : 3;    // PipeStages range
+  localparam [CW-1:0] COS_ONE = {1'b1, {WC{1'b0}}};
+
+  generate
+    if (Kind < 0 || Kind > 2 || PipeStages < 0 || PipeStages > PMAX ||
+        (Kind == 0 && Degree != 2 && Degree != 3) ||
+        (Kind == 1 && (TableBits < 1 || TableBits > CosFracBits))) begin : g_bad_parameter
+      shd_spec_unit_bad_parameter u_bad ();   // no such module: see Checks in the header
+    end
+  endgenerate
 
   // ---------------------------------------------------------------- cycle 1: RG1..RG5, PROM
   wire [CW-1:0]   c_d = (cos_i > COS_ONE) ? COS_ONE : cos_i;
   reg  [CW-1:0]   c_q1;
   reg  [LW-1:0]   light_q1;
   reg             valid_q1;
+  wire [AB-1:0]   rom_addr;
   wire [WORD-1:0] word_q1;
 
+  generate
+    if (Kind == 1) begin : g_table_addr
+      localparam integer TB = TableBits;
+      localparam [CW-1:0] IDX_MAX = {{(CW-TB){1'b0}}, {TB{1'b1}}};  // 2^T - 1
+      wire [CW-1:0] c_sh = c_d >> (WC - TB);                       // <= 2^T (c = 1.0 only)
+      wire [CW-1:0] idx  = (c_sh > IDX_MAX) ? IDX_MAX : c_sh;
+      assign rom_addr = {shin_i, idx[TB-1:0]};
+      wire unused_idx = ^idx[CW-1:TB];
+    end else begin : g_shin_addr
+      assign rom_addr = shin_i;
+    end
+  endgenerate
+
   shd_coef_rom #(
-    .AddrBits(ShinBits),
+    .AddrBits(AB),
     .WordBits(WORD),
     .RomFile (RomFile)
   ) u_rom (
     .clk_i (clk_i),
-    .addr_i(shin_i),
+    .addr_i(rom_addr),
     .word_o(word_q1)
   );
 
@@ -94,116 +131,66 @@ module shd_spec_unit #(
     light_q1 <= {light_b_i, light_g_i, light_r_i};
   end
 
-  // ---------------------------------------------------------------- A: MUL1, BI, Sm1, Horner
-  wire [2*CW-1:0] sq     = {{CW{1'b0}}, c_q1} * {{CW{1'b0}}, c_q1};   // MUL1, <= 2^(2Wc)
-  wire [2*CW-1:0] c_al   = {1'b0, c_q1, {WC{1'b0}}};                  // c at 2Wc fraction bits
-  wire [2*CW-1:0] d_full = sq + ~c_al + {{(2*CW-1){1'b0}}, 1'b1};    // BI + Sm1: c^2 - c
-  // d in [-2^(2Wc-2), 0]: bits [2Wc-2:0] hold it; bits above are copies of its sign.
-  wire signed [2*WC-2:0] d_s     = d_full[2*WC-2:0];
-  wire signed [2*WC-2:0] d_shift = d_s >>> (2 * WC - DiffFracBits);  // Trunc to Df bits
-  wire signed [DTW-1:0]  dt_a    = d_shift[DTW-1:0];
-  wire unused_d = ^{d_full[2*CW-1:2*WC-1], d_shift};
-
-  wire [MW-1:0] m_a;   // MUL2 operand: a (degree 2) or gt (degree 3)
-  wire [CW-1:0] cut_a; // degree 3 cut-off code (0 for degree 2)
-  generate
-    if (Degree == 2) begin : g_quad
-      assign m_a   = word_q1;
-      assign cut_a = {CW{1'b0}};
-    end else begin : g_cubic
-      localparam integer UCW = KW + CW + 1;              // u * {0,c}, natural width
-      localparam integer GW  = KW + WC + 1;              // g = u*c + v*2^Wc
-      localparam integer GSH = CoefFracBits + WC - HornerFracBits;
-      wire signed [KW-1:0]  u_a = word_q1[KW-1:0];
-      wire signed [KW-1:0]  v_a = word_q1[2*KW-1:KW];
-      wire signed [UCW-1:0] uc  = u_a * $signed({1'b0, c_q1});   // signed x signed: no wasted DSP tile
-      // |u*c| <= 2^(KW-1+Wc): bits [GW-2:0] hold it.
-      wire signed [GW-1:0]  g_full = {uc[GW-2], uc[GW-2:0]} + {v_a[KW-1], v_a, {WC{1'b0}}};
-      wire signed [GW-1:0]  g_shift = g_full >>> GSH;    // Trunc to Hf bits
-      assign m_a   = g_shift[GTW-1:0];                   // GW - GSH = GTW: nothing else dropped
-      assign cut_a = word_q1[2*KW+CW-1:2*KW];
-      wire unused_g = ^{uc[UCW-1:GW-1], g_shift};
-    end
-  endgenerate
-
-  // Optional register A (PipeStages >= 2).
-  localparam integer AW = CW + DTW + MW + CW + LW;
-  wire          valid_a;
-  wire [CW-1:0] c_a;
-  wire [DTW-1:0] dt_ar;
-  wire [MW-1:0] m_ar;
-  wire [CW-1:0] cut_ar;
-  wire [LW-1:0] light_a;
-  shd_pipe_reg #(.Width(AW), .Enable((PipeStages >= 2) ? 1 : 0)) u_pipe_a (
-    .clk_i  (clk_i),
-    .rst_ni (rst_ni),
-    .valid_i(valid_q1),
-    .data_i ({c_q1, dt_a, m_a, cut_a, light_q1}),
-    .valid_o(valid_a),
-    .data_o ({c_a, dt_ar, m_ar, cut_ar, light_a})
-  );
-
-  // ---------------------------------------------------------------- B: MUL2, round
-  wire signed [PW-1:0] m_ext  = (Degree == 2) ? {{DTW{1'b0}}, m_ar}
-                                              : {{DTW{m_ar[MW-1]}}, m_ar};
-  wire signed [PW-1:0] dt_ext = {{MW{dt_ar[DTW-1]}}, dt_ar};
-  wire signed [PW-1:0] prod   = m_ext * dt_ext;          // MUL2, fits PW bits (see header)
-  wire signed [PRW-1:0] pr_b;
-  generate
-    if (SH > 0) begin : g_round
-      // RoundHalfUp: add half an output LSB, then drop SH bits (floor). Cannot overflow:
-      // |prod| <= 2^(PW-2) and 2^(SH-1) < 2^(PW-2).
-      wire signed [PW-1:0] half     = {{(PW-1){1'b0}}, 1'b1} << (SH - 1);
-      wire signed [PW-1:0] prod_rnd = prod + half;
-      assign pr_b = prod_rnd[PW-1:SH];
-      wire unused_rnd = ^prod_rnd[SH-1:0];
-    end else begin : g_exact
-      assign pr_b = prod;
-    end
-  endgenerate
-
-  // Optional register B (PipeStages >= 1).
-  localparam integer BW = CW + PRW + CW + LW;
-  wire           valid_b;
-  wire [CW-1:0]  c_b;
-  wire [PRW-1:0] pr_br;
-  wire [CW-1:0]  cut_b;
-  wire [LW-1:0]  light_b;
-  shd_pipe_reg #(.Width(BW), .Enable((PipeStages >= 1) ? 1 : 0)) u_pipe_b (
-    .clk_i  (clk_i),
-    .rst_ni (rst_ni),
-    .valid_i(valid_a),
-    .data_i ({c_a, pr_b, cut_ar, light_a}),
-    .valid_o(valid_b),
-    .data_o ({c_b, pr_br, cut_b, light_b})
-  );
-
-  // ---------------------------------------------------------------- C: Sm2, clamp, cut-off
-  wire signed [FSW-1:0] c_f   = {{(FSW-CW){1'b0}}, c_b} << (WF - WC);  // c at Wf bits
-  wire signed [FSW-1:0] pr_f  = {{(FSW-PRW){pr_br[PRW-1]}}, pr_br};
-  wire signed [FSW-1:0] f_sum = c_f + pr_f;              // Sm2
-  wire signed [FSW-1:0] f_one = {{(FSW-FW){1'b0}}, SPEC_ONE};
-  wire                  cut_c = (Degree == 3) && (c_b < cut_b);
-  reg  [FW-1:0]         f_c;
-  always @* begin
-    if (f_sum[FSW-1] || cut_c) f_c = {FW{1'b0}};          // negative lobe cut to 0
-    else if (f_sum > f_one)    f_c = SPEC_ONE;            // degree 3 only, see header
-    else                       f_c = f_sum[FW-1:0];
-  end
-
-  // Optional register C (PipeStages >= 3).
-  localparam integer CRW = FW + LW;
+  // ---------------------------------------------------------------- the datapath of the kind
+  // From the cycle-1 registers to f (uQ1.Wf) with its valid and the light side-band.
   wire          valid_c;
   wire [FW-1:0] f_cr;
   wire [LW-1:0] light_c;
-  shd_pipe_reg #(.Width(CRW), .Enable((PipeStages >= 3) ? 1 : 0)) u_pipe_c (
-    .clk_i  (clk_i),
-    .rst_ni (rst_ni),
-    .valid_i(valid_b),
-    .data_i ({f_c, light_b}),
-    .valid_o(valid_c),
-    .data_o ({f_cr, light_c})
-  );
+  generate
+    if (Kind == 1) begin : g_table
+      // Optional register T (PipeStages = 1).
+      shd_pipe_reg #(.Width(FW + LW), .Enable((PipeStages >= 1) ? 1 : 0)) u_pipe_t (
+        .clk_i  (clk_i),
+        .rst_ni (rst_ni),
+        .valid_i(valid_q1),
+        .data_i ({word_q1, light_q1}),
+        .valid_o(valid_c),
+        .data_o ({f_cr, light_c})
+      );
+      wire unused_c = ^c_q1;                 // the table was addressed with c already
+    end else if (Kind == 2) begin : g_schlick
+      shd_spec_schlick #(
+        .CosFracBits (CosFracBits),
+        .CoefIntBits (CoefIntBits),
+        .CoefFracBits(CoefFracBits),
+        .SpecFracBits(SpecFracBits),
+        .LightBits   (LightBits),
+        .PipeStages  (PipeStages)
+      ) u_schlick (
+        .clk_i  (clk_i),
+        .rst_ni (rst_ni),
+        .valid_i(valid_q1),
+        .c_i    (c_q1),
+        .m_i    (word_q1),
+        .light_i(light_q1),
+        .valid_o(valid_c),
+        .f_o    (f_cr),
+        .light_o(light_c)
+      );
+    end else begin : g_poly
+      shd_spec_poly #(
+        .Degree        (Degree),
+        .CosFracBits   (CosFracBits),
+        .CoefIntBits   (CoefIntBits),
+        .CoefFracBits  (CoefFracBits),
+        .DiffFracBits  (DiffFracBits),
+        .HornerFracBits(HornerFracBits),
+        .SpecFracBits  (SpecFracBits),
+        .LightBits     (LightBits),
+        .PipeStages    (PipeStages)
+      ) u_poly (
+        .clk_i  (clk_i),
+        .rst_ni (rst_ni),
+        .valid_i(valid_q1),
+        .c_i    (c_q1),
+        .word_i (word_q1),
+        .light_i(light_q1),
+        .valid_o(valid_c),
+        .f_o    (f_cr),
+        .light_o(light_c)
+      );
+    end
+  endgenerate
 
   // ---------------------------------------------------------------- D: MUL3..MUL5, round
   // spec_x = round_half_up(f * L_x / 2^Wf); f <= 1 gives a result <= L_x, so LightBits hold

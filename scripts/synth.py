@@ -9,9 +9,11 @@ Usage: scripts/synth.py CONFIG [--unit spec|span] [--prom FILE] [--out DIR]
 CONFIG is a configuration file (<unit>_<name>.json; --unit names the unit of a file named
 otherwise) or "<unit>:<name>" of the registry vectors/config/ (scripts/shd_config.py reads it:
 `shd_config.py list` prints the registry). The unit decides the top module and the RTL files:
-spec is shd_spec_unit (rtl/shd_spec_unit.v, shd_coef_rom.v, shd_pipe_reg.v), span is
-shd_span_unit (rtl/shd_span_unit.v). Everything below is about the spec unit except where "A span
-configuration" says otherwise.
+spec is shd_spec_unit (rtl/shd_spec_unit.v, shd_spec_poly.v, shd_spec_schlick.v, shd_coef_rom.v,
+shd_pipe_reg.v), span is shd_span_unit (rtl/shd_span_unit.v). Everything below is about the spec
+unit except where "A span configuration" says otherwise. The spec unit's parameter Kind chooses its
+datapath (0 poly, 1 table, 2 schlick; rtl/shd_spec_unit.v); a parameter the configuration leaves
+out takes the Verilog default (Kind 0, TableBits 8) here as in the RTL.
   --prom    the PROM ($readmemh hex file). Default: the repository's vectors/prom/spec_<name>.hex
             when it exists and CONFIG is the registry's configuration of that name (the same JSON);
             otherwise make one with `shadesim prom --config CONFIG --format hex -o FILE` and pass
@@ -27,7 +29,9 @@ The "rtl" object of the configuration becomes one `chparam -set Name Value ... s
 (one command: separate chparams elaborate the module once per parameter, with old and new values
 mixed, and yosys warns about out-of-range selects in those intermediate modules); the PROM
 becomes RomFile, an absolute path (yosys reads it at elaboration: `initial $readmemh` under
-SYNTHESIS). The PROM must hold exactly 2^ShinBits words of the configuration's word width.
+SYNTHESIS). The PROM must hold exactly its depth of words of the configuration's word width:
+2^ShinBits words (2^(ShinBits+TableBits) for Kind 1) of KW = CoefIntBits+CoefFracBits bits (Kind 0
+degree 2, Kind 2), 2*KW+CosFracBits+1 bits (Kind 0 degree 3) or SpecFracBits+1 bits (Kind 1).
 Paths travel inside yosys commands (RomFile as a Verilog string), so the PROM, the output
 directory and the RTL directory must not contain whitespace, quotes, backslashes or ';'.
 Flows:
@@ -52,8 +56,8 @@ Output (in --out; every file is written under a temporary name and renamed):
 
 --check makes the run fail (exit 1) unless the netlist is what the RTL is meant to become:
   rom_bram  The PROM is entirely in block RAM, and in the least block RAM its contents need.
-            yosys drops PROM bit columns that are constant over all 2^ShinBits words, so the
-            geometry is depth 2^ShinBits x (columns that vary in the hex file). iCE40: the
+            yosys drops PROM bit columns that are constant over all the words, so the
+            geometry is depth (as above) x (columns that vary in the hex file). iCE40: the
             SB_RAM40_4K count equals min over its read modes 256x16, 512x8, 1024x4, 2048x2 of
             ceil(depth/d)*ceil(width/w). xc7: the capacity in kbit equals the least one over the
             RAMB18E1 (16384x1 .. 512x36) and RAMB36E1 (32768x1 .. 512x72) aspect ratios (yosys
@@ -63,11 +67,13 @@ Output (in --out; every file is written under a temporary name and renamed):
   dsps      The DSP count equals what the multipliers need. Operand widths come from the RTL
             header's derivation (uQ1.Wc: CW = Wc+1; KW = Ci+Cf; DTW = Df-1; GTW = Ci+1+Hf;
             FW = Wf+1; L = LightBits):
-              MUL1     c*c           CW x CW unsigned
+              MUL1     c*c           CW x CW unsigned                      (Kind 0)
               MUL2     deg 2: a*dt   (KW+1) x DTW signed (a is unsigned: one zero sign bit)
-                       deg 3: gt*dt  GTW x DTW signed
-              Horner   deg 3: u*c    KW x (CW+1) signed
-              MUL3..5  f*L           FW x L unsigned (three of them)
+                       deg 3: gt*dt  GTW x DTW signed                      (Kind 0)
+              Horner   deg 3: u*c    KW x (CW+1) signed                    (Kind 0)
+              den      m*(1-c)       KW x CW unsigned                      (Kind 2)
+              MUL3..5  f*L           FW x L unsigned (three of them)       (every Kind)
+            (Kind 1, the table, has MUL3..5 only; the Kind 2 divider has no multiplier.)
             and each is tiled the way yosys's share/mul2dsp.v does it (iCE40: 16x16 tiles;
             pieces narrower than 2 bits or with a product under 11 bits go to LUTs. xc7:
             signed-only 25x18 tiles, 17-bit A slices, products under 9 bits to LUTs). Fails
@@ -113,13 +119,19 @@ import shd_config  # noqa: E402  (found next to this script)
 ROOT = os.path.dirname(HERE)  # the source tree, or <prefix>/share/shadesim
 PROG = "synth.py"
 
-# The parameters the checks below use; the configuration must define them.
+# The parameters the checks below use; the configuration must define them (the spec unit's per
+# Kind; Kind and TableBits themselves may be left out: SPEC_DEFAULTS).
 REQUIRED = {
-    "spec": ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
-             "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"],
+    "spec": {0: ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
+                 "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"],
+             1: ["ShinBits", "SpecFracBits", "LightBits"],
+             2: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"]},
     "span": ["NumTri", "LanesPerTri", "AlignLanes", "NumAttr", "AttrBits",
              "CoordBits", "RemBits", "PixBits", "TagBits"],
 }
+# The spec unit's Verilog defaults of the parameters a configuration may leave out.
+SPEC_DEFAULTS = {"Kind": 0, "TableBits": 8}
+SPEC_KINDS = {0: "poly", 1: "table", 2: "schlick"}
 
 FLOWS = {
     "ice40": "synth_ice40 -dsp",
@@ -170,10 +182,33 @@ def load_config(ref, unit):
         raise InputError(f"{ref}: name the unit (--unit spec|span)")
     if unit is not None and c.unit != unit:
         raise InputError(f"{ref} is a {c.unit} configuration, not {unit} (--unit {unit})")
-    for name in REQUIRED[c.unit]:
-        if name not in c.rtl:
-            raise InputError(f"{c.path}: rtl.{name} is missing")
+    try:
+        missing = missing_params(c.unit, c.rtl)
+    except ValueError as e:
+        raise InputError(f"{c.path}: {e}")
+    if missing:
+        raise InputError(f"{c.path}: rtl.{missing[0]} is missing")
     return c
+
+
+def spec_params(rtl):
+    """A spec configuration's "rtl" object with the Verilog defaults of what it leaves out."""
+    return dict(SPEC_DEFAULTS, **rtl)
+
+
+def missing_params(unit, rtl):
+    """The parameters the checks need that `rtl` lacks or holds as a non-integer (for spec, those
+    of its Kind); a ValueError for a Kind that is not one of SPEC_KINDS."""
+    if unit == "span":
+        need = REQUIRED[unit]
+    else:
+        kind = spec_params(rtl)["Kind"]
+        if type(kind) is not int or kind not in SPEC_KINDS:
+            raise ValueError(f"rtl.Kind = {json.dumps(kind)} is not one of "
+                             + ", ".join(f"{k} ({n})" for k, n in SPEC_KINDS.items()))
+        need = REQUIRED[unit][kind] + (["TableBits"] if kind == 1 else [])
+        rtl = spec_params(rtl)
+    return [n for n in need if not isinstance(rtl.get(n), int)]
 
 
 def default_prom(c, ref):
@@ -197,9 +232,16 @@ def default_prom(c, ref):
 
 def prom_geometry(path, p):
     """(depth, word bits, bit columns that vary) of a $readmemh file; fails on a malformed one."""
-    depth = 1 << p["ShinBits"]
-    kw = p["CoefIntBits"] + p["CoefFracBits"]
-    word_bits = kw if p["Degree"] == 2 else 2 * kw + p["CosFracBits"] + 1
+    p = spec_params(p)
+    kind = p["Kind"]
+    addr_bits = p["ShinBits"] + (p["TableBits"] if kind == 1 else 0)
+    depth_text = "2^(ShinBits+TableBits)" if kind == 1 else "2^ShinBits"
+    depth = 1 << addr_bits
+    if kind == 1:
+        word_bits = p["SpecFracBits"] + 1
+    else:
+        kw = p["CoefIntBits"] + p["CoefFracBits"]
+        word_bits = kw if kind == 2 or p["Degree"] == 2 else 2 * kw + p["CosFracBits"] + 1
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()
@@ -215,7 +257,7 @@ def prom_geometry(path, p):
             addr = int(tok[1:].replace("_", ""), 16)
             continue
         if addr >= depth:
-            raise InputError(f"{path}: more than {depth} words (2^ShinBits)")
+            raise InputError(f"{path}: more than {depth} words ({depth_text})")
         if re.fullmatch(r"[0-9a-fA-F_]+", tok) is None:
             raise InputError(f"{path}: '{tok}' is not a hex word")
         v = int(tok.replace("_", ""), 16)
@@ -224,7 +266,7 @@ def prom_geometry(path, p):
         words[addr] = v
         addr += 1
     if len(words) != depth:
-        raise InputError(f"{path}: {len(words)} words, the unit needs {depth} (2^ShinBits)")
+        raise InputError(f"{path}: {len(words)} words, the unit needs {depth} ({depth_text})")
     vals = list(words.values())
     varying = sum(1 for b in range(word_bits) if len({(v >> b) & 1 for v in vals}) > 1)
     return depth, word_bits, varying
@@ -349,19 +391,26 @@ def multipliers(unit, p):
         # icur = irow + didx*(xg - xref): AttrBits x (CoordBits+1) signed, low AttrBits used.
         return [(f"row start didx{a}*(xg-xref)", p["AttrBits"], p["CoordBits"] + 1, True, True,
                  p["AttrBits"]) for a in range(p["NumAttr"])]
-    wc = p["CosFracBits"]
-    cw = wc + 1
-    kw = p["CoefIntBits"] + p["CoefFracBits"]
-    dtw = p["DiffFracBits"] - 1
-    gtw = p["CoefIntBits"] + 1 + p["HornerFracBits"]
+    p = spec_params(p)
     fw = p["SpecFracBits"] + 1
     lb = p["LightBits"]
-    m = [("MUL1 c*c", cw, cw, False, False, 2 * wc - 1)]      # only c^2 - c's bits are used
-    if p["Degree"] == 2:
-        m.append(("MUL2 a*dt", kw + 1, dtw, True, True, kw + dtw))
-    else:
-        m.append(("Horner u*c", kw, cw + 1, True, True, kw + wc))
-        m.append(("MUL2 gt*dt", gtw, dtw, True, True, gtw + dtw))
+    m = []
+    if p["Kind"] == 0:
+        wc = p["CosFracBits"]
+        cw = wc + 1
+        kw = p["CoefIntBits"] + p["CoefFracBits"]
+        dtw = p["DiffFracBits"] - 1
+        gtw = p["CoefIntBits"] + 1 + p["HornerFracBits"]
+        m.append(("MUL1 c*c", cw, cw, False, False, 2 * wc - 1))  # only c^2 - c's bits are used
+        if p["Degree"] == 2:
+            m.append(("MUL2 a*dt", kw + 1, dtw, True, True, kw + dtw))
+        else:
+            m.append(("Horner u*c", kw, cw + 1, True, True, kw + wc))
+            m.append(("MUL2 gt*dt", gtw, dtw, True, True, gtw + dtw))
+    elif p["Kind"] == 2:
+        cw = p["CosFracBits"] + 1
+        kw = p["CoefIntBits"] + p["CoefFracBits"]
+        m.append(("den m*omc", kw, cw, False, False, kw + cw))    # den = m*(1-c) + 1
     for k, ch in enumerate("RGB"):
         m.append((f"MUL{3 + k} f*L{ch}", fw, lb, False, False, fw - 1 + lb))
     return m
@@ -504,7 +553,10 @@ def predict_dsps(path, unit, targets):
         raise InputError(f"--dsps-of {path}: not a JSON array of rtl objects")
     out = []
     for i, rtl in enumerate(points):
-        missing = [n for n in REQUIRED[unit] if not isinstance(rtl, dict) or not isinstance(rtl.get(n), int)]
+        try:
+            missing = missing_params(unit, rtl if isinstance(rtl, dict) else {})
+        except ValueError as e:
+            raise InputError(f"--dsps-of {path}: item {i}: {e}")
         if missing:
             raise InputError(f"--dsps-of {path}: item {i}: rtl.{missing[0]} is missing or not an integer")
         out.append({t: sum(tiles(TECH[t], *m[1:]) for m in multipliers(unit, rtl)) for t in targets})

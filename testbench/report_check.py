@@ -192,6 +192,47 @@ def check_pnr_table(report, body):
     check(len(body) == want, f"report.md place and route: {len(body)} lines for {want} unit placements")
 
 
+def prom_bits(rtl):
+    """Depth x word width of a specular configuration's PROM, from its parameters
+    (rtl/shd_spec_unit.v)."""
+    kind, kw = rtl.get("Kind", 0), rtl["CoefIntBits"] + rtl["CoefFracBits"]
+    if kind == 1:
+        return (1 << (rtl["ShinBits"] + rtl["TableBits"])) * (rtl["SpecFracBits"] + 1)
+    if kind == 2:
+        return (1 << rtl["ShinBits"]) * kw
+    return (1 << rtl["ShinBits"]) * (kw if rtl["Degree"] == 2 else 2 * kw + rtl["CosFracBits"] + 1)
+
+
+def check_spec_units_table(report, header, body):
+    units = report["units"]["spec"]
+    check(len(body) == len(units), f"report.md specular units: {len(body)} lines for {len(units)} units")
+    for cells in body:
+        name = cells[0].strip("`")
+        u = units[name]
+        rtl = u["rtl"]
+        check(u["latency"] == 2 + rtl["PipeStages"], f"report.json units.spec.{name}.latency = {u['latency']}")
+        check(u["prom_bits"] == prom_bits(rtl), f"report.json units.spec.{name}.prom_bits = {u['prom_bits']}, "
+              f"the parameters give {prom_bits(rtl)}")
+        pf = next((r for r in report["rows"] if r["lobe"] == u["lobe"] and r["method"] == "phong-fixed"), {})
+        want = [u["kind"], f"`{u['lobe']}`", fmt(u["latency"], 0), fmt(u["prom_bits"], 0)]
+        for h in header[5:]:
+            if h.startswith("iCE40 "):
+                want.append(fmt(get(u, ("area", "ice40", {"LUT": "luts", "DSP": "dsps", "BRAM": "brams"}[h[6:]])), 0))
+            elif h.endswith(" MHz"):
+                want.append(fmt(get(u, ("pnr", h[:-4].lower(), "fmax_mhz")), 2))
+            elif h == "unit max LSB":
+                want.append(fmt(get(u, ("scene_error", "total_max_lsb")), 2))
+            elif h == "unit peak LSB":
+                want.append(fmt(get(u, ("scene_error", "total_peak_max_lsb")), 2))
+            elif h == "phong-fixed max LSB":
+                want.append(fmt(get(pf, ("metrics", "max_abs_lsb")), 2))
+            elif h == "phong-fixed hl max LSB":
+                want.append(fmt(get(pf, ("highlight", "max_abs_lsb")), 2))
+            else:
+                failures.append(f"report.md specular units: unknown column {h!r}")
+        check(cells[1:] == want, f"report.md specular units {name}: {cells[1:]} != {want}")
+
+
 def check_markdown(d, report):
     md = open(os.path.join(d, "report.md"), encoding="utf-8").read()
     sheet = report["contact_sheet"]
@@ -204,6 +245,8 @@ def check_markdown(d, report):
             check_units_table(report, header, body)
         elif heading == "Place and route":
             check_pnr_table(report, body)
+        elif heading == "Specular units compared":
+            check_spec_units_table(report, header, body)
         elif heading == "Contact sheet":
             key = "rows" if header[1] == "lobe" else "columns"
             prefix = "row" if key == "rows" else "column"

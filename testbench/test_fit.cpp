@@ -67,7 +67,7 @@ TEST(FitKind, ParseRejectsUnknownNames) {
       ADD_FAILURE() << "accepted '" << s << "'";
     } catch (const std::invalid_argument& e) {
       EXPECT_EQ(std::string(e.what()), std::string("unknown fit '") + s +
-                                           "' (expected inflection, level, shortcut or minimax)");
+                                           "' (expected inflection, level, shortcut, minimax or exact)");
     }
   }
 }

@@ -53,19 +53,25 @@ void expectClean(const SpecCosimResult& r, const CosimSetup& s) {
 
 }  // namespace
 
-TEST(SpecCosim, ExhaustiveDefaultConfiguration) {
-  const CosimSetup s = setup("default");
+// Every input of the paper's device (default) and of each alternative kind (table, schlick).
+class SpecCosimExhaustive : public testing::TestWithParam<std::string> {};
+
+TEST_P(SpecCosimExhaustive, EveryInput) {
+  const std::string name = GetParam();
+  const CosimSetup s = setup(name);
   SpecUnitModel model(s.table.unit, s.table.words);
   const uint64_t seed = 1;
   ExhaustiveSpecStimulus stim(s.table.unit, seed);
-  const SpecCosimResult r = runSpecCosim("default", model, stim, options(s));
-  std::printf("exhaustive default: seed %llu, %llu vectors, %llu cycles, %llu mismatches, %.2f s (%.1f M vectors/s)\n",
-              static_cast<unsigned long long>(seed), static_cast<unsigned long long>(r.vectors),
+  const SpecCosimResult r = runSpecCosim(name, model, stim, options(s));
+  std::printf("exhaustive %s: seed %llu, %llu vectors, %llu cycles, %llu mismatches, %.2f s (%.1f M vectors/s)\n",
+              name.c_str(), static_cast<unsigned long long>(seed), static_cast<unsigned long long>(r.vectors),
               static_cast<unsigned long long>(r.cycles), static_cast<unsigned long long>(r.mismatches), r.seconds,
               r.vectors / r.seconds / 1e6);
-  EXPECT_EQ(r.vectors, static_cast<uint64_t>(s.table.unit.promDepth()) << (s.table.unit.CosFracBits + 1));
+  EXPECT_EQ(r.vectors, static_cast<uint64_t>(s.table.unit.shinCodes()) << (s.table.unit.CosFracBits + 1));
   expectClean(r, s);
 }
+
+INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimExhaustive, testing::Values("default", "table", "schlick"));
 
 class SpecCosimRandom : public testing::TestWithParam<std::string> {};
 
@@ -83,7 +89,7 @@ TEST_P(SpecCosimRandom, SeededWithValidGaps) {
   expectClean(r, s);
 }
 
-INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimRandom, testing::Values("narrow", "default", "wide", "cubic"));
+INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimRandom, testing::Values("narrow", "default", "wide", "cubic", "table", "schlick"));
 
 TEST(SpecCosim, DetectsADatapathDifferenceAndDumpsTheWindow) {
   // The checker must be able to fail: the model truncates c^2 - c one bit earlier than the RTL.

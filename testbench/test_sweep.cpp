@@ -105,7 +105,7 @@ TEST(SpecSweep, PointParamsAndTheirDerivations) {
   EXPECT_NE(e.find("point DiffFracBits=21"), std::string::npos) << e;
   EXPECT_NE(e.find("c^2 - c is exact at 2*CosFracBits"), std::string::npos) << e;
   const auto names = specParamNames();
-  EXPECT_EQ(names.size(), 10u);
+  EXPECT_EQ(names.size(), 12u);
   EXPECT_NE(std::find(names.begin(), names.end(), "SpecFracBits"), names.end());
 }
 

@@ -168,20 +168,21 @@ TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
         continue;
       }
       shin0 += in.shin == 0;
-      shin_max += in.shin == static_cast<uint32_t>(p.promDepth() - 1);
+      shin_max += in.shin == static_cast<uint32_t>(p.shinCodes() - 1);
       cos0 += in.cos == 0;
       cos_one += in.cos == one;
       cos_above += in.cos > one;
       cos_max += in.cos == 2 * one - 1;
       dark += in.light == std::array<uint32_t, 3>{0, 0, 0};
       full += in.light == std::array<uint32_t, 3>{lmax, lmax, lmax};
-      const int64_t cut = decodePromWord(words[in.shin], p).cut;
-      below_cut += p.Degree == 3 && cut > 0 && in.cos + 1 == cut;
-      at_cut += p.Degree == 3 && cut > 0 && in.cos == cut;
+      const bool cubic = p.kind() == SpecKind::Poly && p.Degree == 3;
+      const int64_t cut = cubic ? decodePromWord(words[in.shin], p).cut : 0;
+      below_cut += cut > 0 && in.cos + 1 == cut;
+      at_cut += cut > 0 && in.cos == cut;
     }
     for (uint64_t n : {shin0, shin_max, cos0, cos_one, cos_above, cos_max, dark, full}) EXPECT_GT(n, 0u) << config;
     EXPECT_GT(gaps, 100u) << config;  // valid dropped between valid inputs
-    if (p.Degree == 3) {
+    if (p.kind() == SpecKind::Poly && p.Degree == 3) {
       EXPECT_GT(below_cut, 10u) << config;  // f cut to 0 one code below the cut-off ...
       EXPECT_GT(at_cut, 10u) << config;     // ... and not at it
     }

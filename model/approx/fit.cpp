@@ -18,15 +18,16 @@ const char* toString(FitKind k) {
     case FitKind::Level: return "level";
     case FitKind::Shortcut: return "shortcut";
     case FitKind::Minimax: return "minimax";
+    case FitKind::Exact: return "exact";
   }
   return "?";
 }
 
 FitKind parseFitKind(std::string_view s) {
-  for (FitKind k : {FitKind::Inflection, FitKind::Level, FitKind::Shortcut, FitKind::Minimax})
+  for (FitKind k : {FitKind::Inflection, FitKind::Level, FitKind::Shortcut, FitKind::Minimax, FitKind::Exact})
     if (s == toString(k)) return k;
   throw std::invalid_argument(
-      fmt::format("unknown fit '{}' (expected inflection, level, shortcut or minimax)", s));
+      fmt::format("unknown fit '{}' (expected inflection, level, shortcut, minimax or exact)", s));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -66,12 +67,22 @@ double Approx::poly(double c) const {
 
 double Approx::eval(double c) const {
   c = clamp01(c);
+  if (form == Form::Schlick) return c / (n - n * c + c);
+  if (form == Form::Table) {
+    const double scaled = std::floor(std::ldexp(c, tableBits()));
+    return table[static_cast<size_t>(std::min(scaled, static_cast<double>(table.size() - 1)))];
+  }
   if (degree == 3 && c < cut) return 0.0;
   return clamp01(poly(c));
 }
 
 std::vector<double> Approx::kinks() const {
   std::vector<double> k;
+  if (form == Form::Schlick) return k;
+  if (form == Form::Table) {
+    for (size_t i = 1; i < table.size(); ++i) k.push_back(std::ldexp(static_cast<double>(i), -tableBits()));
+    return k;
+  }
   const double lo = degree == 3 ? cut : 0.0;
   if (degree == 3 && cut > 0.0) k.push_back(cut);
   const double u = degree == 3 ? a1 : 0.0;
@@ -116,6 +127,28 @@ Approx Approx::cubic(double a1, double b1) {
   f.c1 = 1.0 - a1 - b1;
   f.cut = localMinInUnit(a1, a1 + b1);
   return f;
+}
+
+Approx Approx::schlick(double n) {
+  Approx f;
+  f.form = Form::Schlick;
+  f.n = n;
+  return f;
+}
+
+Approx Approx::stepTable(std::vector<double> values) {
+  if (values.empty() || (values.size() & (values.size() - 1)) != 0)
+    throw std::invalid_argument(fmt::format("a step table needs a power-of-two size, got {}", values.size()));
+  Approx f;
+  f.form = Form::Table;
+  f.table = std::move(values);
+  return f;
+}
+
+int Approx::tableBits() const {
+  int t = 0;
+  while ((size_t{1} << t) < table.size()) ++t;
+  return t;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -170,8 +203,9 @@ double quadraticA(FitKind kind, double n, double level_q) {
     }
     case FitKind::Shortcut: return 0.786 * n;
     case FitKind::Minimax: return minimaxQuadratic(n).a;
+    case FitKind::Exact: break;
   }
-  throw std::invalid_argument("quadraticA: bad fit kind");
+  throw std::invalid_argument("fit 'exact' has no polynomial: it is the fit of the table and schlick kinds");
 }
 
 Approx cubicMatchedAt(double n, double log_s) {
@@ -214,6 +248,7 @@ Approx fitApprox(FitKind kind, int degree, double n, double level_q) {
     case FitKind::Shortcut:
       throw std::invalid_argument("fit 'shortcut' exists only for degree 2");
     case FitKind::Minimax: return minimaxCubic(n).approx;
+    case FitKind::Exact: break;
   }
   throw std::invalid_argument("fitApprox: bad fit kind");
 }

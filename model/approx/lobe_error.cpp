@@ -359,7 +359,12 @@ ApproxErrorSummary summarizeError(const Approx& f, double n) {
   s.approx = f;
   for (const Region& reg : standardRegions(n)) {
     const bool rel = std::string_view(reg.name) != "lobe";
-    s.regions.push_back({reg, maxErrorExact(f, n, reg.lo, reg.hi, rel)});
+    // The exact method covers the polynomial; the table's steps and Schlick's rational are
+    // sampled with their kinks as breakpoints (maxError, whose guarantee holds for both).
+    const RegionError e = f.form == Approx::Form::Poly
+                              ? maxErrorExact(f, n, reg.lo, reg.hi, rel)
+                              : maxError([&](double c) { return f.eval(c); }, n, reg.lo, reg.hi, rel, f.kinks());
+    s.regions.push_back({reg, e});
   }
   return s;
 }

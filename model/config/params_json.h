@@ -15,10 +15,12 @@ template <class P>
 struct ParamMember {
   const char* name;
   int P::*field;
+  bool optional = false;  // may be omitted: keeps the struct's default, which is the Verilog default
 };
 
 // Every member of `rtl` must be one of `members` and an integer that fits an int; with
-// all_required every one of `members` must be present (otherwise the struct's defaults stay).
+// all_required every one of `members` that is not optional must be present (otherwise the
+// struct's defaults stay).
 // Then P::validate(). std::invalid_argument naming `where` and the member.
 template <class P, size_t N>
 P paramsFromJson(const nlohmann::json& rtl, const ParamMember<P> (&members)[N], bool all_required,
@@ -44,7 +46,7 @@ P paramsFromJson(const nlohmann::json& rtl, const ParamMember<P> (&members)[N], 
   }
   if (all_required)
     for (const ParamMember<P>& m : members)
-      if (!rtl.contains(m.name)) throw std::invalid_argument(fmt::format("{}: rtl.{} missing", where, m.name));
+      if (!m.optional && !rtl.contains(m.name)) throw std::invalid_argument(fmt::format("{}: rtl.{} missing", where, m.name));
   try {
     p.validate();
   } catch (const std::invalid_argument& e) {

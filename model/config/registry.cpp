@@ -174,7 +174,7 @@ SpecUnitConfig SpecUnitConfig::parse(const std::string& text, const std::string&
   if (!has_rtl) throw std::invalid_argument(fmt::format("{}: missing \"rtl\" (the Verilog parameters)", where));
   if (!has_prom) throw std::invalid_argument(fmt::format("{}: missing \"prom\" (fit and shininess list)", where));
   try {
-    PromRequest::fromContent(c.prom);
+    checkFitForKind(PromRequest::fromContent(c.prom).fit, c.rtl);
   } catch (const std::invalid_argument& e) {
     throw std::invalid_argument(fmt::format("{}: prom: {}", where, e.what()));
   }

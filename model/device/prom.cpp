@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 
 #include <fmt/format.h>
 
@@ -21,6 +22,44 @@ double parseNumber(std::string_view tok, std::string_view whole) {
   if (s.empty() || end != s.c_str() + s.size() || errno != 0 || !std::isfinite(v))
     throw std::invalid_argument(fmt::format("n '{}': '{}' is not a number", whole, tok));
   return v;
+}
+
+using Quantise = std::function<int64_t(double, const char*, double)>;
+
+void fillPolyEntry(PromEntry& e, const PromRequest& req, const SpecUnitParams& unit, const Quantise& quantise) {
+  e.approx = fitApprox(req.fit, unit.Degree, e.n, req.level);
+  if (unit.Degree == 2) {
+    e.u_real = e.approx.a;
+    e.code.u = quantise(e.u_real, "a", e.n);
+  } else {
+    e.u_real = e.approx.a1;
+    e.v_real = e.approx.a1 + e.approx.b1;
+    e.cut_real = e.approx.cut;
+    e.code.u = quantise(e.u_real, "a1", e.n);
+    e.code.v = quantise(e.v_real, "a1+b1", e.n);
+    e.code.cut = static_cast<int64_t>(std::ceil(std::ldexp(e.cut_real, unit.CosFracBits)));
+  }
+}
+
+// The table's row for e.n: bucket k holds the cos codes whose index is k (rtl/shd_spec_unit.v:
+// min(c >> (Wc - T), 2^T - 1), so the last bucket also holds c = 1.0). Its value minimises the
+// largest error over those codes: the midpoint of c^n at the bucket's first and last code,
+// rounded half-even to uQ1.Wf. The row is words (e.address << T) .. + 2^T - 1.
+void fillTableEntry(PromEntry& e, const SpecUnitParams& unit, std::vector<PromWord>& words) {
+  const int t = unit.TableBits, shift = unit.CosFracBits - t;
+  const size_t buckets = size_t{1} << t;
+  std::vector<double> values(buckets);
+  for (size_t k = 0; k < buckets; ++k) {
+    const int64_t first = static_cast<int64_t>(k) << shift;
+    const int64_t last = k + 1 == buckets ? unit.cosOne() : first + (int64_t{1} << shift) - 1;
+    values[k] = 0.5 * (std::pow(std::ldexp(static_cast<double>(first), -unit.CosFracBits), e.n) +
+                       std::pow(std::ldexp(static_cast<double>(last), -unit.CosFracBits), e.n));
+    SpecCoef code;
+    code.u = Fixed::fromDouble(values[k], unit.specFormat(), Quant::RoundHalfEven, Overflow::Error).raw();
+    words[(static_cast<size_t>(e.address) << t) | k] = encodePromWord(code, unit);
+  }
+  e.approx = Approx::stepTable(std::move(values));
+  e.u_real = std::nan("");  // no single stored quantity: the row's reals are e.approx.table
 }
 
 }  // namespace
@@ -82,15 +121,25 @@ int addressBitsFor(size_t count) {
   return bits;
 }
 
+void checkFitForKind(FitKind fit, const SpecUnitParams& unit) {
+  const bool exact = fit == FitKind::Exact;
+  if (exact != (unit.kind() != SpecKind::Poly))
+    throw std::invalid_argument(fmt::format(
+        "fit {} does not apply to the {} kind (the poly kind takes inflection, level, shortcut or minimax; the "
+        "table and schlick kinds take exact)",
+        toString(fit), specKindInfo(unit.kind()).name));
+}
+
 PromTable buildPromTable(const PromRequest& req, const SpecUnitParams& unit) {
   unit.validate();
+  checkFitForKind(req.fit, unit);
   PromTable t;
   t.unit = unit;
   t.request = req;
-  if (req.n.values.size() > static_cast<size_t>(unit.promDepth()))
+  if (req.n.values.size() > static_cast<size_t>(unit.shinCodes()))
     throw std::invalid_argument(fmt::format(
         "n '{}' has {} codes but ShinBits = {} addresses only {}; use ShinBits >= {}", req.n.text,
-        req.n.values.size(), unit.ShinBits, unit.promDepth(), addressBitsFor(req.n.values.size())));
+        req.n.values.size(), unit.ShinBits, unit.shinCodes(), addressBitsFor(req.n.values.size())));
   const FixedFormat cf = unit.coefFormat();
   auto quantise = [&](double x, const char* what, double n) {
     try {
@@ -107,19 +156,16 @@ PromTable buildPromTable(const PromRequest& req, const SpecUnitParams& unit) {
     PromEntry e;
     e.address = static_cast<uint32_t>(i);
     e.n = req.n.values[i];
-    e.approx = fitApprox(req.fit, unit.Degree, e.n, req.level);
-    if (unit.Degree == 2) {
-      e.u_real = e.approx.a;
-      e.code.u = quantise(e.u_real, "a", e.n);
-    } else {
-      e.u_real = e.approx.a1;
-      e.v_real = e.approx.a1 + e.approx.b1;
-      e.cut_real = e.approx.cut;
-      e.code.u = quantise(e.u_real, "a1", e.n);
-      e.code.v = quantise(e.v_real, "a1+b1", e.n);
-      e.code.cut = static_cast<int64_t>(std::ceil(std::ldexp(e.cut_real, unit.CosFracBits)));
+    switch (unit.kind()) {
+      case SpecKind::Poly: fillPolyEntry(e, req, unit, quantise); break;
+      case SpecKind::Schlick:
+        e.approx = Approx::schlick(e.n);
+        e.u_real = e.n - 1.0;
+        e.code.u = quantise(e.u_real, "m = n - 1", e.n);
+        break;
+      case SpecKind::Table: fillTableEntry(e, unit, t.words); break;
     }
-    t.words[i] = encodePromWord(e.code, unit);
+    if (unit.kind() != SpecKind::Table) t.words[i] = encodePromWord(e.code, unit);
     t.entries.push_back(e);
   }
   return t;

@@ -1,10 +1,13 @@
 // The coefficient PROM of the specular unit: which shininess values it holds (the address
 // map), the fitted real coefficients, and their codes in the unit's coefficient format.
 //
-// Address map: entry i of the n list sits at address i. A range "lo:hi[:step]" lists
+// Address map: entry i of the n list sits at address i (the table kind: its row of 2^TableBits
+// words starts at i << TableBits). A range "lo:hi[:step]" lists
 // lo, lo+step, ... up to hi; an explicit list "8,32,200" keeps the user's order. Addresses from
 // the number of entries up to 2^ShinBits - 1 are unused and hold the all-zero word (degree 2:
-// a = 0, f = c; degree 3: u = v = 0, no cut, f = c).
+// a = 0, f = c; degree 3: u = v = 0, no cut, f = c; schlick: m = 0, f = c; table: f = 0).
+// Contents per kind: poly, the fitted coefficients; schlick, m = n - 1; table, the values of
+// c^n per cosine bucket (prom.cpp fillTableEntry).
 // Rounding of the coefficients: round-half-even to the coefficient format (the table is made
 // once, offline; half-even has no bias). A coefficient that does not fit the format is an
 // error naming the fit, n and the format. The degree 3 cut-off code is ceil(cut * 2^Wc), so the
@@ -47,7 +50,7 @@ struct PromEntry {
   double n = 0;
   Approx approx;                // real coefficients
   SpecCoef code;                // raw codes stored in the word
-  double u_real = 0, v_real = 0, cut_real = 0;  // the stored quantities before rounding
+  double u_real = 0, v_real = 0, cut_real = 0;  // the stored quantities before rounding (not the table's)
 };
 
 struct PromTable {
@@ -59,6 +62,10 @@ struct PromTable {
   // Index of the entry for shininess n, or -1.
   int addressOf(double n) const;
 };
+
+// std::invalid_argument unless the fit applies to the unit's kind: exact for the table and schlick
+// kinds, any other for the poly kind.
+void checkFitForKind(FitKind fit, const SpecUnitParams& unit);
 
 // Smallest ShinBits whose PROM holds `count` codes (at least 1).
 int addressBitsFor(size_t count);

@@ -37,6 +37,9 @@ struct Field {
 // Everything the provenance says, computed once so that the comment lines of every format and
 // the JSON sidecar state the same facts.
 struct Provenance {
+  SpecKind kind = SpecKind::Poly;
+  int table_bits = 0;  // the table kind: words per row = 2^table_bits
+  std::string spec_format;
   std::string tool;
   std::string fit;
   int degree = 2;
@@ -69,15 +72,23 @@ Provenance provenanceOf(const PromTable& t) {
   p.depth = u.promDepth();
   p.shin_bits = u.ShinBits;
   p.cos_frac_bits = u.CosFracBits;
+  p.kind = u.kind();
+  p.spec_format = u.specFormat().str();
   const int cw = u.coefFormat().width();
-  if (u.Degree == 2) {
+  p.used = t.entries.size();
+  if (p.kind == SpecKind::Table) {
+    p.table_bits = u.TableBits;
+    p.used <<= u.TableBits;
+    p.layout.push_back({"f = c^n", p.spec_format, u.SpecFracBits, 0});
+  } else if (p.kind == SpecKind::Schlick) {
+    p.layout.push_back({"m = n-1", p.coef_format, cw - 1, 0});
+  } else if (u.Degree == 2) {
     p.layout.push_back({"a", p.coef_format, cw - 1, 0});
   } else {
     p.layout.push_back({"cut", p.cos_format, 2 * cw + u.CosFracBits, 2 * cw});
     p.layout.push_back({"v = a1+b1", p.coef_format, 2 * cw - 1, cw});
     p.layout.push_back({"a1", p.coef_format, cw - 1, 0});
   }
-  p.used = t.entries.size();
   return p;
 }
 
@@ -90,10 +101,36 @@ std::string layoutText(const Provenance& p) {
   return s + "}";
 }
 
+// The lines of the table and schlick kinds after the first.
+std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std::string> l) {
+  const bool table = p.kind == SpecKind::Table;
+  l.push_back(fmt::format("kind: {}, fit: {}", specKindInfo(p.kind).name, p.fit));
+  l.push_back(fmt::format("n: {} '{}', {} codes; {} i holds the i-th n{}", p.n_is_list ? "list" : "range",
+                          p.n_text, p.n_count, table ? "row" : "address",
+                          p.n_is_list ? " of the list (address map: <file>.map.csv)" : ""));
+  if (table)
+    l.push_back(fmt::format("content: row i is addresses i*{0}..i*{0}+{1}, word k the minimax value of c^n over the "
+                            "cos codes c ({2}) with min(c >> {3}, {1}) = k, round-half-even to {4}",
+                            1 << p.table_bits, (1 << p.table_bits) - 1, p.cos_format,
+                            p.cos_frac_bits - p.table_bits, p.spec_format));
+  else
+    l.push_back(fmt::format("content: m = n - 1 {}, {}; f = c / (m (1 - c) + 1); cos: {}", p.coef_format,
+                            p.coef_round, p.cos_format));
+  l.push_back(fmt::format("word: {} bits = {} (MSB to LSB)", p.word_bits, layoutText(p)));
+  l.push_back(fmt::format("depth: {} words, addresses 0..{} hold the {} codes", p.depth, p.used - 1, p.n_count));
+  if (p.used < static_cast<size_t>(p.depth))
+    l.push_back(fmt::format("padding: addresses {}..{} are unused and hold the all-zero word ({})", p.used,
+                            p.depth - 1, table ? "f = 0" : "m = 0: f = c"));
+  else
+    l.push_back("padding: none, every address holds a code");
+  return l;
+}
+
 // The provenance as comment lines without the comment marker.
 std::vector<std::string> provenanceLines(const Provenance& p) {
   std::vector<std::string> l;
   l.push_back(fmt::format("{}: specular unit coefficient PROM (rtl/shd_coef_rom.v)", p.tool));
+  if (p.kind != SpecKind::Poly) return altProvenanceLines(p, l);
   l.push_back(fmt::format("fit: {}, degree {}, level {}{}", p.fit, p.degree, p.level,
                           p.level_used ? "" : " (not used by this fit)"));
   l.push_back(fmt::format("n: {} '{}', {} codes; address i holds the i-th n{}",
@@ -143,7 +180,19 @@ void checkTable(const PromTable& t) {
 
 std::string csvTable(const PromTable& t) {
   std::string out;
-  if (t.unit.Degree == 2) {
+  if (t.unit.kind() == SpecKind::Table) {
+    out += "n,address,bucket,value_real,value_code\n";
+    for (const PromEntry& e : t.entries)
+      for (size_t k = 0; k < e.approx.table.size(); ++k) {
+        const size_t a = (static_cast<size_t>(e.address) << t.unit.TableBits) | k;
+        out += fmt::format("{},{},{},{},{}\n", real17(e.n), a, k, real17(e.approx.table[k]),
+                           decodePromWord(t.words[a], t.unit).u);
+      }
+  } else if (t.unit.kind() == SpecKind::Schlick) {
+    out += "n,address,m_real,m_code\n";
+    for (const PromEntry& e : t.entries)
+      out += fmt::format("{},{},{},{}\n", real17(e.n), e.address, real17(e.u_real), e.code.u);
+  } else if (t.unit.Degree == 2) {
     out += "n,address,a_real,a_code\n";
     for (const PromEntry& e : t.entries)
       out += fmt::format("{},{},{},{}\n", real17(e.n), e.address, real17(e.u_real), e.code.u);
@@ -262,6 +311,7 @@ std::string renderProvenanceJson(const PromTable& t) {
   nlohmann::ordered_json j;
   j["tool"] = p.tool;
   j["content"] = "specular unit coefficient PROM";
+  j["kind"] = specKindInfo(p.kind).name;
   j["fit"] = p.fit;
   j["degree"] = p.degree;
   j["level"] = p.level;

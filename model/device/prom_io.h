@@ -19,6 +19,8 @@
 //   csv  one row per entry (not the padding) with the real coefficients and their codes:
 //          degree 2: n,address,a_real,a_code
 //          degree 3: n,address,a1_real,a1_code,v_real,v_code,cut_real,cut_code
+//          schlick:  n,address,m_real,m_code                (m = n - 1)
+//          table:    n,address,bucket,value_real,value_code (one row per word of the n's row)
 //        v = a1 + b1 is the second word field (the Horner form p = c - c(1-c)(a1 c + v)); cut is
 //        the cut-off cosine and cut_code = ceil(cut * 2^Wc) the stored uQ1.Wc code. Reals carry
 //        17 significant digits (they round-trip to the same double), codes are signed decimal.

@@ -19,6 +19,8 @@ constexpr ParamMember<SpecUnitParams> kMembers[] = {
     {"SpecFracBits", &SpecUnitParams::SpecFracBits},
     {"LightBits", &SpecUnitParams::LightBits},
     {"PipeStages", &SpecUnitParams::PipeStages},
+    {"Kind", &SpecUnitParams::Kind, true},
+    {"TableBits", &SpecUnitParams::TableBits, true},
 };
 
 void require(bool ok, const char* param, int value, const std::string& rule) {
@@ -34,41 +36,93 @@ void requireModelWidth(int width, const std::string& what) {
         width, FixedFormat::kMaxWidth));
 }
 
+// The checks of one kind's own datapath (the common ones are in validate()).
+void validateTable(const SpecUnitParams& p) {
+  require(p.TableBits >= 1 && p.TableBits <= p.CosFracBits, "TableBits", p.TableBits,
+          fmt::format("must be in 1..CosFracBits = {}", p.CosFracBits));
+  require(p.ShinBits + p.TableBits <= 24, "TableBits", p.TableBits,
+          fmt::format("ShinBits + TableBits = {} exceeds the 24 address bits a PROM file may have", p.ShinBits + p.TableBits));
+  require(p.PipeStages >= 0 && p.PipeStages <= 1, "PipeStages", p.PipeStages, "must be 0 or 1 for the table");
+}
+
+void validateSchlick(const SpecUnitParams& p) {
+  require(p.PipeStages >= 0 && p.PipeStages <= p.SpecFracBits + 1, "PipeStages", p.PipeStages,
+          fmt::format("must be in 0..SpecFracBits+1 = {} (one register rank per divider step at most)",
+                      p.SpecFracBits + 1));
+  const int kw = p.CoefIntBits + p.CoefFracBits;
+  requireModelWidth(kw + p.CosFracBits + 1, "den = m*(1-c) + 1");
+  requireModelWidth(p.CosFracBits + 1 + p.CoefFracBits + p.SpecFracBits, "the dividend c * 2^(Cf+Wf)");
+}
+
+void validatePoly(const SpecUnitParams& p) {
+  require(p.Degree == 2 || p.Degree == 3, "Degree", p.Degree, "must be 2 or 3");
+  require(p.DiffFracBits >= 2 && p.DiffFracBits <= 2 * p.CosFracBits, "DiffFracBits", p.DiffFracBits,
+          fmt::format("must be in 2..2*CosFracBits = {} (c^2 - c is exact at 2*CosFracBits "
+                      "fraction bits)",
+                      2 * p.CosFracBits));
+  require(p.PipeStages >= 0 && p.PipeStages <= 3, "PipeStages", p.PipeStages, "must be in 0..3");
+  require(p.SpecFracBits >= p.CosFracBits, "SpecFracBits", p.SpecFracBits,
+          fmt::format("must be at least CosFracBits = {} (c enters Sm2 unrounded)", p.CosFracBits));
+  const int prod_frac = p.CoefFracBits + p.DiffFracBits;
+  if (p.Degree == 3) {
+    require(p.HornerFracBits >= 0 && p.HornerFracBits <= p.CoefFracBits + p.CosFracBits, "HornerFracBits",
+            p.HornerFracBits,
+            fmt::format("must be in 0..CoefFracBits+CosFracBits = {} (u*c + v is exact there)",
+                        p.CoefFracBits + p.CosFracBits));
+  }
+  const int mul2_frac = p.Degree == 2 ? prod_frac : p.HornerFracBits + p.DiffFracBits;
+  require(p.SpecFracBits <= mul2_frac, "SpecFracBits", p.SpecFracBits,
+          fmt::format("must not exceed the MUL2 product's {} fraction bits", mul2_frac));
+  // Every full-precision intermediate the model forms (formats as in Fixed's operators).
+  requireModelWidth(2 + 2 * p.CosFracBits, "MUL1 c*c");
+  if (p.Degree == 2) {
+    requireModelWidth(p.CoefIntBits + 1 + prod_frac, "MUL2 a*(c^2-c)");
+  } else {
+    requireModelWidth(p.CoefIntBits + 2 + p.CoefFracBits + p.CosFracBits, "Horner u*c + v");
+    requireModelWidth(p.CoefIntBits + 2 + p.HornerFracBits + p.DiffFracBits, "MUL2 (c^2-c)*g");
+  }
+}
+
 }  // namespace
 
+const std::vector<SpecKindInfo>& specKinds() {
+  static const std::vector<SpecKindInfo> kinds = {
+      {SpecKind::Poly, "poly", "the paper's device: a fitted polynomial, coefficients from the PROM"},
+      {SpecKind::Table, "table", "c^n read from a table over shininess and cosine codes"},
+      {SpecKind::Schlick, "schlick", "Schlick's rational c / (n - n c + c), with a divider"},
+  };
+  return kinds;
+}
+
+const SpecKindInfo& specKindInfo(SpecKind k) {
+  for (const SpecKindInfo& i : specKinds())
+    if (i.kind == k) return i;
+  throw std::invalid_argument(fmt::format("unknown specular unit kind {}", static_cast<int>(k)));
+}
+
+int SpecUnitParams::promWordBits() const {
+  switch (kind()) {
+    case SpecKind::Table: return SpecFracBits + 1;
+    case SpecKind::Schlick: return coefFormat().width();
+    case SpecKind::Poly: break;
+  }
+  return Degree == 2 ? coefFormat().width() : 2 * coefFormat().width() + CosFracBits + 1;
+}
+
 void SpecUnitParams::validate() const {
-  require(Degree == 2 || Degree == 3, "Degree", Degree, "must be 2 or 3");
+  require(Kind >= 0 && Kind < static_cast<int>(specKinds().size()), "Kind", Kind,
+          fmt::format("must be in 0..{} (0 poly, 1 table, 2 schlick)", specKinds().size() - 1));
   require(CosFracBits >= 2 && CosFracBits <= 24, "CosFracBits", CosFracBits, "must be in 2..24");
   require(ShinBits >= 1 && ShinBits <= 16, "ShinBits", ShinBits, "must be in 1..16");
   require(CoefIntBits >= 1 && CoefIntBits <= 32, "CoefIntBits", CoefIntBits, "must be in 1..32");
   require(CoefFracBits >= 0 && CoefFracBits <= 40, "CoefFracBits", CoefFracBits, "must be in 0..40");
-  require(DiffFracBits >= 2 && DiffFracBits <= 2 * CosFracBits, "DiffFracBits", DiffFracBits,
-          fmt::format("must be in 2..2*CosFracBits = {} (c^2 - c is exact at 2*CosFracBits "
-                      "fraction bits)",
-                      2 * CosFracBits));
   require(LightBits >= 1 && LightBits <= 16, "LightBits", LightBits, "must be in 1..16");
-  require(PipeStages >= 0 && PipeStages <= 3, "PipeStages", PipeStages, "must be in 0..3");
-  const int prod_frac = CoefFracBits + DiffFracBits;
-  if (Degree == 3) {
-    require(HornerFracBits >= 0 && HornerFracBits <= CoefFracBits + CosFracBits, "HornerFracBits",
-            HornerFracBits,
-            fmt::format("must be in 0..CoefFracBits+CosFracBits = {} (u*c + v is exact there)",
-                        CoefFracBits + CosFracBits));
-  }
-  const int mul2_frac = Degree == 2 ? prod_frac : HornerFracBits + DiffFracBits;
-  require(SpecFracBits >= CosFracBits && SpecFracBits <= 30, "SpecFracBits", SpecFracBits,
-          fmt::format("must be in CosFracBits = {} .. 30 (c enters Sm2 unrounded; spec_o is at "
-                      "most 31 bits)",
-                      CosFracBits));
-  require(SpecFracBits <= mul2_frac, "SpecFracBits", SpecFracBits,
-          fmt::format("must not exceed the MUL2 product's {} fraction bits", mul2_frac));
-  // Every full-precision intermediate the model forms (formats as in Fixed's operators).
-  requireModelWidth(2 + 2 * CosFracBits, "MUL1 c*c");
-  if (Degree == 2) {
-    requireModelWidth(CoefIntBits + 1 + prod_frac, "MUL2 a*(c^2-c)");
-  } else {
-    requireModelWidth(CoefIntBits + 2 + CoefFracBits + CosFracBits, "Horner u*c + v");
-    requireModelWidth(CoefIntBits + 2 + HornerFracBits + DiffFracBits, "MUL2 (c^2-c)*g");
+  require(SpecFracBits >= 1 && SpecFracBits <= 30, "SpecFracBits", SpecFracBits,
+          "must be in 1..30 (spec_o is at most 31 bits)");
+  switch (kind()) {
+    case SpecKind::Poly: validatePoly(*this); break;
+    case SpecKind::Table: validateTable(*this); break;
+    case SpecKind::Schlick: validateSchlick(*this); break;
   }
   requireModelWidth(LightBits + 1 + SpecFracBits, "MUL3..MUL5 f*L");
   if (promWordBits() > 128)

@@ -4,12 +4,24 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
 #include "fixed/fixed.h"
 
 namespace shd {
+
+// The kinds of specular unit (the parameter Kind), one list: the paper's polynomial device and the
+// alternatives a designer would weigh against it (rtl/shd_spec_unit.v describes each datapath).
+enum class SpecKind { Poly = 0, Table = 1, Schlick = 2 };
+struct SpecKindInfo {
+  SpecKind kind;
+  const char* name;   // "poly", "table", "schlick"
+  const char* what;   // one line for tables and --help
+};
+const std::vector<SpecKindInfo>& specKinds();
+const SpecKindInfo& specKindInfo(SpecKind k);
 
 struct SpecUnitParams {
   int Degree = 2;           // 2: a c^2 + (1-a) c ; 3: cubic, Horner form, with cut-off
@@ -21,21 +33,28 @@ struct SpecUnitParams {
   int HornerFracBits = 14;  // Hf: degree 3 only, g = u*c + v truncated to Hf fraction bits
   int SpecFracBits = 16;    // Wf: the specular value f leaves Sm2 as uQ1.Wf
   int LightBits = 8;        // light channels (k_s * L) and colour out: unorm LightBits
-  int PipeStages = 1;       // internal pipeline registers, 0..3; latency = 2 + PipeStages
+  int PipeStages = 1;       // internal pipeline registers (poly 0..3, table 0..1, schlick 0..Wf+1);
+                            // latency = 2 + PipeStages
+  int Kind = 0;             // SpecKind: 0 poly (Degree 2 or 3), 1 table, 2 schlick
+  int TableBits = 8;        // table only: cosine address bits T, 1..CosFracBits
+
+  SpecKind kind() const { return static_cast<SpecKind>(Kind); }
 
   // Derived formats (see rtl/shd_spec_unit.v for the width derivations).
   FixedFormat cosFormat() const { return FixedFormat::u(1, CosFracBits); }
-  FixedFormat coefFormat() const { return {Degree == 3, CoefIntBits, CoefFracBits}; }
+  FixedFormat coefFormat() const { return {kind() == SpecKind::Poly && Degree == 3, CoefIntBits, CoefFracBits}; }
   FixedFormat diffFormat() const { return FixedFormat::s(1, DiffFracBits); }
   FixedFormat hornerFormat() const { return FixedFormat::s(CoefIntBits + 1, HornerFracBits); }
   FixedFormat specFormat() const { return FixedFormat::u(1, SpecFracBits); }
   FixedFormat lightFormat() const { return FixedFormat::u(LightBits, 0); }
   int latency() const { return 2 + PipeStages; }
-  int promDepth() const { return 1 << ShinBits; }
-  // PROM word: degree 2 {a}; degree 3 {cut[Wc:0], v, u} (u in the LSBs).
-  int promWordBits() const {
-    return Degree == 2 ? coefFormat().width() : 2 * coefFormat().width() + CosFracBits + 1;
-  }
+  int shinCodes() const { return 1 << ShinBits; }  // shin_i values
+  // PROM address bits and depth: shin_i, and for the table the cosine index below it.
+  int promAddrBits() const { return ShinBits + (kind() == SpecKind::Table ? TableBits : 0); }
+  int promDepth() const { return 1 << promAddrBits(); }
+  // PROM word: poly degree 2 {a}; poly degree 3 {cut[Wc:0], v, u} (u in the LSBs); table {f}
+  // (uQ1.Wf); schlick {m = n - 1} (uQCi.Cf, unsigned).
+  int promWordBits() const;
   int64_t cosOne() const { return int64_t{1} << CosFracBits; }
   int64_t lightMax() const { return (int64_t{1} << LightBits) - 1; }
 

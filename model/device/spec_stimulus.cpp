@@ -5,7 +5,7 @@ namespace shd {
 ExhaustiveSpecStimulus::ExhaustiveSpecStimulus(const SpecUnitParams& p, uint64_t seed) : p_(p), rng_(seed) {}
 
 uint64_t ExhaustiveSpecStimulus::total() const {
-  return static_cast<uint64_t>(p_.promDepth()) << (p_.CosFracBits + 1);
+  return static_cast<uint64_t>(p_.shinCodes()) << (p_.CosFracBits + 1);
 }
 
 bool ExhaustiveSpecStimulus::next(SpecIn& in) {
@@ -33,7 +33,7 @@ bool RandomSpecStimulus::next(SpecIn& in) {
   const uint64_t r = rng_();
   const uint32_t one = static_cast<uint32_t>(p_.cosOne());
   // Inputs change on idle cycles too: the unit must ignore them.
-  in.shin = static_cast<uint32_t>(r % static_cast<uint64_t>(p_.promDepth()));
+  in.shin = static_cast<uint32_t>(r % static_cast<uint64_t>(p_.shinCodes()));
   const uint64_t r2 = rng_();
   const unsigned sel = static_cast<unsigned>(r2 & 31);
   if (sel == 0) in.cos = one + static_cast<uint32_t>((r2 >> 8) % one);            // above 1.0

@@ -16,11 +16,17 @@ int64_t signExtend(uint64_t v, int bits) {
 }  // namespace
 
 PromWord encodePromWord(const SpecCoef& coef, const SpecUnitParams& p) {
+  if (p.kind() == SpecKind::Table) {
+    if (coef.u < 0 || coef.u > (int64_t{1} << p.SpecFracBits))
+      throw std::out_of_range(fmt::format("table value code {} outside 0..{} (uQ1.{}, at most 1.0)", coef.u,
+                                          int64_t{1} << p.SpecFracBits, p.SpecFracBits));
+    return static_cast<uint64_t>(coef.u);
+  }
   const FixedFormat cf = p.coefFormat();
   const int cw = cf.width();
   if (!cf.holds(coef.u)) throw std::out_of_range(fmt::format("coefficient code {} outside {}", coef.u, cf.str()));
   PromWord w = static_cast<uint64_t>(coef.u) & lowMask(cw);
-  if (p.Degree == 3) {
+  if (p.kind() == SpecKind::Poly && p.Degree == 3) {
     if (!cf.holds(coef.v)) throw std::out_of_range(fmt::format("coefficient code {} outside {}", coef.v, cf.str()));
     if (coef.cut < 0 || coef.cut > p.cosOne())
       throw std::out_of_range(fmt::format("cut-off code {} outside 0..{}", coef.cut, p.cosOne()));
@@ -34,8 +40,12 @@ SpecCoef decodePromWord(PromWord word, const SpecUnitParams& p) {
   const FixedFormat cf = p.coefFormat();
   const int cw = cf.width();
   SpecCoef c;
+  if (p.kind() == SpecKind::Table) {
+    c.u = static_cast<int64_t>(static_cast<uint64_t>(word) & lowMask(p.promWordBits()));
+    return c;
+  }
   const uint64_t u = static_cast<uint64_t>(word) & lowMask(cw);
-  if (p.Degree == 2) {
+  if (p.kind() == SpecKind::Schlick || p.Degree == 2) {
     c.u = static_cast<int64_t>(u);
     return c;
   }
@@ -49,8 +59,8 @@ SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
     : p_(params), prom_(std::move(prom)) {
   p_.validate();
   if (prom_.size() != static_cast<size_t>(p_.promDepth()))
-    throw std::invalid_argument(fmt::format("PROM has {} words, the unit addresses {} (ShinBits = {})",
-                                            prom_.size(), p_.promDepth(), p_.ShinBits));
+    throw std::invalid_argument(fmt::format("PROM has {} words, the unit addresses {} ({} address bits)",
+                                            prom_.size(), p_.promDepth(), p_.promAddrBits()));
   const int wb = p_.promWordBits();
   for (size_t i = 0; i < prom_.size(); ++i) {
     if (wb < 128 && (prom_[i] >> wb) != 0)
@@ -60,15 +70,37 @@ SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
   reset();
 }
 
-SpecTrace SpecUnitModel::trace(uint32_t shin, uint32_t cos) const {
-  if (shin >= static_cast<uint32_t>(p_.promDepth()))
-    throw std::out_of_range(fmt::format("shininess code {} outside 0..{}", shin, p_.promDepth() - 1));
+void SpecUnitModel::checkInputs(uint32_t shin, uint32_t cos) const {
+  if (shin >= static_cast<uint32_t>(p_.shinCodes()))
+    throw std::out_of_range(fmt::format("shininess code {} outside 0..{}", shin, p_.shinCodes() - 1));
   if (cos >= (uint32_t{2} << p_.CosFracBits))
     throw std::out_of_range(fmt::format("cos code {} does not fit uQ1.{}", cos, p_.CosFracBits));
+}
+
+int64_t SpecUnitModel::tableIndex(int64_t c) const {
+  const int t = p_.TableBits;
+  return std::min<int64_t>(c >> (p_.CosFracBits - t), (int64_t{1} << t) - 1);
+}
+
+int64_t SpecUnitModel::altSpec(uint32_t shin, int64_t c) const {
+  if (p_.kind() == SpecKind::Table)  // one ROM read at {shin, index}
+    return static_cast<int64_t>(prom_[(static_cast<size_t>(shin) << p_.TableBits) | static_cast<size_t>(tableIndex(c))]);
+  // Schlick: f = floor(c 2^(Cf+Wf) / (m (1 - c) + 1)), den >= 1 and f <= 1 (rtl/shd_spec_schlick.v).
+  const int wc = p_.CosFracBits, cf = p_.CoefFracBits;
+  const int64_t den = coef_[shin].u * ((int64_t{1} << wc) - c) + (int64_t{1} << (cf + wc));
+  return (c << (cf + p_.SpecFracBits)) / den;
+}
+
+SpecTrace SpecUnitModel::trace(uint32_t shin, uint32_t cos) const {
+  checkInputs(shin, cos);
   const SpecCoef& k = coef_[shin];
   SpecTrace t;
   // RG2: N.H computed upstream may overshoot 1.0 by rounding; the unit saturates it.
   t.c = Fixed::fromRaw(std::min<int64_t>(cos, p_.cosOne()), p_.cosFormat());
+  if (p_.kind() != SpecKind::Poly) {
+    t.f = Fixed::fromRaw(altSpec(shin, t.c.raw()), p_.specFormat());
+    return t;
+  }
   t.sq = t.c * t.c;                                                      // MUL1
   t.d = t.sq - t.c;                                                      // BI + Sm1, carry-in 1
   t.dt = t.d.convert(p_.diffFormat(), Quant::Trunc, Overflow::Error);   // drop 2Wc - Df LSBs
@@ -96,12 +128,14 @@ SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<ui
   // The hot path: the same datapath as trace() on raw integers, wire by wire as in the RTL.
   // validate() bounds every intermediate to 62 bits, so int64_t holds each exactly, and
   // test_spec_unit checks evaluate() against trace() (the Fixed formulation) bit for bit.
-  if (shin >= static_cast<uint32_t>(p_.promDepth()) || cos >= (uint32_t{2} << p_.CosFracBits)) {
-    trace(shin, cos);  // throws the descriptive error
+  if (shin >= static_cast<uint32_t>(p_.shinCodes()) || cos >= (uint32_t{2} << p_.CosFracBits)) {
+    checkInputs(shin, cos);  // throws the descriptive error
   }
   const int wc = p_.CosFracBits, wf = p_.SpecFracBits;
-  const SpecCoef& k = coef_[shin];
   const int64_t c = std::min<int64_t>(cos, p_.cosOne());            // RG2 saturation
+  const int64_t one = int64_t{1} << wf;
+  if (p_.kind() != SpecKind::Poly) return backEnd(altSpec(shin, c), light);
+  const SpecCoef& k = coef_[shin];
   const int64_t dt = (c * c - (c << wc)) >> (2 * wc - p_.DiffFracBits);  // MUL1, Sm1, Trunc
   int64_t prod;                                                     // MUL2
   int prod_frac;
@@ -115,10 +149,15 @@ SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<ui
   }
   const int sh = prod_frac - wf;
   const int64_t pr = sh == 0 ? prod : (prod + (int64_t{1} << (sh - 1))) >> sh;  // RoundHalfUp
-  const int64_t one = int64_t{1} << wf;
   int64_t f = (c << (wf - wc)) + pr;                                // Sm2
   f = f < 0 ? 0 : (f > one ? one : f);                              // clamp to [0, 1]
   if (p_.Degree == 3 && c < k.cut) f = 0;                           // cut-off
+  return backEnd(f, light);
+}
+
+SpecOut SpecUnitModel::backEnd(int64_t f, const std::array<uint32_t, 3>& light) const {
+  const int wf = p_.SpecFracBits;
+  const int64_t one = int64_t{1} << wf;
   SpecOut out;
   out.valid = true;
   out.spec = static_cast<uint32_t>(f);

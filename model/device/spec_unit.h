@@ -1,7 +1,7 @@
 // SpecUnitModel: the bit-exact, cycle-accurate twin of rtl/shd_spec_unit.v.
 //
-// Datapath (paper Fig. 11, with the corrections of docs/paper-corrections.md 4.3), formats from SpecUnitParams, rounding named where the
-// RTL rounds:
+// Datapath of the poly kind (paper Fig. 11, with the corrections of docs/paper-corrections.md
+// 4.3), formats from SpecUnitParams, rounding named where the RTL rounds:
 //   c   = min(cos_i, 1.0)                              uQ1.Wc   (RG2; N.H may overshoot 1)
 //   sq  = c * c                                        MUL1, exact
 //   d   = sq + ~c + 1 = c^2 - c  in [-1/4, 0]           BI + Sm1 with carry-in, exact
@@ -11,6 +11,10 @@
 //   Pr  = P -> Wf fraction bits                        RoundHalfUp
 //   f   = c + Pr, saturated to [0, 1] (degree 3: 0 when c < cut)   Sm2 + clamp, uQ1.Wf
 //   out = f * L_k -> integer                           MUL3..MUL5, RoundHalfUp, unorm LightBits
+// The table kind:   f = PROM[{shin, min(c >> (Wc - T), 2^T - 1)}]      (one registered read)
+// The schlick kind: f = floor(c 2^(Cf+Wf) / (m (2^Wc - c) + 2^(Cf+Wc)))  with m = n - 1 from
+//                   PROM[shin]: c / (n - n c + c) truncated to uQ1.Wf (a restoring divider)
+// Every kind ends in the same MUL3..MUL5.
 // Pipeline: registered inputs and PROM read (cycle 1), PipeStages optional registers, registered
 // outputs; latency 2 + PipeStages, one result per cycle. The output registers load only when
 // their stage is valid, so outputs hold the last valid result; they reset to zero.
@@ -28,7 +32,8 @@ namespace shd {
 using PromWord = unsigned __int128;
 
 // The fields of one PROM word as raw codes. Degree 2: u = a (uQCi.Cf), v = cut = 0.
-// Degree 3: u = a1, v = a1 + b1 (sQCi.Cf), cut = cos code below which f = 0.
+// Degree 3: u = a1, v = a1 + b1 (sQCi.Cf), cut = cos code below which f = 0. Table: u = f
+// (uQ1.Wf). Schlick: u = m = n - 1 (uQCi.Cf).
 struct SpecCoef {
   int64_t u = 0;
   int64_t v = 0;
@@ -54,7 +59,8 @@ struct SpecOut {
   friend bool operator!=(const SpecOut& a, const SpecOut& b) { return !(a == b); }
 };
 
-// Intermediate values of one evaluation, for reports and mismatch diagnostics.
+// Intermediate values of one evaluation, for reports and mismatch diagnostics (the table and
+// schlick kinds fill c and f only).
 struct SpecTrace {
   Fixed c, sq, d, dt, g, p, pr, f;
   bool cut = false;
@@ -83,6 +89,10 @@ class SpecUnitModel {
   uint64_t cycle() const { return cycle_; }
 
  private:
+  void checkInputs(uint32_t shin, uint32_t cos) const;  // std::out_of_range naming the port
+  int64_t tableIndex(int64_t c) const;                   // table: the cosine address
+  int64_t altSpec(uint32_t shin, int64_t c) const;       // f of the table and schlick kinds
+  SpecOut backEnd(int64_t f, const std::array<uint32_t, 3>& light) const;  // MUL3..MUL5
   struct Stage {
     bool valid = false;
     SpecOut value;

@@ -10,10 +10,15 @@ namespace shd {
 
 SpecUnitConfig LobeConfigs::load(Lobe l) const {
   SpecUnitConfig c = specConfig(forLobe(l));
-  const int degree = l == Lobe::Cubic ? 3 : 2;
-  if (c.rtl.Degree != degree)
-    throw std::invalid_argument(fmt::format("the {} lobe needs a degree-{} specular unit; configuration {} has Degree {}",
-                                            toString(l), degree, forLobe(l), c.rtl.Degree));
+  const bool poly = c.rtl.kind() == SpecKind::Poly;
+  if (l == Lobe::Cubic && !(poly && c.rtl.Degree == 3))
+    throw std::invalid_argument(fmt::format("the cubic lobe needs a degree-3 poly specular unit; configuration {} {}",
+                                            forLobe(l), poly ? fmt::format("has Degree {}", c.rtl.Degree)
+                                                             : fmt::format("is of kind {}", specKindInfo(c.rtl.kind()).name)));
+  if (l != Lobe::Cubic && poly && c.rtl.Degree != 2)
+    throw std::invalid_argument(fmt::format(
+        "the quadratic lobe needs a degree-2 poly unit or one of another kind; configuration {} has Degree {}",
+        forLobe(l), c.rtl.Degree));
   return c;
 }
 

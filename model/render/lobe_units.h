@@ -1,5 +1,7 @@
 // The specular units behind the device lobes (quadratic, cubic) of a render: which
-// configuration each lobe uses, and the model's engines for the lobes a scene uses.
+// configuration each lobe uses, and the model's engines for the lobes a scene uses. The
+// quadratic lobe is "(N.H)^n by the specular unit": the paper's degree-2 device by default, or a
+// unit of another kind (table, schlick) standing in for it.
 #pragma once
 
 #include <memory>
@@ -11,8 +13,8 @@
 
 namespace shd {
 
-// A registry name or a JSON file per lobe; the quadratic lobe needs a degree-2 unit, the cubic
-// a degree-3 one. The defaults are the registry's reference configurations of each degree.
+// A registry name or a JSON file per lobe; the quadratic lobe needs a degree-2 poly unit or a
+// unit of another kind, the cubic a degree-3 poly one. The defaults are the registry's reference configurations of each degree.
 struct LobeConfigs {
   std::string quadratic = "default";
   std::string cubic = "cubic";

@@ -118,6 +118,7 @@ nlohmann::json toJson(const SpecErrorReport& r) {
   return {
       {"config", r.config},
       {"rtl", t.unit.toJson()},
+      {"kind", specKindInfo(t.unit.kind()).name},
       {"fit", toString(t.request.fit)},
       {"degree", t.unit.Degree},
       {"level", t.request.level},
@@ -153,13 +154,19 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
                                  const std::vector<double>& show_n) {
   const PromTable& t = primary.table;
   const SpecUnitParams& p = t.unit;
+  const std::string datapath =
+      p.kind() == SpecKind::Poly
+          ? fmt::format("degree {}, cos uQ1.{}, coefficient {}, c^2-c to {} fraction bits", p.Degree, p.CosFracBits,
+                        p.coefFormat().str(), p.DiffFracBits)
+      : p.kind() == SpecKind::Table
+          ? fmt::format("table of 2^{} cosine buckets per n, cos uQ1.{}", p.TableBits, p.CosFracBits)
+          : fmt::format("Schlick's rational with a divider, cos uQ1.{}, m = n - 1 {}", p.CosFracBits,
+                        p.coefFormat().str());
   std::string out = fmt::format(
-      "Specular unit '{}': degree {}, cos uQ1.{}, coefficient {}, c^2-c to {} fraction bits, f uQ1.{}, output "
-      "unorm{}\n"
+      "Specular unit '{}': {}, f uQ1.{}, output unorm{}\n"
       "Approximation (a): ideal device vs cos^n, exact maxima over c in the region.\n"
       "Datapath (b) and total (c): the bit-exact unit at every cos code, in output LSBs (1/{} of full scale).\n\n",
-      primary.config, p.Degree, p.CosFracBits, p.coefFormat().str(), p.DiffFracBits, p.SpecFracBits, p.LightBits,
-      p.lightMax());
+      primary.config, datapath, p.SpecFracBits, p.LightBits, p.lightMax());
   const std::vector<const SpecErrorReport*> reports =
       compare ? std::vector<const SpecErrorReport*>{&primary, compare} : std::vector<const SpecErrorReport*>{&primary};
   for (const SpecErrorReport* r : reports) {
@@ -175,7 +182,7 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
       const PromEntry& e = r->table.entries[static_cast<size_t>(addr)];
       out += fmt::format("{:>7g} {:>9.4g} | {:>9.5f} {:>9.6f} {:>8.5f} | {:>8.3f}% {:>7.3f}% | {:>8.3f} {:>7.2f} | "
                          "{:>8.2f} {:>8.6f} {:>9.2f}\n",
-                         n, p.Degree == 2 ? e.approx.a : e.approx.a1, row.lobe.max_abs, row.lobe.worst_abs_c,
+                         n, e.u_real, row.lobe.max_abs, row.lobe.worst_abs_c,
                          row.peak50.max_abs, 100 * row.peak50.max_rel, 100 * row.inflection.max_rel,
                          row.datapath_max_lsb, row.datapath_max_f_lsb, row.total_max_lsb, row.total_worst_c,
                          row.total_peak_max_lsb);
@@ -191,7 +198,7 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
         s.total_max_lsb.value, s.total_max_lsb.n, s.total_peak_max_lsb.value, s.total_peak_max_lsb.n, r->seconds);
   }
   out +=
-      "Columns: coef = a (degree 2) or a1 (degree 3); lobe = c in [0,1]; peak = c^n >= 0.5; infl = c from the "
+      "Columns: coef = a (degree 2), a1 (degree 3), m = n - 1 (schlick), nan (table); lobe = c in [0,1]; peak = c^n >= 0.5; infl = c from the "
       "inflection point to 1;\n"
       "dp = datapath vs ideal device (LSB of the output, fLSB of f = spec_o); tot = unit vs cos^n; peak LSB = tot "
       "where c^n >= 0.5.\n";

@@ -23,6 +23,7 @@
 
 #include "cli/command.h"
 #include "cli/report_measure.h"
+#include "report/spec_error.h"
 #include "cli/report_write.h"
 #include "cosim/render_rtl.h"
 #include "device/prom_io.h"
@@ -59,7 +60,9 @@ class ReportCmd final : public Command {
 
  private:
   std::string scene_ = "builtin:sphere", dir_, hardware_cache_;
-  std::vector<std::string> modes_;
+  std::vector<std::string> modes_, spec_units_;
+  std::vector<SpecUnitConfig> alt_units_;  // --spec-units, loaded
+  std::vector<double> scene_n_;            // the shininess values the scene's objects use
   size_t bench_ = 5;
   bool rtl_ = false, quiet_ = false, no_hardware_ = false;
   double heat_scale_ = 8, highlight_lsb_ = 32;
@@ -78,6 +81,7 @@ class ReportCmd final : public Command {
   // --hardware-cache: an existing directory or a new one whose parent exists. ArgError otherwise.
   void checkHardwareCache() const;
   std::vector<SpanUnitConfig> modeConfigs() const;
+  std::vector<SpecUnitConfig> altUnitConfigs() const;
   void requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const;
   Hardware hardwareTools() const;
   json unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
@@ -94,6 +98,14 @@ void ReportCmd::add(CLI::App& app) {
   app.add_option("-o,--output", dir_, "the report's directory (made if missing; its parent must exist)")->required();
   app.add_option("--modes", modes_, "the lane modes (span configurations), comma-separated (default: every one of the registry, serial "
                  "first: " + fmt::format("{}", fmt::join(builtinConfigNames("span"), ",")) + ")")
+      ->delimiter(',');
+  std::vector<std::string> alt;
+  for (const std::string& n : builtinConfigNames("spec"))
+    if (specConfig(n).rtl.kind() != SpecKind::Poly) alt.push_back(n);
+  app.add_option("--spec-units", spec_units_,
+                 "specular units of another kind than the paper's, each evaluating the quadratic lobe as a lobe "
+                 "group of its own (<name>-unit): registry names or JSON files, comma-separated, or none (default: "
+                 "every one of the registry: " + fmt::format("{}", fmt::join(alt, ",")) + ")")
       ->delimiter(',');
   app.add_option("--bench", bench_, "frames per row of the model; the median time is reported")
       ->check(countIn(1, 1000))
@@ -162,6 +174,27 @@ std::vector<SpanUnitConfig> ReportCmd::modeConfigs() const {
   return modes;
 }
 
+std::vector<SpecUnitConfig> ReportCmd::altUnitConfigs() const {
+  std::vector<std::string> names = spec_units_;
+  if (names.empty())
+    for (const std::string& n : builtinConfigNames("spec"))
+      if (specConfig(n).rtl.kind() != SpecKind::Poly) names.push_back(n);
+  if (names == std::vector<std::string>{"none"}) return {};
+  std::vector<SpecUnitConfig> units;
+  for (const std::string& n : names) {
+    if (n.empty() || n == "none")
+      throw ArgError(fmt::format("--spec-units: '{}' (name configurations comma-separated, or none alone)", n));
+    units.push_back(specConfigArg("--spec-units", n));
+    if (units.back().rtl.kind() == SpecKind::Poly)
+      throw ArgError(fmt::format("--spec-units: {} is the paper's poly kind, already the quadratic and cubic lobes; "
+                                 "name a table or schlick configuration", n));
+    for (size_t k = 0; k + 1 < units.size(); ++k)
+      if (units[k].name == units.back().name)
+        throw ArgError(fmt::format("--spec-units: {} and {} are both named {}", names[k], n, units.back().name));
+  }
+  return units;
+}
+
 void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const {
   for (const SpanUnitConfig& m : modes) {
     try {
@@ -175,6 +208,13 @@ void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeC
       requireVerilated(lobes.load(l));
     } catch (const std::invalid_argument& e) {
       throw ArgError(fmt::format("--rtl: the {} lobe's specular unit {}: {}", toString(l), lobes.forLobe(l), e.what()));
+    }
+  }
+  for (const SpecUnitConfig& c : alt_units_) {
+    try {
+      requireVerilated(c);
+    } catch (const std::invalid_argument& e) {
+      throw ArgError(fmt::format("--rtl: specular unit {}: {}", c.ref(), e.what()));
     }
   }
 }
@@ -258,6 +298,23 @@ void runHardwareJobs(const std::vector<HardwareJob>& jobs, json& units, Hardware
   }
 }
 
+// The unit against cos^n (report/spec_error.h) for the shininess values of the scene its PROM
+// holds, at every cos code: what the unit alone adds to the scene's error.
+json sceneSpecError(const PromTable& t, const std::vector<double>& scene_n) {
+  PromTable mine = t;
+  mine.entries.clear();
+  for (const PromEntry& e : t.entries)
+    if (std::find(scene_n.begin(), scene_n.end(), e.n) != scene_n.end()) mine.entries.push_back(e);
+  if (mine.entries.empty()) return json();
+  const SpecErrorSummary s = computeSpecError("", mine).summary;
+  std::vector<double> n;
+  for (const PromEntry& e : mine.entries) n.push_back(e.n);
+  return {{"n", n},
+          {"approx_lobe_max_abs", s.approx_lobe_max_abs.value},
+          {"total_max_lsb", s.total_max_lsb.value},
+          {"total_peak_max_lsb", s.total_peak_max_lsb.value}};
+}
+
 // Per unit configuration its parameters and, with the tools, its area and place and route (each
 // computed once, cached). A failed run leaves that figure out and says why.
 json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
@@ -275,15 +332,25 @@ json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measur
       jobs.push_back({"span", c.name, "pnr", "place and route of " + what,
                       [rtl, t = *hw.pnr] { return unitPointPnr("span", rtl, "", json::object(), t); }});
   }
+  std::vector<SpecUnitConfig> spec = alt_units_;
+  spec.push_back(lobes.load(Lobe::Quadratic));
+  spec.push_back(lobes.load(Lobe::Cubic));
   for (const std::string& name : m.spec_configs) {
-    const Lobe l = name == lobes.cubic ? Lobe::Cubic : Lobe::Quadratic;
-    const SpecUnitConfig c = lobes.load(l);
+    const SpecUnitConfig& c =
+        *std::find_if(spec.begin(), spec.end(), [&](const SpecUnitConfig& u) { return u.name == name; });
     units["spec"][c.name] = {{"description", c.description},
                              {"rtl", c.rtl.toJson()},
-                             {"degree", c.rtl.Degree},
-                             {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}}};
+                             {"kind", specKindInfo(c.rtl.kind()).name},
+                             {"degree", c.rtl.kind() == SpecKind::Poly ? json(c.rtl.Degree) : json()},
+                             {"latency", c.rtl.latency()},
+                             {"prom_bits", int64_t{c.rtl.promDepth()} * c.rtl.promWordBits()},
+                             {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}},
+                             {"lobe", c.name == lobes.load(Lobe::Cubic).name      ? toString(Lobe::Cubic)
+                                      : c.name == lobes.load(Lobe::Quadratic).name ? toString(Lobe::Quadratic)
+                                                                                   : c.name + "-unit"}};
     const std::string what = fmt::format("specular configuration {}", c.name);
     const auto table = std::make_shared<const PromTable>(buildPromTable(PromRequest::fromContent(c.prom), c.rtl));
+    units["spec"][c.name]["scene_error"] = sceneSpecError(*table, scene_n_);
     if (hw.synth)
       area_jobs.push_back({"spec", c.name, "area", "area of " + what, [table, t = *hw.synth] { return specPointArea(*table, t); }});
     if (hw.pnr)
@@ -442,6 +509,8 @@ int ReportCmd::run(const CLI::App&) {
   const Scene sc = loadScene(scene_);
   const std::vector<SpanUnitConfig> modes = modeConfigs();
   const LobeConfigs lobes;
+  alt_units_ = altUnitConfigs();
+  for (const SceneObject& o : sc.objects) scene_n_.push_back(sc.materials.at(static_cast<size_t>(o.material)).shininess);
   if (rtl_) requireRtl(modes, lobes);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-report-{}", getpid());
   struct RemoveTmp {
@@ -455,6 +524,7 @@ int ReportCmd::run(const CLI::App&) {
   setup.scene = &sc;
   setup.modes = modes;
   setup.lobes = lobes;
+  for (const SpecUnitConfig& c : alt_units_) setup.alt_units.push_back(c.ref());
   setup.frames = bench_;
   setup.rtl = rtl_;
   setup.quiet = quiet_;
@@ -466,7 +536,7 @@ int ReportCmd::run(const CLI::App&) {
   setup.fail_dir = fs::is_directory(dir(), ec) ? dir().string()
                                               : (dir().has_parent_path() ? dir().parent_path().string() : ".");
   say(fmt::format("{}: {} methods x {} lobes x {} lane modes, {} frames each{}", sc.name, allMethods().size(),
-                  reportLobeGroups().size(), modes.size(), bench_, rtl_ ? ", and with the verilated units" : ""));
+                  reportLobeGroups(setup.alt_units).size(), modes.size(), bench_, rtl_ ? ", and with the verilated units" : ""));
   const Measured m = measureReport(setup);
   for (const std::string& w : m.warnings) std::fprintf(stderr, "report: warning: %s\n", w.c_str());
   Hardware hw = hardwareTools();

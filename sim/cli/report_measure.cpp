@@ -88,13 +88,15 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const Rend
   RenderOptions ro;
   ro.method = m;
   ro.brdf = g.brdf;
+  LobeConfigs lobes = s.lobes;
+  if (!g.unit.empty()) lobes.quadratic = g.unit;
   std::vector<std::string> spec_configs;
-  for (Lobe l : deviceLobesUsed(sc, ro)) spec_configs.push_back(lobeConfigArg(s.lobes, l).name);
+  for (Lobe l : deviceLobesUsed(sc, ro)) spec_configs.push_back(lobeConfigArg(lobes, l).name);
   nlohmann::json rows = nlohmann::json::array();
   Image first;
   nlohmann::json base;
   for (const SpanUnitConfig& mode : s.modes) {
-    Engines model = makeEngines(sc, ro, mode, s.lobes, false, s.tmp, s.fail_dir);
+    Engines model = makeEngines(sc, ro, mode, lobes, false, s.tmp, s.fail_dir);
     const RenderResult res = render(sc, ro, *model.span, model.view);
     RenderResult scratch;
     const double ms = medianFrameMs(sc, ro, model, res, s.frames, scratch);
@@ -125,7 +127,7 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const Rend
       out.failures.push_back(fmt::format("{}/{}: the image in mode {} differs from mode {}'s in {} pixels", toString(m),
                                          g.name, mode.name, s.modes.front().name, differingPixels(first, img).count()));
     if (s.rtl) {
-      Engines hw = makeEngines(sc, ro, mode, s.lobes, true, s.tmp, s.fail_dir);
+      Engines hw = makeEngines(sc, ro, mode, lobes, true, s.tmp, s.fail_dir);
       const RenderResult hres = render(sc, ro, *hw.span, hw.view);
       fs::remove_all(s.tmp);
       const RtlCheck check = checkRtlFrame(sc, res, hres);
@@ -147,17 +149,18 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const Rend
 
 }  // namespace
 
-std::vector<LobeGroup> reportLobeGroups() {
-  std::vector<LobeGroup> g = {{"material", ""}};
+std::vector<LobeGroup> reportLobeGroups(const std::vector<std::string>& alt_units) {
+  std::vector<LobeGroup> g = {{"material", "", ""}};
   for (int l = static_cast<int>(Lobe::Phong); l <= static_cast<int>(Lobe::Pow); ++l)
-    g.push_back({toString(static_cast<Lobe>(l)), toString(static_cast<Lobe>(l))});
+    g.push_back({toString(static_cast<Lobe>(l)), toString(static_cast<Lobe>(l)), ""});
+  for (const std::string& u : alt_units) g.push_back({specConfig(u).name + "-unit", toString(Lobe::Quadratic), u});
   return g;
 }
 
 Measured measureReport(const ReportSetup& s) {
   const Scene& sc = *s.scene;
   Measured out;
-  out.groups = reportLobeGroups();
+  out.groups = reportLobeGroups(s.alt_units);
   out.methods = allMethods();
   std::vector<std::string> group_skip;
   for (const LobeGroup& g : out.groups) group_skip.push_back(groupSkipReason(sc, g));

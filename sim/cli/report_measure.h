@@ -21,16 +21,19 @@
 namespace shd::cli {
 
 // A lobe of the report: a brdf every material is rendered with, or "material": each material's
-// own (RenderOptions::brdf "").
+// own (RenderOptions::brdf ""); or the quadratic lobe evaluated by another specular unit (a
+// table or schlick configuration standing in for the paper's device).
 struct LobeGroup {
-  std::string name;  // "material" or the brdf
+  std::string name;  // "material", the brdf, or "<unit>-unit"
   std::string brdf;  // "" for "material"
+  std::string unit;  // the specular configuration of the quadratic lobe ("": ReportSetup::lobes')
 };
 
 struct ReportSetup {
   const Scene* scene = nullptr;
   std::vector<SpanUnitConfig> modes;  // the lane modes, the first the one whose image is kept
   LobeConfigs lobes;                  // the specular unit of each device lobe
+  std::vector<std::string> alt_units;  // more specular units (registry names or files), each a lobe group
   size_t frames = 5;                  // the model's frames per row (the median is reported)
   bool rtl = false;                   // also with the verilated units (verilated: checked before)
   bool quiet = false;
@@ -60,8 +63,9 @@ struct Measured {
   size_t renders_total = 0, renders_done = 0;  // rows to render, rendered or refused (progress)
 };
 
-// The lobes considered for the scene: "material" and every brdf name, in Lobe's order.
-std::vector<LobeGroup> reportLobeGroups();
+// The lobes considered for the scene: "material" and every brdf name, in Lobe's order, then one
+// per alternative unit (named "<configuration name>-unit").
+std::vector<LobeGroup> reportLobeGroups(const std::vector<std::string>& alt_units);
 
 // Renders everything (stderr progress unless quiet). std::invalid_argument when no method and
 // lobe of the scene can be rendered; the RTL engines' std::runtime_error on a disagreement.

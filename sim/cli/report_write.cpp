@@ -177,6 +177,43 @@ std::string unitsTable(const json& report) {
   return md;
 }
 
+// The specular units side by side (the paper's device among the alternatives): what each costs
+// (latency, PROM bits, area, fmax) and what it gives on this scene (the unit alone against cos^n
+// at every cos code for the scene's shininess values; phong-fixed, which asks the unit at every
+// pixel, against the reference image).
+std::string specUnitsTable(const json& report) {
+  std::vector<std::string> headers = {"configuration", "kind", "lobe", "latency", "PROM bits"};
+  bool ice40 = false;
+  for (const auto& [name, u] : report["units"]["spec"].items()) ice40 = ice40 || !at(u, {"area", "ice40"}).is_null();
+  if (ice40)
+    for (const char* f : {"LUT", "DSP", "BRAM"}) headers.push_back(fmt::format("iCE40 {}", f));
+  const auto devices = devicesOf(report);
+  for (const auto& [d, title] : devices) headers.push_back(title + " MHz");
+  for (const char* h : {"unit max LSB", "unit peak LSB", "phong-fixed max LSB", "phong-fixed hl max LSB"})
+    headers.push_back(h);
+  std::string md = mdHeader(headers);
+  for (const auto& [name, u] : report["units"]["spec"].items()) {
+    const std::string lobe = u["lobe"].get<std::string>();
+    json pf;  // the first phong-fixed row of the unit's lobe
+    for (const json& r : report["rows"])
+      if (r["lobe"] == lobe && r["method"] == "phong-fixed") {
+        pf = r;
+        break;
+      }
+    std::vector<std::string> cells = {"`" + name + "`", u["kind"].get<std::string>(), "`" + lobe + "`",
+                                      num(u["latency"], 0), num(u["prom_bits"], 0)};
+    if (ice40)
+      for (const char* f : {"luts", "dsps", "brams"}) cells.push_back(num(at(u, {"area", "ice40", f}), 0));
+    for (const auto& [d, title] : devices) cells.push_back(num(at(u, {"pnr", d, "fmax_mhz"}), 2));
+    cells.push_back(num(at(u, {"scene_error", "total_max_lsb"}), 2));
+    cells.push_back(num(at(u, {"scene_error", "total_peak_max_lsb"}), 2));
+    cells.push_back(num(at(pf, {"metrics", "max_abs_lsb"}), 2));
+    cells.push_back(num(at(pf, {"highlight", "max_abs_lsb"}), 2));
+    md += mdRow(cells);
+  }
+  return md;
+}
+
 // Each unit's place and route per device: its fmax, or that it does not fit, with its utilisation.
 std::string pnrTable(const json& report) {
   std::string md = mdHeader({"unit", "configuration", "device", "flow", "fmax MHz", "logic cells", "DSP", "BRAM", "result"});
@@ -318,6 +355,12 @@ std::string reportMarkdown(const json& report) {
     md += lobeTable(report, name) + "\n";
   }
   md += "## Units\n\n" + unitsTable(report) + "\n";
+  if (!report["units"]["spec"].empty())
+    md += "## Specular units compared\n\nThe paper's device (kind poly) beside the alternatives a designer would weigh. "
+          "Unit max/peak LSB: the unit alone against cos^n at every cos code, for the scene's shininess values "
+          "(peak: where cos^n >= 0.5), in output LSBs at full light. phong-fixed: the image that asks the unit at "
+          "every pixel, against the reference (hl: in the highlight).\n\n" +
+          specUnitsTable(report) + "\n";
   if (!devicesOf(report).empty())
     md += "## Place and route\n\nEach unit alone on iCE40 by nextpnr (scripts/pnr.py): the UP5K with its DSPs (fmax an "
           "upper bound: the DSPs' own delays are not in it), the HX8K without (every multiplier in logic cells; fmax "

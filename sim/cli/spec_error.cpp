@@ -40,7 +40,8 @@ class SpecErrorCmd final : public Command {
     const SpecErrorReport primary = computeSpecError(cfg.name, t, prog);
     std::optional<SpecErrorReport> second;
     std::string cmp = compare_;
-    if (cmp == "auto") cmp = t.request.fit == FitKind::Minimax ? "inflection" : "minimax";
+    if (cmp == "auto")  // the table and schlick kinds have one content only
+      cmp = t.unit.kind() != SpecKind::Poly ? "none" : t.request.fit == FitKind::Minimax ? "inflection" : "minimax";
     if (cmp != "none" && cmp != toString(t.request.fit)) {
       PromRequest req2 = t.request;
       req2.fit = parseFitKind(cmp);

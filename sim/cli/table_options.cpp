@@ -9,8 +9,10 @@ namespace shd::cli {
 
 void TableOptions::add(CLI::App& app) {
   app.add_option("--config", config, "configuration: " + configChoices("spec"))->default_val("default");
-  app.add_option("--fit", fit, "inflection | level | shortcut | minimax (default: the configuration's)")
-      ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax"}));
+  app.add_option("--fit", fit,
+                 "inflection | level | shortcut | minimax for the poly kind, exact for the table and schlick kinds "
+                 "(default: the configuration's)")
+      ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax", "exact"}));
   app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)")
       ->check(realIn(0, 1, Ends::Open));
   app.add_option("--degree", degree, "2 (quadratic) or 3 (cubic)")->check(countIn(2, 3));
@@ -42,7 +44,7 @@ PromTable TableOptions::build(SpecUnitConfig& cfg_out, bool size_to_n) const {
     } catch (const std::invalid_argument& e) {
       throw ArgError(fmt::format("--coef-format: {}", e.what()));
     }
-    if (f.is_signed != (p.Degree == 3))
+    if (f.is_signed != p.coefFormat().is_signed)
       throw ArgError(fmt::format("--coef-format {}: degree {} coefficients are {}; use {}Qm.f", coef_format, p.Degree,
                                  p.Degree == 3 ? "signed" : "unsigned (a >= 0)", p.Degree == 3 ? 's' : 'u'));
     p.CoefIntBits = f.int_bits;

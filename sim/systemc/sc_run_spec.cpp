@@ -34,9 +34,9 @@ namespace {
 // The parameters as text (compared and shown; SpecUnitParams::toJson would need the JSON headers).
 std::string describe(const SpecUnitParams& p) {
   return fmt::format("Degree={} CosFracBits={} ShinBits={} CoefIntBits={} CoefFracBits={} DiffFracBits={} "
-                     "HornerFracBits={} SpecFracBits={} LightBits={} PipeStages={}",
+                     "HornerFracBits={} SpecFracBits={} LightBits={} PipeStages={} Kind={} TableBits={}",
                      p.Degree, p.CosFracBits, p.ShinBits, p.CoefIntBits, p.CoefFracBits, p.DiffFracBits,
-                     p.HornerFracBits, p.SpecFracBits, p.LightBits, p.PipeStages);
+                     p.HornerFracBits, p.SpecFracBits, p.LightBits, p.PipeStages, p.Kind, p.TableBits);
 }
 
 // --vector-file (null without one), made for the unit's parameters p.

@@ -20,12 +20,13 @@ namespace {
 const char* const kHeaderKeys[] = {"unit", "config", "params", "prom", "latency", "source"};
 
 const char* const kSpecParamOrder = "Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits "
-                                    "SpecFracBits LightBits PipeStages";
+                                    "SpecFracBits LightBits PipeStages Kind TableBits";
 const char* const kSpanParamOrder = "NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits";
 
 std::vector<int> specParamList(const SpecUnitParams& p) {
   return {p.Degree,       p.CosFracBits,    p.ShinBits,     p.CoefIntBits, p.CoefFracBits,
-          p.DiffFracBits, p.HornerFracBits, p.SpecFracBits, p.LightBits,   p.PipeStages};
+          p.DiffFracBits, p.HornerFracBits, p.SpecFracBits, p.LightBits,   p.PipeStages,
+          p.Kind,         p.TableBits};
 }
 
 std::vector<int> spanParamList(const SpanParams& p) {

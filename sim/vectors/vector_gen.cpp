@@ -68,7 +68,7 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
 
   // The corners, valid on every cycle.
   std::vector<SpecIn> corners;
-  const uint32_t depth = static_cast<uint32_t>(p.promDepth());
+  const uint32_t depth = static_cast<uint32_t>(p.shinCodes());
   const uint32_t last_entry = static_cast<uint32_t>(std::max<size_t>(table.entries.size(), 1) - 1);
   const uint32_t one = static_cast<uint32_t>(p.cosOne()), lmax = static_cast<uint32_t>(p.lightMax());
   for (uint32_t shin : {0u, 1u, depth / 2, last_entry, depth - 1})
@@ -85,18 +85,27 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
 
   // Degree 3: the cut-off boundary, cos one code below, at and above the cut of every eighth
   // table entry and the last (the exact boundary is one code in 2^(Wc+1): random cosines miss it).
-  if (p.Degree == 3)
+  auto corner = [&](uint32_t shin, int64_t cos, const std::array<uint32_t, 3>& light) {
+    if (cos < 0 || cos > 2 * int64_t{one} - 1) return;
+    SpecIn in;
+    in.valid = true;
+    in.shin = shin;
+    in.cos = static_cast<uint32_t>(cos);
+    in.light = light;
+    corners.push_back(in);
+  };
+  // The table: both sides of every 16th bucket edge of the last entry's row (the index is the
+  // cosine's top TableBits bits).
+  if (p.kind() == SpecKind::Table)
+    for (int64_t k = 1; k < (int64_t{1} << p.TableBits); k += 16) {
+      const int64_t edge = k << (p.CosFracBits - p.TableBits);
+      corner(last_entry, edge - 1, {lmax, lmax / 2, 1});
+      corner(last_entry, edge, {lmax, lmax / 2, 1});
+    }
+  if (p.kind() == SpecKind::Poly && p.Degree == 3)
     for (uint32_t shin = 0; shin <= last_entry; shin = shin + 8 > last_entry && shin != last_entry ? last_entry : shin + 8) {
       const int64_t cut = decodePromWord(table.words[shin], p).cut;
-      for (int64_t cos = cut - 1; cos <= cut + 1; ++cos) {
-        if (cos < 0 || cos > 2 * int64_t{one} - 1) continue;
-        SpecIn in;
-        in.valid = true;
-        in.shin = shin;
-        in.cos = static_cast<uint32_t>(cos);
-        in.light = {lmax, lmax / 2, 1};
-        corners.push_back(in);
-      }
+      for (int64_t cos = cut - 1; cos <= cut + 1; ++cos) corner(shin, cos, {lmax, lmax / 2, 1});
     }
 
   SpecUnitModel model(p, table.words);

@@ -4,7 +4,8 @@
 //           under Verilator (`shadesim replay`), so the RTL means the same in both simulators.
 // Run:      testbench/icarus/run_icarus.sh FILE does all of it; by hand:
 //             iverilog -g2012 -Wall -I testbench/icarus -s tb_spec_unit -Ptb_spec_unit.<Name>=<value>... -o tb.vvp \
-//               testbench/icarus/tb_spec_unit.v rtl/shd_spec_unit.v rtl/shd_coef_rom.v rtl/shd_pipe_reg.v
+//               testbench/icarus/tb_spec_unit.v rtl/shd_spec_unit.v rtl/shd_spec_poly.v rtl/shd_spec_schlick.v \
+//               rtl/shd_coef_rom.v rtl/shd_pipe_reg.v
 //             vvp -n tb.vvp +vec=/abs/file.vec +prom=/abs/prom.hex [+dump=/abs/wave.fst -fst]
 //           Paths must be absolute: $readmemh (and $fopen) resolve a relative path against the
 //           simulator's current directory, not the vector file's, and a PROM file $readmemh cannot
@@ -27,10 +28,13 @@ module tb_spec_unit #(
   parameter integer HornerFracBits = 14,
   parameter integer SpecFracBits   = 16,
   parameter integer LightBits      = 8,
-  parameter integer PipeStages     = 1
+  parameter integer PipeStages     = 1,
+  parameter integer Kind           = 0,
+  parameter integer TableBits      = 8
 ) ();
 
-  localparam integer DEPTH     = 1 << ShinBits;
+  // The PROM's depth: 2^ShinBits words, 2^(ShinBits+TableBits) for the table (Kind 1).
+  localparam integer DEPTH     = 1 << (ShinBits + ((Kind == 1) ? TableBits : 0));
   localparam integer MAX_SHOWN = 10;
 
   reg                   clk_i   = 1'b0;
@@ -50,7 +54,8 @@ module tb_spec_unit #(
   shd_spec_unit #(
     .Degree(Degree), .CosFracBits(CosFracBits), .ShinBits(ShinBits), .CoefIntBits(CoefIntBits),
     .CoefFracBits(CoefFracBits), .DiffFracBits(DiffFracBits), .HornerFracBits(HornerFracBits),
-    .SpecFracBits(SpecFracBits), .LightBits(LightBits), .PipeStages(PipeStages)
+    .SpecFracBits(SpecFracBits), .LightBits(LightBits), .PipeStages(PipeStages), .Kind(Kind),
+    .TableBits(TableBits)
   ) dut (
     .clk_i(clk_i), .rst_ni(rst_ni), .valid_i(valid_i), .shin_i(shin_i), .cos_i(cos_i),
     .light_r_i(light_r_i), .light_g_i(light_g_i), .light_b_i(light_b_i), .valid_o(valid_o),
@@ -64,7 +69,7 @@ module tb_spec_unit #(
   reg     cycle_bad;
   reg     params_seen;
   reg     dumping;
-  integer hp [0:10];
+  integer hp [0:12];   // one more than the 12 parameters: a 13th number makes the line differ
   reg [63:0] f [0:11];   // one more than the 11 columns: a 12th field makes the line malformed
 
   task automatic clock;
@@ -113,16 +118,20 @@ module tb_spec_unit #(
       if (n > 0) begin
         lineno = lineno + 1;
         if (line[8*n-1 -: 8] == "#") begin
-          if ($sscanf(line, "# params %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4], hp[5],
-                      hp[6], hp[7], hp[8], hp[9], hp[10]) >= 1) begin
+          for (i = 0; i < 13; i = i + 1) hp[i] = 32'bx;
+          if ($sscanf(line, "# params %d %d %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4],
+                      hp[5], hp[6], hp[7], hp[8], hp[9], hp[10], hp[11], hp[12]) >= 1) begin
             if (hp[0] !== Degree || hp[1] !== CosFracBits || hp[2] !== ShinBits || hp[3] !== CoefIntBits ||
                 hp[4] !== CoefFracBits || hp[5] !== DiffFracBits || hp[6] !== HornerFracBits ||
-                hp[7] !== SpecFracBits || hp[8] !== LightBits || hp[9] !== PipeStages || hp[10] !== 32'bx) begin
+                hp[7] !== SpecFracBits || hp[8] !== LightBits || hp[9] !== PipeStages || hp[10] !== Kind ||
+                hp[11] !== TableBits || hp[12] !== 32'bx) begin
               if (line[7:0] == "\n") line = line >> 8;
               $display("tb_spec_unit: error: %0s, line %0d: '%0s' differs from the parameters compiled in:", path, lineno, line);
-              $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits SpecFracBits LightBits PipeStages)",
+              $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (%0s)",
                        Degree, CosFracBits, ShinBits, CoefIntBits, CoefFracBits, DiffFracBits, HornerFracBits,
-                       SpecFracBits, LightBits, PipeStages);
+                       SpecFracBits, LightBits, PipeStages, Kind, TableBits,
+                       {"Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits ",
+                        "SpecFracBits LightBits PipeStages Kind TableBits"});
               $fatal(1);
             end
             params_seen = 1'b1;

@@ -1,0 +1,185 @@
+// The alternative specular units (SpecKind table and schlick): the model against the functions
+// they stand for, computed here another way (bucket edges found by scanning the codes, the
+// rational in long double), at every input of small configurations; their PROMs; their pipeline
+// timing; and the checks that keep a kind and its parameters together.
+#include "device/spec_unit.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+
+#include "approx/lobe_error.h"
+#include "device/prom.h"
+#include "device/prom_io.h"
+
+using namespace shd;
+
+namespace {
+
+SpecUnitParams tableParams() {
+  SpecUnitParams p;
+  p.Kind = static_cast<int>(SpecKind::Table);
+  p.CosFracBits = 10;
+  p.ShinBits = 2;
+  p.TableBits = 4;
+  p.SpecFracBits = 12;
+  p.PipeStages = 1;
+  return p;
+}
+
+SpecUnitParams schlickParams() {
+  SpecUnitParams p;
+  p.Kind = static_cast<int>(SpecKind::Schlick);
+  p.CosFracBits = 11;
+  p.ShinBits = 3;
+  p.CoefIntBits = 10;
+  p.CoefFracBits = 2;  // n = 37.25 is exact
+  p.SpecFracBits = 16;
+  p.PipeStages = 5;
+  return p;
+}
+
+PromTable build(const SpecUnitParams& p, const std::string& n_list) {
+  PromRequest r;
+  r.fit = FitKind::Exact;
+  r.n = NSpec::parse(n_list, true);
+  return buildPromTable(r, p);
+}
+
+const std::array<uint32_t, 3> kFull = {255, 255, 255};
+
+}  // namespace
+
+TEST(SpecKindTable, EveryInputReadsTheMinimaxValueOfItsBucket) {
+  const SpecUnitParams p = tableParams();
+  const PromTable t = build(p, "1,8,100");
+  const SpecUnitModel m(p, t.words);
+  ASSERT_EQ(p.promDepth(), 4 << 4);
+  const double scale = std::ldexp(1.0, -p.CosFracBits);
+  for (const PromEntry& e : t.entries) {
+    // The buckets as the codes fall into them: the codes c in 0..2^Wc (inputs above 1.0 read
+    // c = 1.0) grouped by the index the unit forms, with their smallest and largest code.
+    std::map<int64_t, std::pair<int64_t, int64_t>> bucket;
+    for (int64_t c = 0; c <= p.cosOne(); ++c) {
+      const int64_t k = std::min<int64_t>(static_cast<int64_t>(std::floor(c * scale * 16)), 15);
+      auto [it, fresh] = bucket.emplace(k, std::make_pair(c, c));
+      if (!fresh) it->second.second = c;
+    }
+    ASSERT_EQ(bucket.size(), 16u);
+    for (uint32_t cos = 0; cos < (2u << p.CosFracBits); ++cos) {
+      const int64_t c = std::min<int64_t>(cos, p.cosOne());
+      const int64_t k = std::min<int64_t>(static_cast<int64_t>(std::floor(c * scale * 16)), 15);
+      const auto [lo, hi] = bucket.at(k);
+      const double want = 0.5 * (std::pow(lo * scale, e.n) + std::pow(hi * scale, e.n));
+      const SpecOut o = m.evaluate(e.address, cos, kFull);
+      ASSERT_EQ(o.spec, static_cast<uint32_t>(std::nearbyint(std::ldexp(want, p.SpecFracBits))))
+          << "n " << e.n << " cos " << cos;
+      ASSERT_EQ(m.trace(e.address, cos).f.raw(), o.spec);
+      // Within half the bucket's spread of c^n plus half an LSB of f.
+      const double spread = 0.5 * (std::pow(hi * scale, e.n) - std::pow(lo * scale, e.n));
+      ASSERT_LE(std::fabs(std::ldexp(o.spec, -p.SpecFracBits) - std::pow(c * scale, e.n)),
+                spread + std::ldexp(0.5, -p.SpecFracBits) + 1e-15);
+    }
+  }
+  // The unused address reads the all-zero row.
+  EXPECT_EQ(m.evaluate(3, p.cosOne(), kFull).spec, 0u);
+}
+
+TEST(SpecKindTable, ApproximationErrorCoversEveryCode) {
+  const SpecUnitParams p = tableParams();
+  const PromTable t = build(p, "8");
+  const Approx& f = t.entries[0].approx;
+  ASSERT_EQ(f.form, Approx::Form::Table);
+  double worst = 0;
+  for (int64_t c = 0; c <= p.cosOne(); ++c) {
+    const double x = std::ldexp(static_cast<double>(c), -p.CosFracBits);
+    worst = std::max(worst, std::fabs(f.eval(x) - std::pow(x, 8.0)));
+  }
+  // Over continuous c the error is at least the codes' (each bucket's value is fitted to its codes).
+  const RegionError lobe = summarizeError(f, 8).at("lobe");
+  EXPECT_GE(lobe.max_abs, worst);
+  EXPECT_LE(lobe.max_abs, worst + 8.0 * std::ldexp(1.0, -p.CosFracBits));  // one code's step of c^8
+}
+
+TEST(SpecKindSchlick, EveryInputIsTheTruncatedRational) {
+  const SpecUnitParams p = schlickParams();
+  const PromTable t = build(p, "1,1.5,37.25,1000");
+  const SpecUnitModel m(p, t.words);
+  const long double lsb = std::ldexp(1.0L, -p.SpecFracBits);
+  for (const PromEntry& e : t.entries) {
+    EXPECT_EQ(e.code.u, static_cast<int64_t>(std::ldexp(e.n - 1.0, p.CoefFracBits)));
+    for (uint32_t cos = 0; cos < (2u << p.CosFracBits); ++cos) {
+      const long double c = std::ldexp(static_cast<long double>(std::min<int64_t>(cos, p.cosOne())), -p.CosFracBits);
+      const long double q = c / (e.n - e.n * c + c);  // Schlick's rational
+      const SpecOut o = m.evaluate(e.address, cos, kFull);
+      const long double f = o.spec * lsb;
+      // floor: f <= q < f + 1 LSB (long double carries 64 bits, the quotient 17).
+      ASSERT_LE(f, q + 1e-15L) << "n " << e.n << " cos " << cos;
+      ASSERT_LT(q, f + lsb + 1e-15L) << "n " << e.n << " cos " << cos;
+      ASSERT_EQ(m.trace(e.address, cos).f.raw(), o.spec);
+    }
+  }
+  // Padding holds m = 0: f = c.
+  EXPECT_EQ(m.evaluate(7, 1234, kFull).spec, 1234u << (p.SpecFracBits - p.CosFracBits));
+}
+
+TEST(SpecKindSchlick, ApproximationErrorMatchesDenseSampling) {
+  const Approx f = Approx::schlick(100);
+  double worst = 0;
+  for (int i = 0; i <= 1000000; ++i) {
+    const double c = i / 1e6;
+    worst = std::max(worst, std::fabs(f.eval(c) - std::pow(c, 100.0)));
+  }
+  const RegionError lobe = summarizeError(f, 100).at("lobe");
+  EXPECT_NEAR(lobe.max_abs, worst, 1e-6);
+  EXPECT_GE(lobe.max_abs, worst);
+}
+
+TEST(SpecKinds, PipelineLatencyIsTwoPlusPipeStages) {
+  for (const SpecUnitParams& p : {tableParams(), schlickParams()}) {
+    SpecUnitModel m(p, build(p, "8").words);
+    SpecIn in;
+    in.valid = true;
+    in.shin = 0;
+    in.cos = static_cast<uint32_t>(p.cosOne());
+    in.light = kFull;
+    int ticks = 1;
+    for (SpecOut o = m.tick(in); !o.valid; o = m.tick(SpecIn{})) ++ticks;
+    EXPECT_EQ(ticks, p.latency()) << specKindInfo(p.kind()).name;
+  }
+}
+
+TEST(SpecKinds, ParametersAndFitMustSuitTheKind) {
+  SpecUnitParams p = tableParams();
+  p.TableBits = p.CosFracBits + 1;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = tableParams();
+  p.PipeStages = 2;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = schlickParams();
+  p.PipeStages = p.SpecFracBits + 2;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.Kind = 3;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  // exact is the fit of the table and schlick kinds, and only theirs.
+  PromRequest r;
+  r.n = NSpec::parse("8", true);
+  r.fit = FitKind::Inflection;
+  EXPECT_THROW(buildPromTable(r, schlickParams()), std::invalid_argument);
+  r.fit = FitKind::Exact;
+  EXPECT_THROW(buildPromTable(r, SpecUnitParams{}), std::invalid_argument);
+  // More n than shininess codes: the table's depth counts cosine buckets too, not more n.
+  EXPECT_THROW(build(tableParams(), "1,2,3,4,5"), std::invalid_argument);
+}
+
+TEST(SpecKinds, PromFilesRoundTrip) {
+  for (const SpecUnitParams& p : {tableParams(), schlickParams()}) {
+    const PromTable t = build(p, "1,8,100");
+    const std::string csv = renderProm(t, PromFormat::Csv);
+    const size_t rows = p.kind() == SpecKind::Table ? 3u << p.TableBits : 3u;
+    EXPECT_EQ(static_cast<size_t>(std::count(csv.begin(), csv.end(), '\n')), rows + 1);
+    for (PromFormat f : {PromFormat::Hex, PromFormat::Mem, PromFormat::Coe, PromFormat::Mif})
+      EXPECT_NE(renderProm(t, f).find(specKindInfo(p.kind()).name), std::string::npos);
+  }
+}
