@@ -1,0 +1,46 @@
+// Piecewise polynomial approximations of cos^n = c^n: the cosine range split into S segments per
+// n, each with its own polynomial of degree d, and f = 0 below the lowest segment (the cut-off).
+// The study behind a segmented specular unit: how far S segments bring the whole-lobe error
+// down, against the PROM bits and multipliers they cost (docs/specular-unit.md).
+//
+// minimaxSegment: the minimax polynomial of degree d for c^n on [a, b], by the Remez exchange
+//   with exact extrema: the error e = p - c^n has e^(d+2) = -n (n-1) ... c^(n-d-2), of one sign on
+//   (0, 1) for every real n not an integer in 1..d+1, so rootsByDerivativeChain finds every root
+//   of e' (lobe_error.h) and the extrema of e are those roots and the two ends. The polynomial is
+//   kept in the local variable t = (c - a) / (b - a) for conditioning.
+// fitPiecewise: the least whole-lobe maximum error reachable with S segments. For a target E
+//   the segments are laid greedily from c = 1 down, each as long as its minimax error stays
+//   within E (the error of a segment grows with its length); E is feasible when the S segments
+//   reach down to a cut b_0 with b_0^n <= E (the error of f = 0 below it). The least feasible E
+//   is found by bisection; every segment's error is then at most E, and the result says which
+//   is largest.
+#pragma once
+
+#include <vector>
+
+namespace shd {
+
+struct SegmentFit {
+  double a = 0, b = 1;              // the segment [a, b]
+  std::vector<double> q;            // p = sum q_i t^i, t = (c - a) / (b - a), i = 0..d
+  double err = 0;                   // max over [a, b] of |p - c^n|, exact up to rounding
+  int iterations = 0;               // Remez exchanges
+  double eval(double c) const;
+};
+
+// std::invalid_argument unless 0 <= a < b <= 1, 0 <= degree <= 3 and n >= 1.
+SegmentFit minimaxSegment(double n, int degree, double a, double b);
+
+struct PiecewiseFit {
+  double n = 0;
+  int degree = 2;
+  std::vector<SegmentFit> segments;  // from the top (ending at c = 1) down
+  double cut = 0;                    // b_0: f = 0 below it
+  double err = 0;                    // whole-lobe max |f - c^n| over [0, 1]
+  double eval(double c) const;
+};
+
+// std::invalid_argument unless 1 <= segments <= 64 and the arguments of minimaxSegment hold.
+PiecewiseFit fitPiecewise(double n, int segments, int degree);
+
+}  // namespace shd
