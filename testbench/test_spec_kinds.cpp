@@ -84,6 +84,10 @@ TEST(SpecKindTable, EveryInputReadsTheMinimaxValueOfItsBucket) {
   }
   // The unused address reads the all-zero row.
   EXPECT_EQ(m.evaluate(3, p.cosOne(), kFull).spec, 0u);
+  // A word above 1.0 is no table of c^n: the RTL would drop the top bit of f * L.
+  std::vector<PromWord> bad = t.words;
+  bad[5] = (PromWord{1} << p.SpecFracBits) + 1;
+  EXPECT_THROW(SpecUnitModel(p, bad), std::invalid_argument);
 }
 
 TEST(SpecKindTable, ApproximationErrorCoversEveryCode) {

@@ -65,6 +65,9 @@ SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
   for (size_t i = 0; i < prom_.size(); ++i) {
     if (wb < 128 && (prom_[i] >> wb) != 0)
       throw std::invalid_argument(fmt::format("PROM word {} has bits above its {}-bit width", i, wb));
+    // A table word is f itself: above 1.0 the RTL's MUL3..MUL5 would drop the result's top bit.
+    if (p_.kind() == SpecKind::Table && prom_[i] > (PromWord{1} << p_.SpecFracBits))
+      throw std::invalid_argument(fmt::format("PROM word {} of the table is above 1.0 (uQ1.{})", i, p_.SpecFracBits));
     coef_.push_back(decodePromWord(prom_[i], p_));
   }
   reset();

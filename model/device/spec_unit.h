@@ -69,7 +69,7 @@ struct SpecTrace {
 class SpecUnitModel {
  public:
   // prom holds promDepth() words; std::invalid_argument if not, or if a word has bits above
-  // promWordBits().
+  // promWordBits() (the table kind: a word above 1.0).
   SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom);
 
   const SpecUnitParams& params() const { return p_; }

@@ -29,11 +29,14 @@ using shd::fuzz::finding;
 
 void checkSpecDatapath(const shd::SpecUnitParams& p) {
   const int bits = p.promWordBits();
-  const shd::PromWord ones = bits >= 128 ? ~shd::PromWord{0} : (shd::PromWord{1} << bits) - 1;
+  // The largest word: all ones, but for the table, whose words are f <= 1.0, the word 1.0.
+  const shd::PromWord ones = p.kind() == shd::SpecKind::Table ? shd::PromWord{1} << p.SpecFracBits
+                             : bits >= 128                    ? ~shd::PromWord{0}
+                                                              : (shd::PromWord{1} << bits) - 1;
   const uint32_t one = static_cast<uint32_t>(p.cosOne());
   const uint32_t cos_codes[] = {0, 1, one / 2, one - 1, one, 2 * one - 1};
   const uint32_t light = static_cast<uint32_t>(p.lightMax());
-  const uint32_t last_shin = static_cast<uint32_t>(p.promDepth() - 1);
+  const uint32_t last_shin = static_cast<uint32_t>(p.shinCodes() - 1);
   for (shd::PromWord word : {shd::PromWord{0}, ones}) {
     const shd::SpecUnitModel unit(p, std::vector<shd::PromWord>(static_cast<size_t>(p.promDepth()), word));
     for (uint32_t shin : {0u, last_shin})
