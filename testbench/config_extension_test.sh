@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# config_extension_test.sh SOURCE_DIR WORK_DIR: adding a configuration is adding one JSON file.
+# config_extension_test.sh SOURCE_DIR WORK_DIR BUILD_DIR: adding a configuration is adding one
+# JSON file.
 # Writes a new specular configuration (spec_trial.json) and a new lane mode (span_sierpinski2.json:
 # the 4-way split with two lanes per sub-triangle) into a directory of their own, configures a
 # scratch build with that directory added to the registry (SHD_CONFIG_DIRS), and checks that
@@ -11,12 +12,13 @@
 #   - they are tested: ctest holds their replay, Icarus, SystemC, synthesis and vector-freshness
 #     tests, and all but the SystemC ones pass once scripts/regen_vectors.sh has made their PROM
 #     and vector files.
-# The scratch build is Debug at -O0 with verilated models of the two new configurations only
-# (SHD_VERILATE: the checks run little; compiling is what costs); the registry's other
-# configurations are there for the golden model, marked "no verilated model". shadesim_systemc is
-# not compiled here (50 CPU-seconds at -O0, a quarter of the scratch build): the main build runs
-# the SystemC testbench on every configuration of the registry, through the same per-configuration
-# CMake code that this build generates for the new ones.
+# The scratch build compiles only what depends on the registry: its embedded files and the
+# verilated models of the two new configurations (SHD_VERILATE); the model, vector, co-simulation
+# and CLI libraries are BUILD_DIR's, the build running this test (SHD_PREBUILT, of the same
+# source tree and build type). The registry's other configurations are there for the golden
+# model, marked "no verilated model". shadesim_systemc is not compiled here: the main build runs
+# the SystemC testbench on every configuration of the registry, through the same
+# per-configuration CMake code that this build generates for the new ones.
 set -euo pipefail
 src=$(cd "$1" && pwd)
 work=$2
@@ -54,8 +56,11 @@ JSON
 build=$work/build
 generator=()
 command -v ninja >/dev/null && generator=(-G Ninja)
-step cmake -S "$src" -B "$build" "${generator[@]}" -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG=-O0 \
-  -DSHD_BENCHMARKS=OFF "-DSHD_CONFIG_DIRS=$src/vectors/config;$ext" "-DSHD_VERILATE=spec_trial;span_sierpinski2" \
+main=$(cd "$3" && pwd)
+type=$(sed -n 's/^CMAKE_BUILD_TYPE:[A-Z]*=//p' "$main/CMakeCache.txt")
+sanitize=$(sed -n 's/^SHD_SANITIZE:[A-Z]*=//p' "$main/CMakeCache.txt")
+step cmake -S "$src" -B "$build" "${generator[@]}" "-DCMAKE_BUILD_TYPE=$type" "-DSHD_SANITIZE=${sanitize:-OFF}" \
+  "-DSHD_PREBUILT=$main" -DSHD_BENCHMARKS=OFF "-DSHD_CONFIG_DIRS=$src/vectors/config;$ext" "-DSHD_VERILATE=spec_trial;span_sierpinski2" \
   >"$work/configure.log"
 grep -E '^-- shadesim configurations: spec .*trial.*; span .*sierpinski2' "$work/configure.log"
 grep -q 'Vsc_spec_trial' "$build/build.ninja"

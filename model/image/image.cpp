@@ -32,11 +32,6 @@ size_t checkedSamples(int width, int height, size_t channels, const char* what) 
   return w * h * channels;
 }
 
-void requireSameSize(int w0, int h0, int w1, int h1, const char* what) {
-  if (w0 != w1 || h0 != h1)
-    throw std::invalid_argument(fmt::format("{}: sizes differ ({}x{} vs {}x{})", what, w0, h0, w1, h1));
-}
-
 // A png_image ready for the simplified API (the header asks for a zeroed struct with version).
 png_image blankPngImage() {
   png_image img;
@@ -50,6 +45,11 @@ png_image blankPngImage() {
 constexpr uint64_t kMaxReadPixels = uint64_t{1} << 28;
 
 }  // namespace
+
+void requireSameSize(int w0, int h0, int w1, int h1, const char* what) {
+  if (w0 != w1 || h0 != h1)
+    throw std::invalid_argument(fmt::format("{}: sizes differ ({}x{} vs {}x{})", what, w0, h0, w1, h1));
+}
 
 Image::Image(int w, int h) : width(w), height(h), rgb(checkedSamples(w, h, 3, "Image"), 0) {}
 

@@ -93,6 +93,9 @@ struct PixelMask {
 // Pixels set in both. std::invalid_argument if the sizes differ.
 PixelMask intersect(const PixelMask& a, const PixelMask& b);
 
+// std::invalid_argument "<what>: sizes differ (w0xh0 vs w1xh1)" unless the sizes are equal.
+void requireSameSize(int w0, int h0, int w1, int h1, const char* what);
+
 // Pixels whose largest channel exceeds threshold (strictly): e.g. the highlight region, from an
 // image of the reference specular term alone in LSB units.
 PixelMask thresholdMask(const ImageF& img, double threshold);

@@ -14,11 +14,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-void requireSameSize(int w0, int h0, int w1, int h1, const char* what) {
-  if (w0 != w1 || h0 != h1)
-    throw std::invalid_argument(fmt::format("{}: sizes differ ({}x{} vs {}x{})", what, w0, h0, w1, h1));
-}
-
 // Ref is ImageF (LSB values) or Image (codes, exact as doubles); mask nullptr selects all.
 template <typename Ref>
 ImageMetrics measure(const Image& test, const Ref& ref, const PixelMask* mask) {
