@@ -91,6 +91,14 @@ class ReportCmd final : public Command {
   void write(const Measured& m, json report, const fs::path& tmp) const;
 };
 
+// The registry's specular configurations of another kind than the paper's poly.
+std::vector<std::string> otherKindConfigs() {
+  std::vector<std::string> names;
+  for (const std::string& n : builtinConfigNames("spec"))
+    if (specConfig(n).rtl.kind() != SpecKind::Poly) names.push_back(n);
+  return names;
+}
+
 void ReportCmd::add(CLI::App& app) {
   app.add_option("--scene", scene_, "builtin:sphere | builtin:plane | builtin:torus | builtin:materials, a scene JSON "
                                     "file or a mesh file")
@@ -99,13 +107,10 @@ void ReportCmd::add(CLI::App& app) {
   app.add_option("--modes", modes_, "the lane modes (span configurations), comma-separated (default: every one of the registry, serial "
                  "first: " + fmt::format("{}", fmt::join(builtinConfigNames("span"), ",")) + ")")
       ->delimiter(',');
-  std::vector<std::string> alt;
-  for (const std::string& n : builtinConfigNames("spec"))
-    if (specConfig(n).rtl.kind() != SpecKind::Poly) alt.push_back(n);
   app.add_option("--spec-units", spec_units_,
                  "specular units of another kind than the paper's, each evaluating the quadratic lobe as a lobe "
                  "group of its own (<name>-unit): registry names or JSON files, comma-separated, or none (default: "
-                 "every one of the registry: " + fmt::format("{}", fmt::join(alt, ",")) + ")")
+                 "every one of the registry: " + fmt::format("{}", fmt::join(otherKindConfigs(), ",")) + ")")
       ->delimiter(',');
   app.add_option("--bench", bench_, "frames per row of the model; the median time is reported")
       ->check(countIn(1, 1000))
@@ -175,10 +180,7 @@ std::vector<SpanUnitConfig> ReportCmd::modeConfigs() const {
 }
 
 std::vector<SpecUnitConfig> ReportCmd::altUnitConfigs() const {
-  std::vector<std::string> names = spec_units_;
-  if (names.empty())
-    for (const std::string& n : builtinConfigNames("spec"))
-      if (specConfig(n).rtl.kind() != SpecKind::Poly) names.push_back(n);
+  const std::vector<std::string> names = spec_units_.empty() ? otherKindConfigs() : spec_units_;
   if (names == std::vector<std::string>{"none"}) return {};
   std::vector<SpecUnitConfig> units;
   for (const std::string& n : names) {
@@ -332,12 +334,13 @@ json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measur
       jobs.push_back({"span", c.name, "pnr", "place and route of " + what,
                       [rtl, t = *hw.pnr] { return unitPointPnr("span", rtl, "", json::object(), t); }});
   }
-  std::vector<SpecUnitConfig> spec = alt_units_;
-  spec.push_back(lobes.load(Lobe::Quadratic));
-  spec.push_back(lobes.load(Lobe::Cubic));
+  // The specular configurations a row may name, each with the lobe group it evaluates.
+  std::vector<std::pair<SpecUnitConfig, std::string>> spec = {{lobes.load(Lobe::Quadratic), toString(Lobe::Quadratic)},
+                                                               {lobes.load(Lobe::Cubic), toString(Lobe::Cubic)}};
+  for (const SpecUnitConfig& c : alt_units_) spec.push_back({c, unitLobeGroup(c.name)});
   for (const std::string& name : m.spec_configs) {
-    const SpecUnitConfig& c =
-        *std::find_if(spec.begin(), spec.end(), [&](const SpecUnitConfig& u) { return u.name == name; });
+    const auto& [c, lobe] =
+        *std::find_if(spec.begin(), spec.end(), [&](const auto& u) { return u.first.name == name; });
     units["spec"][c.name] = {{"description", c.description},
                              {"rtl", c.rtl.toJson()},
                              {"kind", specKindInfo(c.rtl.kind()).name},
@@ -345,9 +348,7 @@ json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measur
                              {"latency", c.rtl.latency()},
                              {"prom_bits", int64_t{c.rtl.promDepth()} * c.rtl.promWordBits()},
                              {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}},
-                             {"lobe", c.name == lobes.load(Lobe::Cubic).name      ? toString(Lobe::Cubic)
-                                      : c.name == lobes.load(Lobe::Quadratic).name ? toString(Lobe::Quadratic)
-                                                                                   : c.name + "-unit"}};
+                             {"lobe", lobe}};
     const std::string what = fmt::format("specular configuration {}", c.name);
     const auto table = std::make_shared<const PromTable>(buildPromTable(PromRequest::fromContent(c.prom), c.rtl));
     units["spec"][c.name]["scene_error"] = sceneSpecError(*table, scene_n_);

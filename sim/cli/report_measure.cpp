@@ -153,7 +153,7 @@ std::vector<LobeGroup> reportLobeGroups(const std::vector<std::string>& alt_unit
   std::vector<LobeGroup> g = {{"material", "", ""}};
   for (int l = static_cast<int>(Lobe::Phong); l <= static_cast<int>(Lobe::Pow); ++l)
     g.push_back({toString(static_cast<Lobe>(l)), toString(static_cast<Lobe>(l)), ""});
-  for (const std::string& u : alt_units) g.push_back({specConfig(u).name + "-unit", toString(Lobe::Quadratic), u});
+  for (const std::string& u : alt_units) g.push_back({unitLobeGroup(specConfig(u).name), toString(Lobe::Quadratic), u});
   return g;
 }
 

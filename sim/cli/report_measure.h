@@ -63,8 +63,11 @@ struct Measured {
   size_t renders_total = 0, renders_done = 0;  // rows to render, rendered or refused (progress)
 };
 
+// The lobe group of an alternative unit: "<configuration name>-unit".
+inline std::string unitLobeGroup(const std::string& config_name) { return config_name + "-unit"; }
+
 // The lobes considered for the scene: "material" and every brdf name, in Lobe's order, then one
-// per alternative unit (named "<configuration name>-unit").
+// per alternative unit (unitLobeGroup).
 std::vector<LobeGroup> reportLobeGroups(const std::vector<std::string>& alt_units);
 
 // Renders everything (stderr progress unless quiet). std::invalid_argument when no method and
