@@ -5,6 +5,7 @@
 #include "test_util.h"
 
 #include <filesystem>
+#include <set>
 #include <fstream>
 #include <sstream>
 
@@ -161,6 +162,7 @@ TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
     const uint32_t one = static_cast<uint32_t>(p.cosOne()), lmax = static_cast<uint32_t>(p.lightMax());
     uint64_t shin0 = 0, shin_max = 0, cos0 = 0, cos_one = 0, cos_above = 0, cos_max = 0, dark = 0, full = 0;
     uint64_t gaps = 0, below_cut = 0, at_cut = 0;
+    std::set<std::pair<uint32_t, uint32_t>> inputs;  // (shin, cos) of the valid cycles
     for (size_t i = 0; i < v.in.size(); ++i) {
       const SpecIn& in = v.in[i];
       if (!in.valid) {
@@ -179,9 +181,20 @@ TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
       const int64_t cut = cubic ? decodePromWord(words[in.shin], p).cut : 0;
       below_cut += cut > 0 && in.cos + 1 == cut;
       at_cut += cut > 0 && in.cos == cut;
+      inputs.insert({in.shin, in.cos});
     }
     for (uint64_t n : {shin0, shin_max, cos0, cos_one, cos_above, cos_max, dark, full}) EXPECT_GT(n, 0u) << config;
     EXPECT_GT(gaps, 100u) << config;  // valid dropped between valid inputs
+    if (p.kind() == SpecKind::Table) {
+      // Every 16th bucket edge of the last entry's row from both sides (random cosines hit an
+      // edge of a given row about once in 2^(Wc+1) draws).
+      const uint32_t last = static_cast<uint32_t>(
+          buildPromTable(PromRequest::fromContent(specConfig(config).prom), p).entries.size() - 1);
+      for (uint32_t k = 1; k < (1u << p.TableBits); k += 16) {
+        const uint32_t edge = k << (p.CosFracBits - p.TableBits);
+        EXPECT_TRUE(inputs.count({last, edge - 1}) && inputs.count({last, edge})) << config << " bucket edge " << k;
+      }
+    }
     if (p.kind() == SpecKind::Poly && p.Degree == 3) {
       EXPECT_GT(below_cut, 10u) << config;  // f cut to 0 one code below the cut-off ...
       EXPECT_GT(at_cut, 10u) << config;     // ... and not at it
