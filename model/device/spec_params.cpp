@@ -110,8 +110,12 @@ int SpecUnitParams::promWordBits() const {
 }
 
 void SpecUnitParams::validate() const {
-  require(Kind >= 0 && Kind < static_cast<int>(specKinds().size()), "Kind", Kind,
-          fmt::format("must be in 0..{} (0 poly, 1 table, 2 schlick)", specKinds().size() - 1));
+  if (Kind < 0 || Kind >= static_cast<int>(specKinds().size())) {
+    std::string names;
+    for (const SpecKindInfo& k : specKinds())
+      names += fmt::format("{}{} {}", names.empty() ? "" : ", ", static_cast<int>(k.kind), k.name);
+    require(false, "Kind", Kind, fmt::format("must be in 0..{} ({})", specKinds().size() - 1, names));
+  }
   require(CosFracBits >= 2 && CosFracBits <= 24, "CosFracBits", CosFracBits, "must be in 2..24");
   require(ShinBits >= 1 && ShinBits <= 16, "ShinBits", ShinBits, "must be in 1..16");
   require(CoefIntBits >= 1 && CoefIntBits <= 32, "CoefIntBits", CoefIntBits, "must be in 1..32");

@@ -71,20 +71,7 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
   const uint32_t depth = static_cast<uint32_t>(p.shinCodes());
   const uint32_t last_entry = static_cast<uint32_t>(std::max<size_t>(table.entries.size(), 1) - 1);
   const uint32_t one = static_cast<uint32_t>(p.cosOne()), lmax = static_cast<uint32_t>(p.lightMax());
-  for (uint32_t shin : {0u, 1u, depth / 2, last_entry, depth - 1})
-    for (uint32_t cos : {0u, 1u, one / 2, one - 1, one, one + 1, 2 * one - 1})
-      for (const std::array<uint32_t, 3>& light : {std::array<uint32_t, 3>{0, 0, 0}, std::array<uint32_t, 3>{lmax, lmax, lmax},
-                                                   std::array<uint32_t, 3>{1, lmax / 2, lmax - 1}}) {
-        SpecIn in;
-        in.valid = true;
-        in.shin = shin;
-        in.cos = cos;
-        in.light = light;
-        corners.push_back(in);
-      }
-
-  // Degree 3: the cut-off boundary, cos one code below, at and above the cut of every eighth
-  // table entry and the last (the exact boundary is one code in 2^(Wc+1): random cosines miss it).
+  // One valid input; cosines outside the port's codes are left out.
   auto corner = [&](uint32_t shin, int64_t cos, const std::array<uint32_t, 3>& light) {
     if (cos < 0 || cos > 2 * int64_t{one} - 1) return;
     SpecIn in;
@@ -94,6 +81,14 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
     in.light = light;
     corners.push_back(in);
   };
+  for (uint32_t shin : {0u, 1u, depth / 2, last_entry, depth - 1})
+    for (uint32_t cos : {0u, 1u, one / 2, one - 1, one, one + 1, 2 * one - 1})
+      for (const std::array<uint32_t, 3>& light : {std::array<uint32_t, 3>{0, 0, 0}, std::array<uint32_t, 3>{lmax, lmax, lmax},
+                                                   std::array<uint32_t, 3>{1, lmax / 2, lmax - 1}})
+        corner(shin, cos, light);
+
+  // Degree 3: the cut-off boundary, cos one code below, at and above the cut of every eighth
+  // table entry and the last (the exact boundary is one code in 2^(Wc+1): random cosines miss it).
   // The table: both sides of every 16th bucket edge of the last entry's row (the index is the
   // cosine's top TableBits bits).
   if (p.kind() == SpecKind::Table)
