@@ -1,5 +1,5 @@
 // shd_spec_unit: specular term ks*L * f(N.H), f from a PROM indexed by the shininess code (paper
-// Fig. 11), by one of three datapaths chosen by the parameter Kind; ports and back end are common.
+// Fig. 11), by one of four datapaths chosen by the parameter Kind; ports and back end are common.
 // Why:      Kind 0, poly (rtl/shd_spec_poly.v, the paper's device): f(c) = a*(c^2 - c) + c =
 //           a c^2 + (1-a) c needs two multipliers and no pow; a(n) comes from the PROM. Degree 3 is
 //           the same structure with a Horner step: f = c + (c^2 - c)*(u*c + v), u = a1,
@@ -8,37 +8,49 @@
 //           c}: no arithmetic before MUL3..MUL5, but 2^T PROM words per shininess code.
 //           Kind 2, schlick (rtl/shd_spec_schlick.v): Schlick's rational c / (n - n c + c) =
 //           c / ((n-1)(1-c) + 1), m = n - 1 from the PROM, one multiplier and a restoring divider.
+//           Kind 3, explog (rtl/shd_spec_explog.v): the exact power c^n = 2^(-n L), L = -log2 c,
+//           n from the PROM, by two fixed interpolated tables (log and exp, 2^T words each, in
+//           block RAM) and three multipliers: no fit and no per-n table.
 //           Every kind ends in the same stage D (MUL3..MUL5) and output registers.
 // Latency:  2 + PipeStages cycles valid_i -> valid_o; one result per cycle, no stalls.
-//           Cycle 1: RG1..RG5 (the PROM's address register is RG1). Optional registers:
+//           Cycle 1: RG1..RG5 (the PROM's address register is RG1; Kind 3 adds its own cycle-1
+//           registers and the log ROM's read register in shd_spec_explog). Optional registers:
 //           Kind 0 (PipeStages 0..3): enabled in this order as PipeStages grows: B after
 //             MUL2+rounding, A after Sm1 (and Horner), C after Sm2+clamp.
 //           Kind 1 (PipeStages 0..1): T between the PROM output and stage D.
 //           Kind 2 (PipeStages 0..Wf+1): that many ranks spread evenly over the Wf+1 divider steps
 //             (rank j after step floor(j*(Wf+1)/(PipeStages+1)), step 0 being the den multiply).
+//           Kind 3 (PipeStages 1..3): X, the exp ROM's read register, always; then A after
+//             P = DN*G (PipeStages >= 2), C after the rounding of f (PipeStages = 3).
 //           Output registers load only while their stage is valid, so the outputs hold the last
 //           result; valid and outputs reset to 0 (rst_ni, asynchronous).
 // Formats:  cos_i uQ1.Wc (codes above 1.0 saturate to 1.0: an upstream N.H may overshoot);
 //           PROM word: Kind 0 the coefficient uQCi.Cf (degree 2) or {cut-off uQ1.Wc, v, u} in
 //           sQCi.Cf (degree 3); Kind 1 f itself, uQ1.Wf; Kind 2 m = n - 1, uQCi.Cf (unsigned; the
-//           padding words are 0, giving f = c). spec_o = f in uQ1.Wf, in [0, 1];
+//           padding words are 0, giving f = c); Kind 3 n itself, uQCi.Cf (unsigned; the padding
+//           words are 0, giving f = 1 for c > 0). spec_o = f in uQ1.Wf, in [0, 1];
 //           light_*_i and spec_*_o unorm LightBits (code/(2^LightBits-1)), spec_x = round(f*L_x).
 // Widths:   PROM address: ShinBits; Kind 1 ShinBits + T, {shin_i, idx} with
 //           idx = min(c >> (Wc - T), 2^T - 1) (c >> (Wc - T) <= 2^T, equal only for c = 1.0), formed
 //           from the input ports so that the PROM's address register is the cycle-1 register.
 //           PROM word: Kind 0 KW = Ci + Cf (degree 2) or 2*KW + Wc + 1 (degree 3); Kind 1 Wf + 1;
-//           Kind 2 KW. The datapaths' widths are derived in their files (Kind 0: c^2 - c in
+//           Kind 2 and 3 KW. The datapaths' widths are derived in their files (Kind 0: c^2 - c in
 //           [-1/4, 0] gives dt Df-1 bits, MUL2 KW+DTW or DTW+GTW bits signed, g KW+Wc+1 bits;
-//           Kind 2: den KW+Wc+1 bits, f <= 1). Stage D: f <= 1, so f*L_x <= L_x * 2^Wf and the
-//           rounded result fits LightBits (see there).
+//           Kind 2: den KW+Wc+1 bits, f <= 1; Kind 3: the table words, L <= Wc, y, f <= 1).
+//           Kind 3 takes c from c_d (cycle 0): its log ROM's address register is a cycle-1
+//           register, as the table kind's PROM address is. Stage D: f <= 1, so
+//           f*L_x <= L_x * 2^Wf and the rounded result fits LightBits (see there).
 // Rounding: Kind 0: Trunc (floor) of c^2 - c to Df bits and of g to Hf bits; RoundHalfUp of the
 //           MUL2 product to Wf bits; Sm2 saturates f to [0, 1] (degree 2: only the lower clamp can
 //           act). Kind 1: none in the unit (the table words are f as `shadesim prom` rounded them).
-//           Kind 2: Trunc (floor) of the quotient to Wf bits. All: RoundHalfUp of MUL3..MUL5 to
-//           integers.
-// Checks:   a Kind outside 0..2, a Degree other than 2 or 3 (Kind 0), PipeStages outside its kind's
-//           range or TableBits outside 1..Wc (Kind 1) instantiate the module
-//           shd_spec_unit_bad_parameter, which does not exist: every tool stops at elaboration.
+//           Kind 2: Trunc (floor) of the quotient to Wf bits. Kind 3: table words rounded half
+//           up; Trunc (floor) of both interpolations, of L and of y's fraction; RoundHalfUp of f
+//           to Wf bits. All: RoundHalfUp of MUL3..MUL5 to integers.
+// Checks:   a Kind outside 0..3, a Degree other than 2 or 3 (Kind 0), PipeStages outside its kind's
+//           range, TableBits outside 1..Wc (Kind 1) or 1..min(Wc, Wf+3) (Kind 3), or Kind 3's
+//           log-table fraction bits GF = Wf + 6 + max(0, Ci - Wc - 4) above 56 (its tables are
+//           60-bit fixed point) instantiate the module shd_spec_unit_bad_parameter, which does
+//           not exist: every tool stops at elaboration.
 // Model:    model/device/spec_unit.h SpecUnitModel, bit-exact and cycle-accurate.
 module shd_spec_unit #(
   parameter integer Degree         = 2,
@@ -78,15 +90,19 @@ module shd_spec_unit #(
   localparam integer LW    = 3 * LightBits;
   localparam integer AB    = (Kind == 1) ? ShinBits + TableBits : ShinBits;  // PROM address
   localparam integer WORD  = (Kind == 1) ? FW                                // PROM word
-                           : (Kind == 2) ? KW
+                           : (Kind == 2 || Kind == 3) ? KW
                            : (Degree == 2) ? KW : 2 * KW + CW;
-  localparam integer PMAX  = (Kind == 1) ? 1 : (Kind == 2) ? WF + 1 : 3;    // PipeStages range
+  localparam integer PMIN  = (Kind == 3) ? 1 : 0;                          // PipeStages range
+  localparam integer PMAX  = (Kind == 1) ? 1 : (Kind == 2) ? WF + 1 : 3;
+  localparam integer XGF   = WF + 6 + ((CoefIntBits > WC + 4) ? CoefIntBits - WC - 4 : 0);
   localparam [CW-1:0] COS_ONE = {1'b1, {WC{1'b0}}};
 
   generate
-    if (Kind < 0 || Kind > 2 || PipeStages < 0 || PipeStages > PMAX ||
+    if (Kind < 0 || Kind > 3 || PipeStages < PMIN || PipeStages > PMAX ||
         (Kind == 0 && Degree != 2 && Degree != 3) ||
-        (Kind == 1 && (TableBits < 1 || TableBits > CosFracBits))) begin : g_bad_parameter
+        (Kind == 1 && (TableBits < 1 || TableBits > CosFracBits)) ||
+        (Kind == 3 && (TableBits < 1 || TableBits > CosFracBits || TableBits > WF + 3 ||
+                       XGF > 56))) begin : g_bad_parameter
       shd_spec_unit_bad_parameter u_bad ();   // no such module: see Checks in the header
     end
   endgenerate
@@ -148,6 +164,27 @@ module shd_spec_unit #(
         .data_o ({f_cr, light_c})
       );
       wire unused_c = ^c_q1;                 // the table was addressed with c already
+    end else if (Kind == 3) begin : g_explog
+      shd_spec_explog #(
+        .CosFracBits (CosFracBits),
+        .CoefIntBits (CoefIntBits),
+        .CoefFracBits(CoefFracBits),
+        .SpecFracBits(SpecFracBits),
+        .LightBits   (LightBits),
+        .TableBits   (TableBits),
+        .PipeStages  (PipeStages)
+      ) u_explog (
+        .clk_i   (clk_i),
+        .rst_ni  (rst_ni),
+        .c_i     (c_d),
+        .valid_q1(valid_q1),
+        .n_i     (word_q1),
+        .light_i (light_q1),
+        .valid_o (valid_c),
+        .f_o     (f_cr),
+        .light_o (light_c)
+      );
+      wire unused_c = ^c_q1;                 // the log ROM was addressed with c already
     end else if (Kind == 2) begin : g_schlick
       shd_spec_schlick #(
         .CosFracBits (CosFracBits),

@@ -574,8 +574,8 @@ def main(argv):
         for o in args.only:
             if o not in known:
                 raise ProofError(f"--only {o}: not one of {', '.join(known)}")
-        # The proofs model the paper's device (Kind 0). The table and schlick kinds have no proof
-        # here: their model is checked at every input against the functions they stand for
+        # The proofs model the paper's device (Kind 0). The other kinds have no proof here: their
+        # model is checked at every input against the functions they stand for
         # (test_spec_kinds) and the RTL against the model at every input (test_spec_cosim).
         other_kind = [f"spec:{c['name']}" for c in configs if c["unit"] == "spec" and c["rtl"].get("Kind", 0) != 0]
         for o in args.only:

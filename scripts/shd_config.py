@@ -40,7 +40,7 @@ DEFAULT_DIR = os.path.join(ROOT, "vectors", "config")
 # The units: their top module and RTL files (in rtl/, the top first).
 UNITS = {
     "spec": {"top": "shd_spec_unit", "rtl": ["shd_spec_unit.v", "shd_spec_poly.v", "shd_spec_schlick.v",
-                                             "shd_coef_rom.v", "shd_pipe_reg.v"]},
+                                             "shd_spec_explog.v", "shd_coef_rom.v", "shd_pipe_reg.v"]},
     "span": {"top": "shd_span_unit", "rtl": ["shd_span_unit.v"]},
 }
 # The figures a configuration's optional "expected" member may record, per unit: group -> figure

@@ -9,11 +9,11 @@ Usage: scripts/synth.py CONFIG [--unit spec|span] [--prom FILE] [--out DIR]
 CONFIG is a configuration file (<unit>_<name>.json; --unit names the unit of a file named
 otherwise) or "<unit>:<name>" of the registry vectors/config/ (scripts/shd_config.py reads it:
 `shd_config.py list` prints the registry). The unit decides the top module and the RTL files:
-spec is shd_spec_unit (rtl/shd_spec_unit.v, shd_spec_poly.v, shd_spec_schlick.v, shd_coef_rom.v,
-shd_pipe_reg.v), span is shd_span_unit (rtl/shd_span_unit.v). Everything below is about the spec
-unit except where "A span configuration" says otherwise. The spec unit's parameter Kind chooses its
-datapath (0 poly, 1 table, 2 schlick; rtl/shd_spec_unit.v); a parameter the configuration leaves
-out takes the Verilog default (Kind 0, TableBits 8) here as in the RTL.
+spec is shd_spec_unit (rtl/shd_spec_unit.v, shd_spec_poly.v, shd_spec_schlick.v, shd_spec_explog.v,
+shd_coef_rom.v, shd_pipe_reg.v), span is shd_span_unit (rtl/shd_span_unit.v). Everything below is
+about the spec unit except where "A span configuration" says otherwise. The spec unit's parameter
+Kind chooses its datapath (0 poly, 1 table, 2 schlick, 3 explog; rtl/shd_spec_unit.v); a parameter
+the configuration leaves out takes the Verilog default (Kind 0, TableBits 8) here as in the RTL.
   --prom    the PROM ($readmemh hex file). Default: the repository's vectors/prom/spec_<name>.hex
             when it exists and CONFIG is the registry's configuration of that name (the same JSON);
             otherwise make one with `shadesim prom --config CONFIG --format hex -o FILE` and pass
@@ -31,7 +31,7 @@ mixed, and yosys warns about out-of-range selects in those intermediate modules)
 becomes RomFile, an absolute path (yosys reads it at elaboration: `initial $readmemh` under
 SYNTHESIS). The PROM must hold exactly its depth of words of the configuration's word width:
 2^ShinBits words (2^(ShinBits+TableBits) for Kind 1) of KW = CoefIntBits+CoefFracBits bits (Kind 0
-degree 2, Kind 2), 2*KW+CosFracBits+1 bits (Kind 0 degree 3) or SpecFracBits+1 bits (Kind 1).
+degree 2, Kinds 2 and 3), 2*KW+CosFracBits+1 bits (Kind 0 degree 3) or SpecFracBits+1 bits (Kind 1).
 Paths travel inside yosys commands (RomFile as a Verilog string), so the PROM, the output
 directory and the RTL directory must not contain whitespace, quotes, backslashes or ';'.
 Flows:
@@ -63,7 +63,10 @@ Output (in --out; every file is written under a temporary name and renamed):
             RAMB18E1 (16384x1 .. 512x36) and RAMB36E1 (32768x1 .. 512x72) aspect ratios (yosys
             may pick either primitive when they tie, so kbit is compared, not the count). Also:
             no $mem cell and no distributed-RAM/ROM primitive is left. Fails when the ROM falls
-            into LUTs (rom_style = "logic", an asynchronous read) or is duplicated.
+            into LUTs (rom_style = "logic", an asynchronous read) or is duplicated. Kind 3 has
+            two more ROMs, its fixed log and exp tables of 2^TableBits words (rtl/shd_spec_explog.v
+            computes them at elaboration); their geometry comes from the same integer algorithm
+            here (explog_tables), and each of the three memories is counted on its own.
   dsps      The DSP count equals what the multipliers need. Operand widths come from the RTL
             header's derivation (uQ1.Wc: CW = Wc+1; KW = Ci+Cf; DTW = Df-1; GTW = Ci+1+Hf;
             FW = Wf+1; L = LightBits):
@@ -72,6 +75,11 @@ Output (in --out; every file is written under a temporary name and renamed):
                        deg 3: gt*dt  GTW x DTW signed                      (Kind 0)
               Horner   deg 3: u*c    KW x (CW+1) signed                    (Kind 0)
               den      m*(1-c)       KW x CW unsigned                      (Kind 2)
+              dg*r     log interp.   DGW x (Wc-T+1) unsigned               (Kind 3; GF, LF, EF,
+              DN*G     D g(D)        CW x GW unsigned                       EX, GW = GF+2,
+              N*L      y = n L       KW x (clog2(Wc+1)+LF) unsigned         DGW = GF-T+1,
+              de*r2    exp interp.   DEW x (EX-T) unsigned, when EX > T     DEW = EF-T+1 as in
+                                                                            rtl/shd_spec_explog.v)
               MUL3..5  f*L           FW x L unsigned (three of them)       (every Kind)
             (Kind 1, the table, has MUL3..5 only; the Kind 2 divider has no multiplier.)
             and each is tiled the way yosys's share/mul2dsp.v does it (iCE40: 16x16 tiles;
@@ -125,13 +133,14 @@ REQUIRED = {
     "spec": {0: ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
                  "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"],
              1: ["ShinBits", "SpecFracBits", "LightBits"],
-             2: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"]},
+             2: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"],
+             3: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"]},
     "span": ["NumTri", "LanesPerTri", "AlignLanes", "NumAttr", "AttrBits",
              "CoordBits", "RemBits", "PixBits", "TagBits"],
 }
 # The spec unit's Verilog defaults of the parameters a configuration may leave out.
 SPEC_DEFAULTS = {"Kind": 0, "TableBits": 8}
-SPEC_KINDS = {0: "poly", 1: "table", 2: "schlick"}
+SPEC_KINDS = {0: "poly", 1: "table", 2: "schlick", 3: "explog"}
 
 FLOWS = {
     "ice40": "synth_ice40 -dsp",
@@ -206,7 +215,7 @@ def missing_params(unit, rtl):
         if type(kind) is not int or kind not in SPEC_KINDS:
             raise ValueError(f"rtl.Kind = {json.dumps(kind)} is not one of "
                              + ", ".join(f"{k} ({n})" for k, n in SPEC_KINDS.items()))
-        need = REQUIRED[unit][kind] + (["TableBits"] if kind == 1 else [])
+        need = REQUIRED[unit][kind] + (["TableBits"] if kind in (1, 3) else [])
         rtl = spec_params(rtl)
     return [n for n in need if not isinstance(rtl.get(n), int)]
 
@@ -241,7 +250,7 @@ def prom_geometry(path, p):
         word_bits = p["SpecFracBits"] + 1
     else:
         kw = p["CoefIntBits"] + p["CoefFracBits"]
-        word_bits = kw if kind == 2 or p["Degree"] == 2 else 2 * kw + p["CosFracBits"] + 1
+        word_bits = kw if kind in (2, 3) or p["Degree"] == 2 else 2 * kw + p["CosFracBits"] + 1
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()
@@ -411,9 +420,58 @@ def multipliers(unit, p):
         cw = p["CosFracBits"] + 1
         kw = p["CoefIntBits"] + p["CoefFracBits"]
         m.append(("den m*omc", kw, cw, False, False, kw + cw))    # den = m*(1-c) + 1
+    elif p["Kind"] == 3:
+        wc, t = p["CosFracBits"], p["TableBits"]
+        kw = p["CoefIntBits"] + p["CoefFracBits"]
+        gf, lf, ef, ex = explog_widths(p)
+        dgw, rw, gw, llw, dew = gf - t + 1, wc - t + 1, gf + 2, (wc).bit_length() + lf, ef - t + 1
+        m.append(("dg*r", dgw, rw, False, False, dgw + rw))
+        m.append(("DN*G", wc + 1, gw, False, False, wc + 1 + gw))
+        m.append(("N*L", kw, llw, False, False, kw + llw))
+        if ex > t:
+            m.append(("de*r2", dew, ex - t, False, False, dew + ex - t))
     for k, ch in enumerate("RGB"):
         m.append((f"MUL{3 + k} f*L{ch}", fw, lb, False, False, fw - 1 + lb))
     return m
+
+
+def explog_widths(p):
+    """GF, LF, EF, EX of the explog kind (rtl/shd_spec_explog.v, SpecUnitParams::expLogWidths)."""
+    wf, ci, wc = p["SpecFracBits"], p["CoefIntBits"], p["CosFracBits"]
+    return wf + 6 + max(0, ci - wc - 4), wf + ci + 3, wf + 4, wf + 3
+
+
+def explog_tables(p):
+    """[(name, depth, word bits, varying bits)] of the explog kind's log and exp ROMs: their words
+    by the integer algorithm of rtl/shd_spec_explog.v (60-bit fixed point, floors, rounded half up),
+    so that the check knows which bit columns are constant."""
+    p = spec_params(p)
+    t = p["TableBits"]
+    gf, _, ef, _ = explog_widths(p)
+    q, log2e, ln2 = 60, 1663314137230540311, 799144290325165978
+
+    def g(i):
+        d, s, term = i << (q - t - 1), 0, 1 << q
+        for k in range(62):
+            s, term = s + term // (k + 1), (term * d) >> q
+        return (((s * log2e) >> q) + (1 << (q - gf - 1))) >> (q - gf)
+
+    def e(j):
+        z, pos, neg, term = ((j << (q - t)) * ln2) >> q, 0, 0, 1 << q
+        for k in range(30):
+            pos, neg = (pos + term, neg) if k % 2 == 0 else (pos, neg + term)
+            term = ((term * z) >> q) // (k + 1)
+        return (pos - neg + (1 << (q - ef - 1))) >> (q - ef)
+
+    gs, es = [g(i) for i in range((1 << t) + 1)], [e(j) for j in range((1 << t) + 1)]
+    gw, dgw, ew, dew = gf + 2, gf - t + 1, ef + 1, ef - t + 1
+    logw = [((gs[i + 1] - gs[i]) << gw) | gs[i] for i in range(1 << t)]
+    expw = [((es[j] - es[j + 1]) << ew) | es[j] for j in range(1 << t)]
+    out = []
+    for name, words, bits in (("log table", logw, dgw + gw), ("exp table", expw, dew + ew)):
+        varying = sum(1 for b in range(bits) if len({(v >> b) & 1 for v in words}) > 1)
+        out.append((name, 1 << t, bits, varying))
+    return out
 
 
 def ice40_brams(d_need, w_need):
@@ -487,11 +545,14 @@ def evaluate(c, tgt, wall, out, geometry, failed):
                           f"{r['distributed_ram']} distributed RAM/ROM cells (expected none)")
     else:
         depth, word_bits, varying = geometry
+        mems = [("PROM", depth, word_bits, varying)]
+        if spec_params(p)["Kind"] == 3:
+            mems += explog_tables(p)
         if tgt == "ice40":
-            exp["brams"] = ice40_brams(depth, varying)
+            exp["brams"] = sum(ice40_brams(d, v) for _, d, _, v in mems)
             rom_ok = r["brams"] == exp["brams"]
         else:
-            exp["bram_kbits"] = xc7_bram_kbits(depth, varying)
+            exp["bram_kbits"] = sum(xc7_bram_kbits(d, v) for _, d, _, v in mems)
             rom_ok = r["bram_kbits"] == exp["bram_kbits"]
         rom_ok = rom_ok and leftover_mem == 0 and r["distributed_ram"] == 0
         checks = dict(rom_bram=rom_ok, dsps=r["dsps"] == exp["dsps"], warnings=not warns)
@@ -503,8 +564,8 @@ def evaluate(c, tgt, wall, out, geometry, failed):
               f"cells {r['cells_total']:5d}  ROM in BRAM: {'yes' if rom_ok else 'NO'}")
         if not checks["rom_bram"]:
             want = f"{exp['brams']} SB_RAM40_4K" if tgt == "ice40" else f"{exp['bram_kbits']} kbit"
-            failed.append(f"{name}/{tgt} rom_bram: PROM {depth}x{varying} (of {word_bits} bits; "
-                          f"constant columns dropped) should take {want}; got {bram}, "
+            geo = " + ".join(f"{n} {d}x{v} (of {b} bits)" for n, d, b, v in mems)
+            failed.append(f"{name}/{tgt} rom_bram: {geo}, constant columns dropped, should take {want}; got {bram}, "
                           f"{leftover_mem} $mem, {r['distributed_ram']} distributed RAM/ROM cells")
     if not checks["dsps"]:
         failed.append(f"{name}/{tgt} dsps: {r['dsps']} DSPs, expected {exp['dsps']} = {per_mul}")

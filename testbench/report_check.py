@@ -198,7 +198,7 @@ def prom_bits(rtl):
     kind, kw = rtl.get("Kind", 0), rtl["CoefIntBits"] + rtl["CoefFracBits"]
     if kind == 1:
         return (1 << (rtl["ShinBits"] + rtl["TableBits"])) * (rtl["SpecFracBits"] + 1)
-    if kind == 2:
+    if kind in (2, 3):  # schlick m, explog n (its fixed log and exp tables are not the PROM)
         return (1 << rtl["ShinBits"]) * kw
     return (1 << rtl["ShinBits"]) * (kw if rtl["Degree"] == 2 else 2 * kw + rtl["CosFracBits"] + 1)
 

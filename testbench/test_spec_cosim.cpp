@@ -53,7 +53,7 @@ void expectClean(const SpecCosimResult& r, const CosimSetup& s) {
 
 }  // namespace
 
-// Every input of the paper's device (default) and of each alternative kind (table, schlick).
+// Every input of the paper's device (default) and of each alternative kind (table, schlick, explog).
 class SpecCosimExhaustive : public testing::TestWithParam<std::string> {};
 
 TEST_P(SpecCosimExhaustive, EveryInput) {
@@ -71,7 +71,7 @@ TEST_P(SpecCosimExhaustive, EveryInput) {
   expectClean(r, s);
 }
 
-INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimExhaustive, testing::Values("default", "table", "schlick"));
+INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimExhaustive, testing::Values("default", "table", "schlick", "explog"));
 
 class SpecCosimRandom : public testing::TestWithParam<std::string> {};
 
@@ -89,7 +89,7 @@ TEST_P(SpecCosimRandom, SeededWithValidGaps) {
   expectClean(r, s);
 }
 
-INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimRandom, testing::Values("narrow", "default", "wide", "cubic", "table", "schlick"));
+INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimRandom, testing::Values("narrow", "default", "wide", "cubic", "table", "schlick", "explog"));
 
 TEST(SpecCosim, DetectsADatapathDifferenceAndDumpsTheWindow) {
   // The checker must be able to fail: the model truncates c^2 - c one bit earlier than the RTL.

@@ -1,7 +1,7 @@
-// The alternative specular units (SpecKind table and schlick): the model against the functions
-// they stand for, computed here another way (bucket edges found by scanning the codes, the
-// rational in long double), at every input of small configurations; their PROMs; their pipeline
-// timing; and the checks that keep a kind and its parameters together.
+// The alternative specular units (SpecKind table, schlick and explog): the model against the
+// functions they stand for, computed here another way (bucket edges found by scanning the codes,
+// the rational and the power in long double), at every input of small configurations; their
+// PROMs; their pipeline timing; and the checks that keep a kind and its parameters together.
 #include "device/spec_unit.h"
 
 #include <gtest/gtest.h>
@@ -37,6 +37,19 @@ SpecUnitParams schlickParams() {
   p.CoefFracBits = 2;  // n = 37.25 is exact
   p.SpecFracBits = 16;
   p.PipeStages = 5;
+  return p;
+}
+
+SpecUnitParams expLogParams() {
+  SpecUnitParams p;
+  p.Kind = static_cast<int>(SpecKind::ExpLog);
+  p.CosFracBits = 11;
+  p.ShinBits = 3;
+  p.CoefIntBits = 10;
+  p.CoefFracBits = 2;  // n = 37.25 is exact
+  p.SpecFracBits = 14;
+  p.TableBits = 6;
+  p.PipeStages = 3;
   return p;
 }
 
@@ -140,8 +153,75 @@ TEST(SpecKindSchlick, ApproximationErrorMatchesDenseSampling) {
   EXPECT_GE(lobe.max_abs, worst);
 }
 
+TEST(SpecKindExpLog, TablesHoldTheFunctionsRoundedToTheirBits) {
+  SpecUnitParams p = expLogParams();
+  p.TableBits = 8;
+  p.SpecFracBits = 16;
+  const ExpLogWidths w = p.expLogWidths();
+  const ExpLogTables t = makeExpLogTables(p);
+  ASSERT_EQ(t.g.size(), 257u);
+  ASSERT_EQ(t.e.size(), 257u);
+  for (size_t i = 0; i < t.g.size(); ++i) {
+    const long double d = std::ldexp(static_cast<long double>(i), -(p.TableBits + 1));
+    const long double g = i == 0 ? 1.0L / std::log(2.0L) : -std::log2(1.0L - d) / d;
+    const long double e = std::exp2(-std::ldexp(static_cast<long double>(i), -p.TableBits));
+    // Rounded half up from 60 bits: within half a unit of the function (and a 2^-50 margin).
+    EXPECT_LE(std::fabs(t.g[i] - std::ldexp(g, w.GF)), 0.5L + 1e-9L) << "g " << i;
+    EXPECT_LE(std::fabs(t.e[i] - std::ldexp(e, w.EF)), 0.5L + 1e-9L) << "e " << i;
+  }
+  // The ends the datapath relies on: g(1/2) = 2 and 2^-1 exactly, e(0) = 1.
+  EXPECT_EQ(t.g.back(), int64_t{2} << w.GF);
+  EXPECT_EQ(t.e.front(), int64_t{1} << w.EF);
+  EXPECT_EQ(t.e.back(), int64_t{1} << (w.EF - 1));
+}
+
+// |f - c^n| in f-LSBs is at most: 1/2 (the final rounding); the log table's interpolation,
+// relative error g''(1/2) h^2 / 8 / g(0) with h = 2^-(T+1), which moves f by at most 1/e of it
+// (f ln2 y rel and y 2^-y <= 1/(e ln2)); the exp table's, (ln 2)^2 h^2 / 8 with h = 2^-T; the
+// truncations of L (n 2^-LF <= 2^-(Wf+3) in y) and of y (2^-EX = 2^-(Wf+3)), each moving f by
+// ln 2 times; the roundings of the table entries and the floor of the exp interpolation, 1.5 units of
+// 2^-EF; the log table's rounding, relative 2^-GF, below 2^-20 LSB here (neglected).
+double expLogBoundLsb(const SpecUnitParams& p) {
+  const ExpLogWidths w = p.expLogWidths();
+  const double one = std::ldexp(1.0, p.SpecFracBits), ln2 = std::log(2.0);
+  const double hl = std::ldexp(1.0, -(p.TableBits + 1)), he = std::ldexp(1.0, -p.TableBits);
+  const double log_interp = 4.4585 * hl * hl / 8 / (1 / ln2) / std::exp(1.0);
+  const double exp_interp = ln2 * ln2 * he * he / 8;
+  const double truncs = 2 * ln2 * std::ldexp(1.0, -(p.SpecFracBits + 3));
+  return 0.5 + (log_interp + exp_interp + truncs + 1.5 * std::ldexp(1.0, -w.EF)) * one;
+}
+
+TEST(SpecKindExpLog, EveryInputIsThePowerWithinItsBound) {
+  for (int T : {4, 6, 11}) {
+    SpecUnitParams p = expLogParams();
+    p.TableBits = T;
+    const PromTable t = build(p, "1,1.5,37.25,1000");
+    const SpecUnitModel m(p, t.words);
+    const double bound = expLogBoundLsb(p);
+    double worst = 0;
+    for (const PromEntry& e : t.entries) {
+      EXPECT_EQ(e.code.u, static_cast<int64_t>(std::ldexp(e.n, p.CoefFracBits)));
+      for (uint32_t cos = 0; cos < (2u << p.CosFracBits); ++cos) {
+        const long double c = std::ldexp(static_cast<long double>(std::min<int64_t>(cos, p.cosOne())), -p.CosFracBits);
+        const SpecOut o = m.evaluate(e.address, cos, kFull);
+        const double err = static_cast<double>(std::fabs(o.spec - std::ldexp(std::pow(c, static_cast<long double>(e.n)), p.SpecFracBits)));
+        ASSERT_LE(err, bound) << "T " << T << " n " << e.n << " cos " << cos;
+        worst = std::max(worst, err);
+        ASSERT_EQ(m.trace(e.address, cos).f.raw(), o.spec);
+      }
+    }
+    // The bound's terms peak at different inputs, so it is not reached; it stays within a factor
+    // of two (worst/bound: 0.61, 0.70, 0.85 for T = 4, 6, 11).
+    EXPECT_GT(worst, bound / 2) << "T " << T;
+  }
+  // Padding holds n = 0: f = 1 above c = 0, 0 at c = 0.
+  const SpecUnitModel m(expLogParams(), build(expLogParams(), "8").words);
+  EXPECT_EQ(m.evaluate(7, 1234, kFull).spec, 1u << expLogParams().SpecFracBits);
+  EXPECT_EQ(m.evaluate(7, 0, kFull).spec, 0u);
+}
+
 TEST(SpecKinds, PipelineLatencyIsTwoPlusPipeStages) {
-  for (const SpecUnitParams& p : {tableParams(), schlickParams()}) {
+  for (const SpecUnitParams& p : {tableParams(), schlickParams(), expLogParams()}) {
     SpecUnitModel m(p, build(p, "8").words);
     SpecIn in;
     in.valid = true;
@@ -164,9 +244,18 @@ TEST(SpecKinds, ParametersAndFitMustSuitTheKind) {
   p = schlickParams();
   p.PipeStages = p.SpecFracBits + 2;
   EXPECT_THROW(p.validate(), std::invalid_argument);
-  p.Kind = 3;
+  p.Kind = static_cast<int>(specKinds().size());
   EXPECT_THROW(p.validate(), std::invalid_argument);
-  // exact is the fit of the table and schlick kinds, and only theirs.
+  p = expLogParams();
+  p.PipeStages = 0;  // the exp table's read is a register rank
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p = expLogParams();
+  p.TableBits = p.SpecFracBits + 4;
+  p.CosFracBits = p.TableBits;
+  EXPECT_THROW(p.validate(), std::invalid_argument);
+  p.TableBits = p.SpecFracBits + 3;
+  EXPECT_NO_THROW(p.validate());
+  // exact is the fit of the kinds other than poly, and only theirs.
   PromRequest r;
   r.n = NSpec::parse("8", true);
   r.fit = FitKind::Inflection;
@@ -178,7 +267,7 @@ TEST(SpecKinds, ParametersAndFitMustSuitTheKind) {
 }
 
 TEST(SpecKinds, PromFilesRoundTrip) {
-  for (const SpecUnitParams& p : {tableParams(), schlickParams()}) {
+  for (const SpecUnitParams& p : {tableParams(), schlickParams(), expLogParams()}) {
     const PromTable t = build(p, "1,8,100");
     const std::string csv = renderProm(t, PromFormat::Csv);
     const size_t rows = p.kind() == SpecKind::Table ? 3u << p.TableBits : 3u;

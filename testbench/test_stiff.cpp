@@ -70,8 +70,8 @@ PromTable tableWithN(const std::string& config, const std::string& n_list) {
 }
 
 // The registry's units of the paper's kind (poly): the bounds below are its datapath's. The
-// table and schlick kinds are checked at every input against their own functions in
-// test_spec_kinds and against the RTL in test_spec_cosim.
+// other kinds are checked at every input against their own functions in test_spec_kinds and
+// against the RTL in test_spec_cosim.
 const std::vector<std::string>& specConfigs() {
   static const std::vector<std::string> names = [] {
     std::vector<std::string> v;

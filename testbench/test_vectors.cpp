@@ -185,14 +185,20 @@ TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
     }
     for (uint64_t n : {shin0, shin_max, cos0, cos_one, cos_above, cos_max, dark, full}) EXPECT_GT(n, 0u) << config;
     EXPECT_GT(gaps, 100u) << config;  // valid dropped between valid inputs
+    const uint32_t last = static_cast<uint32_t>(
+        buildPromTable(PromRequest::fromContent(specConfig(config).prom), p).entries.size() - 1);
     if (p.kind() == SpecKind::Table) {
       // Every 16th bucket edge of the last entry's row from both sides (random cosines hit an
       // edge of a given row about once in 2^(Wc+1) draws).
-      const uint32_t last = static_cast<uint32_t>(
-          buildPromTable(PromRequest::fromContent(specConfig(config).prom), p).entries.size() - 1);
       for (uint32_t k = 1; k < (1u << p.TableBits); k += 16) {
         const uint32_t edge = k << (p.CosFracBits - p.TableBits);
         EXPECT_TRUE(inputs.count({last, edge - 1}) && inputs.count({last, edge})) << config << " bucket edge " << k;
+      }
+    }
+    if (p.kind() == SpecKind::ExpLog) {  // the normalisation's steps: every power of two and its neighbours
+      for (uint32_t k = 0; k <= static_cast<uint32_t>(p.CosFracBits); ++k) {
+        const bool all = inputs.count({last, (1u << k) - 1}) && inputs.count({last, 1u << k}) && inputs.count({last, (1u << k) + 1});
+        EXPECT_TRUE(all) << config << " 2^" << k;
       }
     }
     if (p.kind() == SpecKind::Poly && p.Degree == 3) {

@@ -68,6 +68,7 @@ double Approx::poly(double c) const {
 double Approx::eval(double c) const {
   c = clamp01(c);
   if (form == Form::Schlick) return c / (n - n * c + c);
+  if (form == Form::Power) return std::pow(c, n);
   if (form == Form::Table) {
     const double scaled = std::floor(std::ldexp(c, tableBits()));
     return table[static_cast<size_t>(std::min(scaled, static_cast<double>(table.size() - 1)))];
@@ -78,7 +79,7 @@ double Approx::eval(double c) const {
 
 std::vector<double> Approx::kinks() const {
   std::vector<double> k;
-  if (form == Form::Schlick) return k;
+  if (form == Form::Schlick || form == Form::Power) return k;
   if (form == Form::Table) {
     for (size_t i = 1; i < table.size(); ++i) k.push_back(std::ldexp(static_cast<double>(i), -tableBits()));
     return k;
@@ -132,6 +133,13 @@ Approx Approx::cubic(double a1, double b1) {
 Approx Approx::schlick(double n) {
   Approx f;
   f.form = Form::Schlick;
+  f.n = n;
+  return f;
+}
+
+Approx Approx::power(double n) {
+  Approx f;
+  f.form = Form::Power;
   f.n = n;
   return f;
 }
@@ -205,7 +213,7 @@ double quadraticA(FitKind kind, double n, double level_q) {
     case FitKind::Minimax: return minimaxQuadratic(n).a;
     case FitKind::Exact: break;
   }
-  throw std::invalid_argument("fit 'exact' has no polynomial: it is the fit of the table and schlick kinds");
+  throw std::invalid_argument("fit 'exact' has no polynomial: it is the fit of the table, schlick and explog kinds");
 }
 
 Approx cubicMatchedAt(double n, double log_s) {

@@ -37,8 +37,8 @@
 //               a cancellation-free form; exact c^n at n = 1, 2, 3).
 //   Shortcut    degree 2 only: a = 0.786 n, the paper's cheap formula; offered as a labelled
 //               option only, its error claims do not hold (test_fit).
-//   Exact       no polynomial: the table kind stores c^n itself, the schlick kind uses n itself
-//               (the Approx forms Table and Schlick below); fitApprox refuses it.
+//   Exact       no polynomial: the table kind stores c^n itself, the schlick and explog kinds use
+//               n itself (the Approx forms Table, Schlick and Power below); fitApprox refuses it.
 //   Minimax     the coefficients minimising the whole-lobe (c in [0, 1]) maximum absolute error
 //               of the CLAMPED (and, degree 3, cut) approximation. See minimaxQuadratic and
 //               minimaxCubic.
@@ -60,15 +60,15 @@ constexpr double kMaxShininess = 1000.0;
 
 // The ideal device in double precision. Form Poly: the polynomial with its clamp and cut (the
 // header comment). Form Table (the table kind): f(c) = table[min(floor(c 2^T), 2^T - 1)], a step
-// function of c. Form Schlick: f(c) = c / (n - n c + c).
+// function of c. Form Schlick: f(c) = c / (n - n c + c). Form Power (the explog kind): f(c) = c^n.
 struct Approx {
-  enum class Form { Poly, Table, Schlick };
+  enum class Form { Poly, Table, Schlick, Power };
   Form form = Form::Poly;
   int degree = 2;
   double a = 0.0;                      // degree 2 coefficient
   double a1 = 0.0, b1 = 0.0, c1 = 0.0;  // monomial coefficients of p (degree 2: 0, a, 1 - a)
   double cut = 0.0;                    // degree 3 cut-off (0: none); always 0 for degree 2
-  double n = 0.0;                      // Schlick: the shininess
+  double n = 0.0;                      // Schlick, Power: the shininess
   std::vector<double> table;           // Table: 2^T values in [0, 1], bucket k = [k, k+1) / 2^T
 
   // The ideal device: the rule of the header comment, exactly.
@@ -83,6 +83,7 @@ struct Approx {
   // c1 = 1 - a1 - b1; the cut is derived from (a1, b1) by the rule above.
   static Approx cubic(double a1, double b1);
   static Approx schlick(double n);
+  static Approx power(double n);
   static Approx stepTable(std::vector<double> values);  // size a power of two
   int tableBits() const;  // T: log2 of the table's size
 };

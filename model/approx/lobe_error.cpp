@@ -359,8 +359,9 @@ ApproxErrorSummary summarizeError(const Approx& f, double n) {
   s.approx = f;
   for (const Region& reg : standardRegions(n)) {
     const bool rel = std::string_view(reg.name) != "lobe";
-    // The exact method covers the polynomial; the table's steps and Schlick's rational are
-    // sampled with their kinks as breakpoints (maxError, whose guarantee holds for both).
+    // The exact method covers the polynomial; the table's steps, Schlick's rational and the
+    // power itself are sampled with their kinks as breakpoints (maxError, whose guarantee holds
+    // for each).
     const RegionError e = f.form == Approx::Form::Poly
                               ? maxErrorExact(f, n, reg.lo, reg.hi, rel)
                               : maxError([&](double c) { return f.eval(c); }, n, reg.lo, reg.hi, rel, f.kinks());

@@ -126,7 +126,7 @@ void checkFitForKind(FitKind fit, const SpecUnitParams& unit) {
   if (exact != (unit.kind() != SpecKind::Poly))
     throw std::invalid_argument(fmt::format(
         "fit {} does not apply to the {} kind (the poly kind takes inflection, level, shortcut or minimax; the "
-        "table and schlick kinds take exact)",
+        "table, schlick and explog kinds take exact)",
         toString(fit), specKindInfo(unit.kind()).name));
 }
 
@@ -162,6 +162,11 @@ PromTable buildPromTable(const PromRequest& req, const SpecUnitParams& unit) {
         e.approx = Approx::schlick(e.n);
         e.u_real = e.n - 1.0;
         e.code.u = quantise(e.u_real, "m = n - 1", e.n);
+        break;
+      case SpecKind::ExpLog:
+        e.approx = Approx::power(e.n);
+        e.u_real = e.n;
+        e.code.u = quantise(e.u_real, "n", e.n);
         break;
       case SpecKind::Table: fillTableEntry(e, unit, t.words); break;
     }

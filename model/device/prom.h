@@ -5,8 +5,9 @@
 // words starts at i << TableBits). A range "lo:hi[:step]" lists
 // lo, lo+step, ... up to hi; an explicit list "8,32,200" keeps the user's order. Addresses from
 // the number of entries up to 2^ShinBits - 1 are unused and hold the all-zero word (degree 2:
-// a = 0, f = c; degree 3: u = v = 0, no cut, f = c; schlick: m = 0, f = c; table: f = 0).
-// Contents per kind: poly, the fitted coefficients; schlick, m = n - 1; table, the values of
+// a = 0, f = c; degree 3: u = v = 0, no cut, f = c; schlick: m = 0, f = c; table: f = 0;
+// explog: n = 0, f = 1 above c = 0). Contents per kind: poly, the fitted coefficients; schlick,
+// m = n - 1; explog, n; table, the values of
 // c^n per cosine bucket (prom.cpp fillTableEntry).
 // Rounding of the coefficients: round-half-even to the coefficient format (the table is made
 // once, offline; half-even has no bias). A coefficient that does not fit the format is an
@@ -63,8 +64,8 @@ struct PromTable {
   int addressOf(double n) const;
 };
 
-// std::invalid_argument unless the fit applies to the unit's kind: exact for the table and schlick
-// kinds, any other for the poly kind.
+// std::invalid_argument unless the fit applies to the unit's kind: exact for the table, schlick
+// and explog kinds, any other for the poly kind.
 void checkFitForKind(FitKind fit, const SpecUnitParams& unit);
 
 // Smallest ShinBits whose PROM holds `count` codes (at least 1).

@@ -38,7 +38,7 @@ struct Field {
 // the JSON sidecar state the same facts.
 struct Provenance {
   SpecKind kind = SpecKind::Poly;
-  int table_bits = 0;  // the table kind: words per row = 2^table_bits
+  int table_bits = 0;  // TableBits: the table kind's words per row, the explog kind's table size
   std::string spec_format;
   std::string tool;
   std::string fit;
@@ -76,12 +76,14 @@ Provenance provenanceOf(const PromTable& t) {
   p.spec_format = u.specFormat().str();
   const int cw = u.coefFormat().width();
   p.used = t.entries.size();
+  p.table_bits = u.TableBits;
   if (p.kind == SpecKind::Table) {
-    p.table_bits = u.TableBits;
     p.used <<= u.TableBits;
     p.layout.push_back({"f = c^n", p.spec_format, u.SpecFracBits, 0});
   } else if (p.kind == SpecKind::Schlick) {
     p.layout.push_back({"m = n-1", p.coef_format, cw - 1, 0});
+  } else if (p.kind == SpecKind::ExpLog) {
+    p.layout.push_back({"n", p.coef_format, cw - 1, 0});
   } else if (u.Degree == 2) {
     p.layout.push_back({"a", p.coef_format, cw - 1, 0});
   } else {
@@ -101,7 +103,7 @@ std::string layoutText(const Provenance& p) {
   return s + "}";
 }
 
-// The lines of the table and schlick kinds after the first.
+// The lines of the table, schlick and explog kinds after the first.
 std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std::string> l) {
   const bool table = p.kind == SpecKind::Table;
   l.push_back(fmt::format("kind: {}, fit: {}", specKindInfo(p.kind).name, p.fit));
@@ -113,14 +115,19 @@ std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std
                             "cos codes c ({2}) with min(c >> {3}, {1}) = k, round-half-even to {4}",
                             1 << p.table_bits, (1 << p.table_bits) - 1, p.cos_format,
                             p.cos_frac_bits - p.table_bits, p.spec_format));
-  else
+  else if (p.kind == SpecKind::Schlick)
     l.push_back(fmt::format("content: m = n - 1 {}, {}; f = c / (m (1 - c) + 1); cos: {}", p.coef_format,
                             p.coef_round, p.cos_format));
+  else
+    l.push_back(fmt::format("content: n {}, {}; f = 2^(n log2 c) by the unit's fixed log and exp tables (2^{} "
+                            "intervals each); cos: {}",
+                            p.coef_format, p.coef_round, p.table_bits, p.cos_format));
   l.push_back(fmt::format("word: {} bits = {} (MSB to LSB)", p.word_bits, layoutText(p)));
   l.push_back(fmt::format("depth: {} words, addresses 0..{} hold the {} codes", p.depth, p.used - 1, p.n_count));
   if (p.used < static_cast<size_t>(p.depth))
     l.push_back(fmt::format("padding: addresses {}..{} are unused and hold the all-zero word ({})", p.used,
-                            p.depth - 1, table ? "f = 0" : "m = 0: f = c"));
+                            p.depth - 1,
+                            table ? "f = 0" : p.kind == SpecKind::Schlick ? "m = 0: f = c" : "n = 0: f = 1 above c = 0"));
   else
     l.push_back("padding: none, every address holds a code");
   return l;
@@ -188,8 +195,8 @@ std::string csvTable(const PromTable& t) {
         out += fmt::format("{},{},{},{},{}\n", real17(e.n), a, k, real17(e.approx.table[k]),
                            decodePromWord(t.words[a], t.unit).u);
       }
-  } else if (t.unit.kind() == SpecKind::Schlick) {
-    out += "n,address,m_real,m_code\n";
+  } else if (t.unit.kind() != SpecKind::Poly) {  // schlick, explog: one code per n
+    out += t.unit.kind() == SpecKind::Schlick ? "n,address,m_real,m_code\n" : "n,address,n_real,n_code\n";
     for (const PromEntry& e : t.entries)
       out += fmt::format("{},{},{},{}\n", real17(e.n), e.address, real17(e.u_real), e.code.u);
   } else if (t.unit.Degree == 2) {

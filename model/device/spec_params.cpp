@@ -1,5 +1,7 @@
 #include "device/spec_params.h"
 
+#include <algorithm>
+
 #include <fmt/format.h>
 
 #include "config/params_json.h"
@@ -54,6 +56,21 @@ void validateSchlick(const SpecUnitParams& p) {
   requireModelWidth(p.CosFracBits + 1 + p.CoefFracBits + p.SpecFracBits, "the dividend c * 2^(Cf+Wf)");
 }
 
+void validateExpLog(const SpecUnitParams& p) {
+  const int tmax = std::min(p.CosFracBits, p.SpecFracBits + 3);
+  require(p.TableBits >= 1 && p.TableBits <= tmax, "TableBits", p.TableBits,
+          fmt::format("must be in 1..min(CosFracBits, SpecFracBits+3) = {} for explog", tmax));
+  require(p.PipeStages >= 1 && p.PipeStages <= 3, "PipeStages", p.PipeStages,
+          "must be in 1..3 for explog (the exp table's read is one register rank)");
+  const ExpLogWidths w = p.expLogWidths();
+  require(w.GF <= 56, "CoefIntBits", p.CoefIntBits,
+          fmt::format("makes the log table's fraction bits {} exceed 56 (its entries are computed to 60 bits)", w.GF));
+  int lbits = 1;  // bits of the integer part of L <= CosFracBits
+  while ((1 << lbits) < p.CosFracBits + 1) ++lbits;
+  requireModelWidth(p.CoefIntBits + p.CoefFracBits + lbits + w.LF, "y = n * L");
+  requireModelWidth(p.CosFracBits + 1 + w.gBits(), "P = D * G");
+}
+
 void validatePoly(const SpecUnitParams& p) {
   require(p.Degree == 2 || p.Degree == 3, "Degree", p.Degree, "must be 2 or 3");
   require(p.DiffFracBits >= 2 && p.DiffFracBits <= 2 * p.CosFracBits, "DiffFracBits", p.DiffFracBits,
@@ -90,6 +107,7 @@ const std::vector<SpecKindInfo>& specKinds() {
       {SpecKind::Poly, "poly", "the paper's device: a fitted polynomial, coefficients from the PROM"},
       {SpecKind::Table, "table", "c^n read from a table over shininess and cosine codes"},
       {SpecKind::Schlick, "schlick", "Schlick's rational c / (n - n c + c), with a divider"},
+      {SpecKind::ExpLog, "explog", "c^n = 2^(n log2 c) by logarithm and exponent tables, interpolated"},
   };
   return kinds;
 }
@@ -103,10 +121,16 @@ const SpecKindInfo& specKindInfo(SpecKind k) {
 int SpecUnitParams::promWordBits() const {
   switch (kind()) {
     case SpecKind::Table: return SpecFracBits + 1;
-    case SpecKind::Schlick: return coefFormat().width();
+    case SpecKind::Schlick:
+    case SpecKind::ExpLog: return coefFormat().width();
     case SpecKind::Poly: break;
   }
   return Degree == 2 ? coefFormat().width() : 2 * coefFormat().width() + CosFracBits + 1;
+}
+
+ExpLogWidths SpecUnitParams::expLogWidths() const {
+  const int wf = SpecFracBits;
+  return {wf + 6 + std::max(0, CoefIntBits - CosFracBits - 4), wf + CoefIntBits + 3, wf + 4, wf + 3};
 }
 
 void SpecUnitParams::validate() const {
@@ -127,6 +151,7 @@ void SpecUnitParams::validate() const {
     case SpecKind::Poly: validatePoly(*this); break;
     case SpecKind::Table: validateTable(*this); break;
     case SpecKind::Schlick: validateSchlick(*this); break;
+    case SpecKind::ExpLog: validateExpLog(*this); break;
   }
   requireModelWidth(LightBits + 1 + SpecFracBits, "MUL3..MUL5 f*L");
   if (promWordBits() > 128)

@@ -14,14 +14,25 @@ namespace shd {
 
 // The kinds of specular unit (the parameter Kind), one list: the paper's polynomial device and the
 // alternatives a designer would weigh against it (rtl/shd_spec_unit.v describes each datapath).
-enum class SpecKind { Poly = 0, Table = 1, Schlick = 2 };
+enum class SpecKind { Poly = 0, Table = 1, Schlick = 2, ExpLog = 3 };
 struct SpecKindInfo {
   SpecKind kind;
-  const char* name;   // "poly", "table", "schlick"
+  const char* name;   // "poly", "table", "schlick", "explog"
   const char* what;   // one line for tables and --help
 };
 const std::vector<SpecKindInfo>& specKinds();
 const SpecKindInfo& specKindInfo(SpecKind k);
+
+// The widths the explog kind derives from the parameters (rtl/shd_spec_explog.v proves each):
+// fraction bits of the log table's g = -log2(1 - D) / D, of L = -log2 c, of the exp table's
+// e = 2^-x, and of y = n L as the exp table and its interpolation use it.
+struct ExpLogWidths {
+  int GF, LF, EF, EX;
+  int gBits() const { return GF + 2; }             // g <= 2
+  int gStepBits(int T) const { return GF - T + 1; }
+  int eBits() const { return EF + 1; }             // e <= 1
+  int eStepBits(int T) const { return EF - T + 1; }
+};
 
 struct SpecUnitParams {
   int Degree = 2;           // 2: a c^2 + (1-a) c ; 3: cubic, Horner form, with cut-off
@@ -33,10 +44,11 @@ struct SpecUnitParams {
   int HornerFracBits = 14;  // Hf: degree 3 only, g = u*c + v truncated to Hf fraction bits
   int SpecFracBits = 16;    // Wf: the specular value f leaves Sm2 as uQ1.Wf
   int LightBits = 8;        // light channels (k_s * L) and colour out: unorm LightBits
-  int PipeStages = 1;       // internal pipeline registers (poly 0..3, table 0..1, schlick 0..Wf+1);
-                            // latency = 2 + PipeStages
-  int Kind = 0;             // SpecKind: 0 poly (Degree 2 or 3), 1 table, 2 schlick
-  int TableBits = 8;        // table only: cosine address bits T, 1..CosFracBits
+  int PipeStages = 1;       // internal pipeline registers (poly 0..3, table 0..1, schlick 0..Wf+1,
+                            // explog 1..3); latency = 2 + PipeStages
+  int Kind = 0;             // SpecKind: 0 poly (Degree 2 or 3), 1 table, 2 schlick, 3 explog
+  int TableBits = 8;        // table: cosine address bits T, 1..CosFracBits; explog: the log and
+                            // exp tables have 2^T intervals each, 1..min(CosFracBits, Wf+3)
 
   SpecKind kind() const { return static_cast<SpecKind>(Kind); }
 
@@ -53,8 +65,9 @@ struct SpecUnitParams {
   int promAddrBits() const { return ShinBits + (kind() == SpecKind::Table ? TableBits : 0); }
   int promDepth() const { return 1 << promAddrBits(); }
   // PROM word: poly degree 2 {a}; poly degree 3 {cut[Wc:0], v, u} (u in the LSBs); table {f}
-  // (uQ1.Wf); schlick {m = n - 1} (uQCi.Cf, unsigned).
+  // (uQ1.Wf); schlick {m = n - 1} (uQCi.Cf, unsigned); explog {n} (uQCi.Cf, unsigned).
   int promWordBits() const;
+  ExpLogWidths expLogWidths() const;
   int64_t cosOne() const { return int64_t{1} << CosFracBits; }
   int64_t lightMax() const { return (int64_t{1} << LightBits) - 1; }
 

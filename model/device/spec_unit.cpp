@@ -45,7 +45,7 @@ SpecCoef decodePromWord(PromWord word, const SpecUnitParams& p) {
     return c;
   }
   const uint64_t u = static_cast<uint64_t>(word) & lowMask(cw);
-  if (p.kind() == SpecKind::Schlick || p.Degree == 2) {
+  if (p.kind() != SpecKind::Poly || p.Degree == 2) {  // schlick, explog: unsigned
     c.u = static_cast<int64_t>(u);
     return c;
   }
@@ -70,6 +70,7 @@ SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
       throw std::invalid_argument(fmt::format("PROM word {} of the table is above 1.0 (uQ1.{})", i, p_.SpecFracBits));
     coef_.push_back(decodePromWord(prom_[i], p_));
   }
+  if (p_.kind() == SpecKind::ExpLog) explog_ = makeExpLogTables(p_);
   reset();
 }
 
@@ -88,6 +89,7 @@ int64_t SpecUnitModel::tableIndex(int64_t c) const {
 int64_t SpecUnitModel::altSpec(uint32_t shin, int64_t c) const {
   if (p_.kind() == SpecKind::Table)  // one ROM read at {shin, index}
     return static_cast<int64_t>(prom_[(static_cast<size_t>(shin) << p_.TableBits) | static_cast<size_t>(tableIndex(c))]);
+  if (p_.kind() == SpecKind::ExpLog) return expLogSpec(p_, explog_, coef_[shin].u, c);
   // Schlick: f = floor(c 2^(Cf+Wf) / (m (1 - c) + 1)), den >= 1 and f <= 1 (rtl/shd_spec_schlick.v).
   const int wc = p_.CosFracBits, cf = p_.CoefFracBits;
   const int64_t den = coef_[shin].u * ((int64_t{1} << wc) - c) + (int64_t{1} << (cf + wc));

@@ -14,6 +14,8 @@
 // The table kind:   f = PROM[{shin, min(c >> (Wc - T), 2^T - 1)}]      (one registered read)
 // The schlick kind: f = floor(c 2^(Cf+Wf) / (m (2^Wc - c) + 2^(Cf+Wc)))  with m = n - 1 from
 //                   PROM[shin]: c / (n - n c + c) truncated to uQ1.Wf (a restoring divider)
+// The explog kind:  f = 2^(-n L), L = -log2 c, n from PROM[shin], both by interpolated tables
+//                   (device/spec_explog.h)
 // Every kind ends in the same MUL3..MUL5.
 // Pipeline: registered inputs and PROM read (cycle 1), PipeStages optional registers, registered
 // outputs; latency 2 + PipeStages, one result per cycle. The output registers load only when
@@ -24,6 +26,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "device/spec_explog.h"
 #include "device/spec_params.h"
 #include "fixed/fixed.h"
 
@@ -33,7 +36,7 @@ using PromWord = unsigned __int128;
 
 // The fields of one PROM word as raw codes. Degree 2: u = a (uQCi.Cf), v = cut = 0.
 // Degree 3: u = a1, v = a1 + b1 (sQCi.Cf), cut = cos code below which f = 0. Table: u = f
-// (uQ1.Wf). Schlick: u = m = n - 1 (uQCi.Cf).
+// (uQ1.Wf). Schlick: u = m = n - 1 (uQCi.Cf). Explog: u = n (uQCi.Cf).
 struct SpecCoef {
   int64_t u = 0;
   int64_t v = 0;
@@ -60,7 +63,7 @@ struct SpecOut {
 };
 
 // Intermediate values of one evaluation, for reports and mismatch diagnostics (the table and
-// schlick kinds fill c and f only).
+// other kinds fill c and f only).
 struct SpecTrace {
   Fixed c, sq, d, dt, g, p, pr, f;
   bool cut = false;
@@ -91,7 +94,7 @@ class SpecUnitModel {
  private:
   void checkInputs(uint32_t shin, uint32_t cos) const;  // std::out_of_range naming the port
   int64_t tableIndex(int64_t c) const;                   // table: the cosine address
-  int64_t altSpec(uint32_t shin, int64_t c) const;       // f of the table and schlick kinds
+  int64_t altSpec(uint32_t shin, int64_t c) const;       // f of the kinds other than poly
   SpecOut backEnd(int64_t f, const std::array<uint32_t, 3>& light) const;  // MUL3..MUL5
   struct Stage {
     bool valid = false;
@@ -100,6 +103,7 @@ class SpecUnitModel {
   SpecUnitParams p_;
   std::vector<PromWord> prom_;
   std::vector<SpecCoef> coef_;  // decoded prom_
+  ExpLogTables explog_;         // the explog kind's fixed tables
   std::vector<Stage> pipe_;     // ring buffer, latency() entries
   size_t head_ = 0;
   SpecOut out_;

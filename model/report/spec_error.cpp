@@ -160,8 +160,11 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
                         p.coefFormat().str(), p.DiffFracBits)
       : p.kind() == SpecKind::Table
           ? fmt::format("table of 2^{} cosine buckets per n, cos uQ1.{}", p.TableBits, p.CosFracBits)
-          : fmt::format("Schlick's rational with a divider, cos uQ1.{}, m = n - 1 {}", p.CosFracBits,
-                        p.coefFormat().str());
+      : p.kind() == SpecKind::Schlick
+          ? fmt::format("Schlick's rational with a divider, cos uQ1.{}, m = n - 1 {}", p.CosFracBits,
+                        p.coefFormat().str())
+          : fmt::format("2^(n log2 c) by log and exp tables of 2^{} intervals, cos uQ1.{}, n {}", p.TableBits,
+                        p.CosFracBits, p.coefFormat().str());
   std::string out = fmt::format(
       "Specular unit '{}': {}, f uQ1.{}, output unorm{}\n"
       "Approximation (a): ideal device vs cos^n, exact maxima over c in the region.\n"
@@ -198,7 +201,7 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
         s.total_max_lsb.value, s.total_max_lsb.n, s.total_peak_max_lsb.value, s.total_peak_max_lsb.n, r->seconds);
   }
   out +=
-      "Columns: coef = a (degree 2), a1 (degree 3), m = n - 1 (schlick), nan (table); lobe = c in [0,1]; peak = c^n >= 0.5; infl = c from the "
+      "Columns: coef = a (degree 2), a1 (degree 3), m = n - 1 (schlick), n (explog), nan (table); lobe = c in [0,1]; peak = c^n >= 0.5; infl = c from the "
       "inflection point to 1;\n"
       "dp = datapath vs ideal device (LSB of the output, fLSB of f = spec_o); tot = unit vs cos^n; peak LSB = tot "
       "where c^n >= 0.5.\n";

@@ -40,7 +40,7 @@ class SpecErrorCmd final : public Command {
     const SpecErrorReport primary = computeSpecError(cfg.name, t, prog);
     std::optional<SpecErrorReport> second;
     std::string cmp = compare_;
-    if (cmp == "auto")  // the table and schlick kinds have one content only
+    if (cmp == "auto")  // the other kinds have one content only
       cmp = t.unit.kind() != SpecKind::Poly ? "none" : t.request.fit == FitKind::Minimax ? "inflection" : "minimax";
     if (cmp != "none" && cmp != toString(t.request.fit)) {
       PromRequest req2 = t.request;

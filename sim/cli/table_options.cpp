@@ -10,7 +10,7 @@ namespace shd::cli {
 void TableOptions::add(CLI::App& app) {
   app.add_option("--config", config, "configuration: " + configChoices("spec"))->default_val("default");
   app.add_option("--fit", fit,
-                 "inflection | level | shortcut | minimax for the poly kind, exact for the table and schlick kinds "
+                 "inflection | level | shortcut | minimax for the poly kind, exact for the other kinds "
                  "(default: the configuration's)")
       ->check(CLI::IsMember({"inflection", "level", "shortcut", "minimax", "exact"}));
   app.add_option("--level", level, "level q (degree 2) or Q (degree 3) of the level fit, in (0, 1)")

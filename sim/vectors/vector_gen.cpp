@@ -97,6 +97,10 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
       corner(last_entry, edge - 1, {lmax, lmax / 2, 1});
       corner(last_entry, edge, {lmax, lmax / 2, 1});
     }
+  // Explog: the cosine's normalisation changes at powers of two (one code below, at, above).
+  if (p.kind() == SpecKind::ExpLog)
+    for (int k = 0; k <= p.CosFracBits; ++k)
+      for (int64_t cos = (int64_t{1} << k) - 1; cos <= (int64_t{1} << k) + 1; ++cos) corner(last_entry, cos, {lmax, lmax / 2, 1});
   if (p.kind() == SpecKind::Poly && p.Degree == 3)
     for (uint32_t shin = 0; shin <= last_entry; shin = shin + 8 > last_entry && shin != last_entry ? last_entry : shin + 8) {
       const int64_t cut = decodePromWord(table.words[shin], p).cut;

@@ -5,6 +5,7 @@
 // Run:      testbench/icarus/run_icarus.sh FILE does all of it; by hand:
 //             iverilog -g2012 -Wall -I testbench/icarus -s tb_spec_unit -Ptb_spec_unit.<Name>=<value>... -o tb.vvp \
 //               testbench/icarus/tb_spec_unit.v rtl/shd_spec_unit.v rtl/shd_spec_poly.v rtl/shd_spec_schlick.v \
+//               rtl/shd_spec_explog.v \
 //               rtl/shd_coef_rom.v rtl/shd_pipe_reg.v
 //             vvp -n tb.vvp +vec=/abs/file.vec +prom=/abs/prom.hex [+dump=/abs/wave.fst -fst]
 //           Paths must be absolute: $readmemh (and $fopen) resolve a relative path against the
