@@ -203,6 +203,16 @@ def prom_bits(rtl):
     return (1 << rtl["ShinBits"]) * (kw if rtl["Degree"] == 2 else 2 * kw + rtl["CosFracBits"] + 1)
 
 
+def fixed_rom_bits(rtl):
+    """Bits of the explog kind's log and exp tables (rtl/shd_spec_explog.v: 2^T words of
+    {g step, g} and of {e step, e}); 0 for the other kinds."""
+    if rtl.get("Kind", 0) != 3:
+        return 0
+    t, wf = rtl["TableBits"], rtl["SpecFracBits"]
+    gf, ef = wf + 6 + max(0, rtl["CoefIntBits"] - rtl["CosFracBits"] - 4), wf + 4
+    return (1 << t) * ((gf - t + 1) + (gf + 2) + (ef - t + 1) + (ef + 1))
+
+
 def check_spec_units_table(report, header, body):
     units = report["units"]["spec"]
     check(len(body) == len(units), f"report.md specular units: {len(body)} lines for {len(units)} units")
@@ -213,9 +223,12 @@ def check_spec_units_table(report, header, body):
         check(u["latency"] == 2 + rtl["PipeStages"], f"report.json units.spec.{name}.latency = {u['latency']}")
         check(u["prom_bits"] == prom_bits(rtl), f"report.json units.spec.{name}.prom_bits = {u['prom_bits']}, "
               f"the parameters give {prom_bits(rtl)}")
+        check(u["fixed_rom_bits"] == fixed_rom_bits(rtl), f"report.json units.spec.{name}.fixed_rom_bits = "
+              f"{u['fixed_rom_bits']}, the parameters give {fixed_rom_bits(rtl)}")
         pf = next((r for r in report["rows"] if r["lobe"] == u["lobe"] and r["method"] == "phong-fixed"), {})
-        want = [u["kind"], f"`{u['lobe']}`", fmt(u["latency"], 0), fmt(u["prom_bits"], 0)]
-        for h in header[5:]:
+        want = [u["kind"], f"`{u['lobe']}`", fmt(u["latency"], 0), fmt(u["prom_bits"], 0),
+                fmt(u["fixed_rom_bits"], 0)]
+        for h in header[6:]:
             if h.startswith("iCE40 "):
                 want.append(fmt(get(u, ("area", "ice40", {"LUT": "luts", "DSP": "dsps", "BRAM": "brams"}[h[6:]])), 0))
             elif h.endswith(" MHz"):

@@ -133,6 +133,13 @@ ExpLogWidths SpecUnitParams::expLogWidths() const {
   return {wf + 6 + std::max(0, CoefIntBits - CosFracBits - 4), wf + CoefIntBits + 3, wf + 4, wf + 3};
 }
 
+int64_t SpecUnitParams::fixedRomBits() const {
+  if (kind() != SpecKind::ExpLog) return 0;
+  const ExpLogWidths w = expLogWidths();
+  return (int64_t{1} << TableBits) *
+         (w.gStepBits(TableBits) + w.gBits() + w.eStepBits(TableBits) + w.eBits());
+}
+
 void SpecUnitParams::validate() const {
   if (Kind < 0 || Kind >= static_cast<int>(specKinds().size())) {
     std::string names;

@@ -68,6 +68,8 @@ struct SpecUnitParams {
   // (uQ1.Wf); schlick {m = n - 1} (uQCi.Cf, unsigned); explog {n} (uQCi.Cf, unsigned).
   int promWordBits() const;
   ExpLogWidths expLogWidths() const;
+  // Bits of the fixed ROMs beside the PROM: the explog kind's log and exp tables, 0 otherwise.
+  int64_t fixedRomBits() const;
   int64_t cosOne() const { return int64_t{1} << CosFracBits; }
   int64_t lightMax() const { return (int64_t{1} << LightBits) - 1; }
 

@@ -13,7 +13,8 @@ namespace shd {
 namespace {
 
 void keepWorst(SpecErrorWorst& w, double value, double n) {
-  if (std::isfinite(value) && value > w.value) w = {value, n};
+  // n = 0 before the first row (every n is at least 1): a quantity that is 0 at every n names the first.
+  if (std::isfinite(value) && (value > w.value || w.n == 0)) w = {value, n};
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ struct SpecErrorRow {
   double total_peak_max_lsb = 0;  // (c) restricted to c^n >= 0.5
 };
 
-// Worst of each quantity over all rows, with the n where it occurs.
+// Worst of each quantity over all rows, with the n where it first occurs.
 struct SpecErrorWorst {
   double value = 0;
   double n = 0;

@@ -182,7 +182,7 @@ std::string unitsTable(const json& report) {
 // at every cos code for the scene's shininess values; phong-fixed, which asks the unit at every
 // pixel, against the reference image).
 std::string specUnitsTable(const json& report) {
-  std::vector<std::string> headers = {"configuration", "kind", "lobe", "latency", "PROM bits"};
+  std::vector<std::string> headers = {"configuration", "kind", "lobe", "latency", "PROM bits", "fixed ROM bits"};
   bool ice40 = false;
   for (const auto& [name, u] : report["units"]["spec"].items()) ice40 = ice40 || !at(u, {"area", "ice40"}).is_null();
   if (ice40)
@@ -201,7 +201,7 @@ std::string specUnitsTable(const json& report) {
         break;
       }
     std::vector<std::string> cells = {"`" + name + "`", u["kind"].get<std::string>(), "`" + lobe + "`",
-                                      num(u["latency"], 0), num(u["prom_bits"], 0)};
+                                      num(u["latency"], 0), num(u["prom_bits"], 0), num(u["fixed_rom_bits"], 0)};
     if (ice40)
       for (const char* f : {"luts", "dsps", "brams"}) cells.push_back(num(at(u, {"area", "ice40", f}), 0));
     for (const auto& [d, title] : devices) cells.push_back(num(at(u, {"pnr", d, "fmax_mhz"}), 2));
