@@ -4,8 +4,11 @@
 // segment, the segments and the cut-off laid for equal error), beside the paper's clamped
 // quadratic (its inflection fit and the minimax coefficient) as the device has them. Cost per n,
 // stated as a model: S breakpoints (uQ1.15, 16 bits) and S (d+1) coefficients (18 bits each); d
-// multipliers for Horner's scheme, S comparators to pick the segment.
+// multipliers for Horner's scheme, S comparators to pick the segment. Then the same segments in
+// integers (approx/piecewise.h PiecewiseCodes) for coefficient fraction bits Kf = 16..24.
 //   study_piecewise [n ...]      (default 8 32 100 300 1000)
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -34,5 +37,33 @@ int main(int argc, char** argv) {
       for (double n : ns) std::printf(" %9.5f", shd::fitPiecewise(n, S, d).err);
       std::printf("\n");
     }
+  // The same segments as a unit would hold them (approx/piecewise.h PiecewiseCodes): cosine
+  // uQ1.15, f uQ1.16, coefficients with Kf fraction bits; the largest |f - c^n| over every cosine
+  // code in LSBs of f, beside the ideal segments' error in the same unit, and the integer bits the
+  // coefficients need.
+  const int wc = 15, wf = 16;
+  std::printf("\nquantised (cos uQ1.%d, f uQ1.%d): max |f - c^n| in f-LSB over every cos code; int = coefficient integer bits\n",
+              wc, wf);
+  for (int S : {2, 4}) {
+    const int d = 2;
+    std::vector<shd::PiecewiseFit> fits;
+    for (double n : ns) fits.push_back(shd::fitPiecewise(n, S, d));
+    std::printf("%-26s", ("degree 2, " + std::to_string(S) + " segments, ideal").c_str());
+    for (const shd::PiecewiseFit& f : fits) std::printf(" %9.2f", std::ldexp(f.err, wf));
+    std::printf("\n");
+    for (int kf : {16, 18, 20, 24}) {
+      std::printf("%-26s", ("  Kf = " + std::to_string(kf)).c_str());
+      int ibits = 0;
+      for (size_t i = 0; i < ns.size(); ++i) {
+        const shd::PiecewiseCodes q = shd::quantisePiecewise(fits[i], wc, wf, kf);
+        double worst = 0;
+        for (int64_t C = 0; C <= (int64_t{1} << wc); ++C)
+          worst = std::max(worst, std::fabs(static_cast<double>(q.eval(C)) - std::ldexp(std::pow(std::ldexp(static_cast<double>(C), -wc), ns[i]), wf)));
+        ibits = std::max(ibits, q.coefIntBits());
+        std::printf(" %9.2f", worst);
+      }
+      std::printf("   int %d\n", ibits);
+    }
+  }
   return 0;
 }

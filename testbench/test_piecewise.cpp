@@ -61,3 +61,22 @@ TEST(Piecewise, SegmentsLowerTheWholeLobeError) {
     EXPECT_GE(f.err, dense * (1 - 1e-9)) << S;
   }
 }
+
+TEST(Piecewise, IntegerSegmentsFollowTheRealOnesToTheirRounding) {
+  // With wide coefficients the integer evaluation is the real fit rounded: within half an LSB
+  // of f (and a margin for the coefficients' and Horner's 2^-30 steps) at every cosine code, the
+  // segment picked by comparing codes with B being the one the real fit picks.
+  const int wc = 12, wf = 16;
+  for (double n : {8.0, 100.0, 1000.0})
+    for (int S : {1, 2, 4}) {
+      const PiecewiseFit f = fitPiecewise(n, S, 2);
+      const PiecewiseCodes q = quantisePiecewise(f, wc, wf, 30);
+      ASSERT_EQ(q.segs.size(), static_cast<size_t>(S));
+      double worst = 0;
+      for (int64_t C = 0; C <= (int64_t{1} << wc); ++C) {
+        const double real = std::clamp(f.eval(std::ldexp(static_cast<double>(C), -wc)), 0.0, 1.0);
+        worst = std::max(worst, std::fabs(static_cast<double>(q.eval(C)) - std::ldexp(real, wf)));
+      }
+      EXPECT_LE(worst, 0.5 + 1e-3) << "n " << n << " S " << S;
+    }
+}

@@ -193,4 +193,62 @@ PiecewiseFit fitPiecewise(double n, int segments, int degree) {
   return best;
 }
 
+PiecewiseCodes quantisePiecewise(const PiecewiseFit& f, int wc, int wf, int kf) {
+  if (wc < 2 || wc > 24 || wf < 1 || kf < wf || kf > 40)
+    throw std::invalid_argument(fmt::format("quantisePiecewise: Wc {} Wf {} Kf {}", wc, wf, kf));
+  PiecewiseCodes q;
+  q.wc = wc;
+  q.wf = wf;
+  q.kf = kf;
+  const double one = std::ldexp(1.0, wc);
+  int64_t top = (int64_t{1} << wc) + 1;  // one past the segment's last code
+  for (const SegmentFit& s : f.segments) {  // from the top down
+    PiecewiseCodes::Seg g;
+    g.B = static_cast<int64_t>(std::ceil(s.a * one));
+    const int64_t last = std::max<int64_t>(top - 1 - g.B, 0);  // C - B of the segment's last code
+    g.e = 0;
+    while (g.e < wc && (last << (g.e + 1)) < (int64_t{1} << wc)) ++g.e;
+    // t = (c - a) / (b - a) = alpha + beta u with c = B 2^-Wc + u 2^-e.
+    const double alpha = (g.B / one - s.a) / (s.b - s.a), beta = std::ldexp(1.0, -g.e) / (s.b - s.a);
+    const size_t d = s.q.size() - 1;
+    std::vector<double> K(d + 1, 0.0);
+    for (size_t i = 0; i <= d; ++i) {
+      double binom = 1;  // C(i, j)
+      for (size_t j = 0; j <= i; ++j) {
+        K[j] += s.q[i] * binom * std::pow(alpha, static_cast<double>(i - j)) * std::pow(beta, static_cast<double>(j));
+        binom = binom * static_cast<double>(i - j) / static_cast<double>(j + 1);
+      }
+    }
+    for (double k : K) g.K.push_back(static_cast<int64_t>(std::nearbyint(std::ldexp(k, kf))));
+    q.segs.insert(q.segs.begin(), g);
+    top = g.B;
+  }
+  return q;
+}
+
+int64_t PiecewiseCodes::eval(int64_t C) const {
+  const Seg* s = nullptr;
+  for (const Seg& g : segs)
+    if (C >= g.B) s = &g;
+  if (s == nullptr) return 0;  // below the cut
+  const int64_t x = C - s->B;  // u = x 2^(e - Wc)
+  const int ush = wc - s->e;
+  int64_t acc = s->K.back();
+  for (size_t j = s->K.size() - 1; j-- > 0;) {
+    const __int128 p = static_cast<__int128>(acc) * x;
+    acc = static_cast<int64_t>(p >> ush) + s->K[j];  // arithmetic shift: floor
+  }
+  const int sh = kf - wf;
+  const int64_t f = sh == 0 ? acc : (acc + (int64_t{1} << (sh - 1))) >> sh;
+  return std::clamp<int64_t>(f, 0, int64_t{1} << wf);
+}
+
+int PiecewiseCodes::coefIntBits() const {
+  int bits = 1;
+  for (const Seg& g : segs)
+    for (int64_t k : g.K)
+      while ((k >> kf) >= (int64_t{1} << (bits - 1)) || (k >> kf) < -(int64_t{1} << (bits - 1))) ++bits;
+  return bits;
+}
+
 }  // namespace shd

@@ -16,6 +16,7 @@
 //   is largest.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 namespace shd {
@@ -42,5 +43,26 @@ struct PiecewiseFit {
 
 // std::invalid_argument unless 1 <= segments <= 64 and the arguments of minimaxSegment hold.
 PiecewiseFit fitPiecewise(double n, int segments, int degree);
+
+// A piecewise fit in the integers a segmented unit would hold: cosine codes C (uQ1.Wc); per
+// segment its first code B = ceil(a 2^Wc) (so a code belongs to the segment the real fit puts it
+// in), a scale e (the largest, at most Wc, with u = (C - B) 2^(e-Wc) < 1 over the segment's codes)
+// and the coefficients K_j of p in u, rounded half-even to Kf fraction bits. f = K_d u^d + ...
+// by Horner's scheme, each product truncated (floor) back to Kf fraction bits, rounded half up to
+// Wf bits and clamped to [0, 1]; 0 below the lowest segment's B (the cut).
+struct PiecewiseCodes {
+  struct Seg {
+    int64_t B = 0;
+    int e = 0;
+    std::vector<int64_t> K;  // K_0 .. K_d
+  };
+  int wc = 15, wf = 16, kf = 16;
+  std::vector<Seg> segs;  // ascending B: segs[0].B is the cut
+  int64_t eval(int64_t C) const;  // the f code, 0..2^Wf
+  int coefIntBits() const;        // integer bits (with the sign) that every K_j needs
+};
+
+// std::invalid_argument unless 2 <= Wc <= 24, 1 <= Wf <= Kf <= 40.
+PiecewiseCodes quantisePiecewise(const PiecewiseFit& f, int wc, int wf, int kf);
 
 }  // namespace shd
