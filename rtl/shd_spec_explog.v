@@ -169,34 +169,31 @@ module shd_spec_explog #(
     end
   endfunction
 
-  // The ROM words. In simulation a field that does not hold its value (a wrong width proof,
-  // see the header; a negative step wraps to a huge one) stops the run, as the model's check does.
-  function [LOGW-1:0] log_word(input integer i);
-    reg [127:0] g0, g1, dg;
+  // Word k of the log table (which = 0) or the exp table (1): {step to entry k+1, entry k}, in
+  // the low LOGW or EXPW bits. In simulation a field that does not hold its value (a wrong width
+  // proof, see the header; a negative step wraps to a huge one) stops the run, as the model's
+  // check does.
+  function [127:0] table_word(input integer which, input integer k);
+    reg [127:0] v0, v1, step;
+    integer vb, sb;
     begin
-      g0 = g_code(i);
-      g1 = g_code(i + 1);
-      dg = g1 - g0;
-      log_word = {dg[DGW-1:0], g0[GW-1:0]};
-`ifndef SYNTHESIS
-      if (g1 < g0 || dg[127:DGW] != 0 || g0[127:GW] != 0) begin
-        $display("shd_spec_explog: log table word %0d does not fit its fields", i);
-        $fatal(1);
+      if (which == 0) begin                            // g increases
+        v0   = g_code(k);
+        v1   = g_code(k + 1);
+        step = v1 - v0;
+        vb   = GW;
+        sb   = DGW;
+      end else begin                                   // e decreases
+        v0   = e_code(k);
+        v1   = e_code(k + 1);
+        step = v0 - v1;
+        vb   = EW;
+        sb   = DEW;
       end
-`endif
-    end
-  endfunction
-
-  function [EXPW-1:0] exp_word(input integer j);
-    reg [127:0] e0, e1, de;
-    begin
-      e0 = e_code(j);
-      e1 = e_code(j + 1);
-      de = e0 - e1;
-      exp_word = {de[DEW-1:0], e0[EW-1:0]};
+      table_word = (step << vb) | v0;
 `ifndef SYNTHESIS
-      if (e0 < e1 || de[127:DEW] != 0 || e0[127:EW] != 0) begin
-        $display("shd_spec_explog: exp table word %0d does not fit its fields", j);
+      if ((v0 >> vb) != 0 || (step >> sb) != 0) begin
+        $display("shd_spec_explog: %0s table word %0d does not fit its fields", (which == 0) ? "log" : "exp", k);
         $fatal(1);
       end
 `endif
@@ -208,12 +205,16 @@ module shd_spec_explog #(
   (* rom_style = "block" *)
   reg [EXPW-1:0] exp_rom [0:DEPTH-1];
   integer w;
+  reg [127:0] log_w, exp_w;
   initial begin
     for (w = 0; w < DEPTH; w = w + 1) begin
-      log_rom[w[T-1:0]] = log_word(w);
-      exp_rom[w[T-1:0]] = exp_word(w);
+      log_w = table_word(0, w);
+      exp_w = table_word(1, w);
+      log_rom[w[T-1:0]] = log_w[LOGW-1:0];
+      exp_rom[w[T-1:0]] = exp_w[EXPW-1:0];
     end
   end
+  wire unused_words = ^{log_w[127:LOGW], exp_w[127:EXPW]};   // zero: checked above
 
   // ---------------------------------------------------------------- cycle 0: normalise c
   // g_norm[k], k = 1..ZW, shifts left by 2^(ZW-k) when the top 2^(ZW-k) bits are 0; the shifts
