@@ -129,6 +129,23 @@ TEST(SpecSweep, PointRecordIsTheErrorReportsSummary) {
   EXPECT_EQ(r.at("inputs"), 4 * 1025);
   EXPECT_EQ(r.dump(), evaluateSpecPoint(3, p, req).dump());
   EXPECT_GT(r.at("error").at("total_max_lsb").get<double>(), 0.5);  // the final rounding alone
+  EXPECT_EQ(r.at("rom_bits"), r.at("prom_bits"));                     // no fixed tables
+}
+
+// The explog kind's ROM bits count its log and exp tables: 2^T words of {g step, g} and
+// {e step, e} (rtl/shd_spec_explog.v), so a finer table costs bits the PROM alone does not show.
+TEST(SpecSweep, ExpLogRomBitsCountTheTables) {
+  SpecUnitConfig cfg = specConfig("explog");
+  PromRequest req = PromRequest::fromContent(cfg.prom);
+  req.n = NSpec::parse("8,100", true);
+  for (int T : {4, 8}) {
+    const SpecUnitParams p = specPointParams(cfg.rtl, {{"TableBits", T}});
+    const nlohmann::json r = evaluateSpecPoint(0, p, req);
+    const int gf = p.SpecFracBits + 6, ef = p.SpecFracBits + 4;  // Ci = 10 <= Wc + 4
+    const int64_t tables = (int64_t{1} << T) * ((gf - T + 1) + (gf + 2) + (ef - T + 1) + (ef + 1));
+    EXPECT_EQ(r.at("prom_bits"), 1024 * p.promWordBits()) << T;
+    EXPECT_EQ(r.at("rom_bits").get<int64_t>(), r.at("prom_bits").get<int64_t>() + tables) << T;
+  }
 }
 
 namespace {

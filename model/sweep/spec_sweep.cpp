@@ -71,6 +71,7 @@ nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const 
   };
   j["latency"] = p.latency();
   j["prom_bits"] = static_cast<int64_t>(p.promDepth()) * p.promWordBits();
+  j["rom_bits"] = j["prom_bits"].get<int64_t>() + p.fixedRomBits();  // with the explog kind's tables
   j["inputs"] = static_cast<int64_t>(table.entries.size()) * (codes.empty() ? p.cosOne() + 1 : static_cast<int64_t>(codes.size()));
   j["exhaustive"] = codes.empty() ? 1 : 0;
   return j;
@@ -99,7 +100,7 @@ SweepUnit specSweepUnit(const nlohmann::json& base_json) {
   u.params = specParamNames();
   u.params_member = "rtl";
   u.front_error = "datapath_max_lsb";
-  u.front_costs = {"latency", "prom_bits"};
+  u.front_costs = {"latency", "rom_bits"};
   u.validate = [base, req](const Grid& grid) {
     std::set<std::tuple<int, int, int, int, int>> tables;  // the coefficient formats built
     for (uint64_t k = 0; k < grid.size(); ++k) {

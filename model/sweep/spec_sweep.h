@@ -35,7 +35,8 @@ std::vector<int64_t> specSampleCodes(const SpecUnitParams& p, size_t entries, ui
 // The parameter names a specular sweep may vary.
 std::vector<std::string> specParamNames();
 
-// The point's record: {"index", "hash", "rtl", "error": {...}, "latency", "prom_bits",
+// The point's record: {"index", "hash", "rtl", "error": {...}, "latency", "prom_bits", "rom_bits"
+// (the PROM and the fixed tables of the explog kind: SpecUnitParams::fixedRomBits),
 // "inputs", "exhaustive" (1 or 0: sampled)}. Deterministic: the same parameters and request
 // give the same record, byte for byte, on any machine (no timings in it).
 nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const PromRequest& req);
@@ -47,7 +48,7 @@ nlohmann::json specSweepBase(const std::string& config, const SpecUnitParams& rt
 // The specular unit as a sweep sees it: the base's parameters with the grid's values, each
 // point's PROM built by the base's request. validate() builds the PROM of every distinct
 // coefficient format (coefficients that do not fit stop the sweep); the fronts weigh
-// datapath_max_lsb against latency and PROM bits.
+// datapath_max_lsb against latency and ROM bits.
 SweepUnit specSweepUnit(const nlohmann::json& base);
 
 // The hash naming a point's parameters (textHash of its "rtl" object).
