@@ -5,6 +5,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include <fmt/format.h>
@@ -130,6 +131,22 @@ TEST(SpecSweep, PointRecordIsTheErrorReportsSummary) {
   EXPECT_EQ(r.dump(), evaluateSpecPoint(3, p, req).dump());
   EXPECT_GT(r.at("error").at("total_max_lsb").get<double>(), 0.5);  // the final rounding alone
   EXPECT_EQ(r.at("rom_bits"), r.at("prom_bits"));                     // no fixed tables
+}
+
+// Minimality (sweep --target-lsb) narrows the widths the unit's kind has: never a width its
+// datapath does not read (DiffFracBits outside the poly kind), always the tables' TableBits.
+TEST(SpecSweep, EachKindNarrowsItsOwnWidths) {
+  const std::map<std::string, std::vector<std::string>> want = {
+      {"default", {"CoefIntBits", "CoefFracBits", "DiffFracBits", "SpecFracBits"}},
+      {"cubic", {"CoefIntBits", "CoefFracBits", "DiffFracBits", "SpecFracBits", "HornerFracBits"}},
+      {"table", {"SpecFracBits", "TableBits"}},
+      {"schlick", {"CoefIntBits", "CoefFracBits", "SpecFracBits"}},
+      {"explog", {"CoefIntBits", "CoefFracBits", "SpecFracBits", "TableBits"}},
+  };
+  for (const auto& [name, widths] : want) {
+    const SpecUnitConfig c = specConfig(name);
+    EXPECT_EQ(specSweepUnit(specSweepBase(name, c.rtl, c.prom)).widths, widths) << name;
+  }
 }
 
 // The explog kind's ROM bits count its log and exp tables: 2^T words of {g step, g} and

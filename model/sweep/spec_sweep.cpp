@@ -129,10 +129,19 @@ SweepUnit specSweepUnit(const nlohmann::json& base_json) {
                           {"prom", pj}};
   };
   // The datapath's own widths; CosFracBits, ShinBits and LightBits are its interface (the
-  // inputs' formats and the PROM's depth), PipeStages and Degree no widths. HornerFracBits only
-  // at degree 3 (the quadratic unit has no Horner step).
-  u.widths = {"CoefIntBits", "CoefFracBits", "DiffFracBits", "SpecFracBits"};
-  if (base.Degree == 3) u.widths.push_back("HornerFracBits");
+  // inputs' formats and the PROM's depth), PipeStages and Degree no widths. Each kind has its
+  // own: HornerFracBits only at degree 3 (the quadratic unit has no Horner step); the other kinds
+  // use neither DiffFracBits nor HornerFracBits, and TableBits is the resolution of the table's
+  // and explog's tables.
+  switch (base.kind()) {
+    case SpecKind::Poly:
+      u.widths = {"CoefIntBits", "CoefFracBits", "DiffFracBits", "SpecFracBits"};
+      if (base.Degree == 3) u.widths.push_back("HornerFracBits");
+      break;
+    case SpecKind::Table: u.widths = {"SpecFracBits", "TableBits"}; break;
+    case SpecKind::Schlick: u.widths = {"CoefIntBits", "CoefFracBits", "SpecFracBits"}; break;
+    case SpecKind::ExpLog: u.widths = {"CoefIntBits", "CoefFracBits", "SpecFracBits", "TableBits"}; break;
+  }
   return u;
 }
 
