@@ -276,9 +276,13 @@ def prom_geometry(path, p):
         addr += 1
     if len(words) != depth:
         raise InputError(f"{path}: {len(words)} words, the unit needs {depth} ({depth_text})")
-    vals = list(words.values())
-    varying = sum(1 for b in range(word_bits) if len({(v >> b) & 1 for v in vals}) > 1)
-    return depth, word_bits, varying
+    return depth, word_bits, varying_bits(words.values(), word_bits)
+
+
+def varying_bits(words, bits):
+    """The bit columns of a ROM's words that are not the same in every word (yosys drops the rest)."""
+    words = list(words)
+    return sum(1 for b in range(bits) if len({(v >> b) & 1 for v in words}) > 1)
 
 
 def prepare(ref, unit, prom_arg):
@@ -467,11 +471,8 @@ def explog_tables(p):
     gw, dgw, ew, dew = gf + 2, gf - t + 1, ef + 1, ef - t + 1
     logw = [((gs[i + 1] - gs[i]) << gw) | gs[i] for i in range(1 << t)]
     expw = [((es[j] - es[j + 1]) << ew) | es[j] for j in range(1 << t)]
-    out = []
-    for name, words, bits in (("log table", logw, dgw + gw), ("exp table", expw, dew + ew)):
-        varying = sum(1 for b in range(bits) if len({(v >> b) & 1 for v in words}) > 1)
-        out.append((name, 1 << t, bits, varying))
-    return out
+    return [(name, 1 << t, bits, varying_bits(words, bits))
+            for name, words, bits in (("log table", logw, dgw + gw), ("exp table", expw, dew + ew))]
 
 
 def ice40_brams(d_need, w_need):

@@ -51,6 +51,7 @@ ExpLogTables makeExpLogTables(const SpecUnitParams& p) {
   const ExpLogWidths w = p.expLogWidths();
   const int T = p.TableBits;
   ExpLogTables t;
+  t.w = w;
   for (int64_t i = 0; i <= (int64_t{1} << T); ++i) {
     t.g.push_back(logCode(i, T, w.GF));
     t.e.push_back(expCode(i, T, w.EF));
@@ -65,7 +66,7 @@ ExpLogTables makeExpLogTables(const SpecUnitParams& p) {
 }
 
 int64_t expLogSpec(const SpecUnitParams& p, const ExpLogTables& t, int64_t n_code, int64_t c) {
-  const ExpLogWidths w = p.expLogWidths();
+  const ExpLogWidths& w = t.w;
   const int wc = p.CosFracBits, cw = wc + 1, T = p.TableBits;
   if (c == 0) return 0;                                    // log2 0: f = 0
   // Cycle 0: c = 2^(1-z) u with u = M / 2^CW in [1/2, 1); D = 1 - u = DN / 2^CW in (0, 1/2].

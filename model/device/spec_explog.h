@@ -20,6 +20,7 @@
 namespace shd {
 
 struct ExpLogTables {
+  ExpLogWidths w{};        // the parameters' widths, derived once
   std::vector<int64_t> g;  // 2^T + 1 codes, GF fraction bits
   std::vector<int64_t> e;  // 2^T + 1 codes, EF fraction bits
 };

@@ -65,9 +65,7 @@ void validateExpLog(const SpecUnitParams& p) {
   const ExpLogWidths w = p.expLogWidths();
   require(w.GF <= 56, "CoefIntBits", p.CoefIntBits,
           fmt::format("makes the log table's fraction bits {} exceed 56 (its entries are computed to 60 bits)", w.GF));
-  int lbits = 1;  // bits of the integer part of L <= CosFracBits
-  while ((1 << lbits) < p.CosFracBits + 1) ++lbits;
-  requireModelWidth(p.CoefIntBits + p.CoefFracBits + lbits + w.LF, "y = n * L");
+  requireModelWidth(p.CoefIntBits + p.CoefFracBits + w.LI + w.LF, "y = n * L");
   requireModelWidth(p.CosFracBits + 1 + w.gBits(), "P = D * G");
 }
 
@@ -130,7 +128,9 @@ int SpecUnitParams::promWordBits() const {
 
 ExpLogWidths SpecUnitParams::expLogWidths() const {
   const int wf = SpecFracBits;
-  return {wf + 6 + std::max(0, CoefIntBits - CosFracBits - 4), wf + CoefIntBits + 3, wf + 4, wf + 3};
+  int li = 1;  // clog2(CosFracBits + 1)
+  while ((1 << li) < CosFracBits + 1) ++li;
+  return {wf + 6 + std::max(0, CoefIntBits - CosFracBits - 4), wf + CoefIntBits + 3, wf + 4, wf + 3, li};
 }
 
 int64_t SpecUnitParams::fixedRomBits() const {

@@ -25,9 +25,10 @@ const SpecKindInfo& specKindInfo(SpecKind k);
 
 // The widths the explog kind derives from the parameters (rtl/shd_spec_explog.v proves each):
 // fraction bits of the log table's g = -log2(1 - D) / D, of L = -log2 c, of the exp table's
-// e = 2^-x, and of y = n L as the exp table and its interpolation use it.
+// e = 2^-x, and of y = n L as the exp table and its interpolation use it; LI the integer bits of
+// L <= CosFracBits.
 struct ExpLogWidths {
-  int GF, LF, EF, EX;
+  int GF, LF, EF, EX, LI;
   int gBits() const { return GF + 2; }             // g <= 2
   int gStepBits(int T) const { return GF - T + 1; }
   int eBits() const { return EF + 1; }             // e <= 1
@@ -70,6 +71,7 @@ struct SpecUnitParams {
   ExpLogWidths expLogWidths() const;
   // Bits of the fixed ROMs beside the PROM: the explog kind's log and exp tables, 0 otherwise.
   int64_t fixedRomBits() const;
+  int64_t promBits() const { return int64_t{promDepth()} * promWordBits(); }
   int64_t cosOne() const { return int64_t{1} << CosFracBits; }
   int64_t lightMax() const { return (int64_t{1} << LightBits) - 1; }
 

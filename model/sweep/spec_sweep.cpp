@@ -70,8 +70,8 @@ nlohmann::json evaluateSpecPoint(uint64_t index, const SpecUnitParams& p, const 
       {"total_peak_max_lsb", s.total_peak_max_lsb.value},
   };
   j["latency"] = p.latency();
-  j["prom_bits"] = static_cast<int64_t>(p.promDepth()) * p.promWordBits();
-  j["rom_bits"] = j["prom_bits"].get<int64_t>() + p.fixedRomBits();  // with the explog kind's tables
+  j["prom_bits"] = p.promBits();
+  j["rom_bits"] = p.promBits() + p.fixedRomBits();  // with the explog kind's tables
   j["inputs"] = static_cast<int64_t>(table.entries.size()) * (codes.empty() ? p.cosOne() + 1 : static_cast<int64_t>(codes.size()));
   j["exhaustive"] = codes.empty() ? 1 : 0;
   return j;

@@ -346,7 +346,7 @@ json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measur
                              {"kind", specKindInfo(c.rtl.kind()).name},
                              {"degree", c.rtl.kind() == SpecKind::Poly ? json(c.rtl.Degree) : json()},
                              {"latency", c.rtl.latency()},
-                             {"prom_bits", int64_t{c.rtl.promDepth()} * c.rtl.promWordBits()},
+                             {"prom_bits", c.rtl.promBits()},
                              {"fixed_rom_bits", c.rtl.fixedRomBits()},
                              {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}},
                              {"lobe", lobe}};
