@@ -4,13 +4,17 @@
 // Latency:  1 cycle, registered read (addr_i at edge k -> word_o after edge k), so FPGA tools
 //           map it to block RAM (SB_RAM40_4K on iCE40; RAMB on xc7 via rom_style = "block").
 // Contents: $readmemh of RomFile, or of the file named by the plusarg +prom=<path> when a
-//           simulator is given one. $readmemh only warns on a missing or short file (Verilator
-//           fills zeros, Icarus leaves X): the testbenches verify known words after loading.
-// Model:    model/device/spec_unit.h decodePromWord() reads the same words.
+//           simulator is given one, with Suffix appended to the name (the piecewise kind's
+//           segment ROM is <PROM>.seg: Suffix = ".seg"; "" for the PROM itself). $readmemh only
+//           warns on a missing or short file (Verilator fills zeros, Icarus leaves X): the
+//           testbenches verify known words after loading.
+// Model:    model/device/spec_unit.h decodePromWord() reads the same words (the piecewise
+//           kind's PROM and segment ROM words: decodePiecewise()).
 module shd_coef_rom #(
   parameter integer AddrBits = 10,
   parameter integer WordBits = 24,
-  parameter         RomFile  = ""
+  parameter         RomFile  = "",
+  parameter         Suffix   = ""
 ) (
   input  wire                clk_i,
   input  wire [AddrBits-1:0] addr_i,
@@ -23,9 +27,10 @@ module shd_coef_rom #(
   reg [WordBits-1:0] rom [0:DEPTH-1] /*verilator public_flat_rd*/;
 
 `ifdef SYNTHESIS
-  initial $readmemh(RomFile, rom);
+  initial $readmemh({RomFile, Suffix}, rom);
 `else
   reg [8*1024-1:0] rom_path;
+  reg [8*1024-1:0] rom_full;
   initial begin
     if (!$value$plusargs("prom=%s", rom_path)) begin
       if (RomFile == "") begin
@@ -34,7 +39,8 @@ module shd_coef_rom #(
       end
       $sformat(rom_path, "%0s", RomFile);
     end
-    $readmemh(rom_path, rom);
+    $sformat(rom_full, "%0s%0s", rom_path, Suffix);
+    $readmemh(rom_full, rom);
   end
 `endif
 

@@ -27,7 +27,7 @@ struct Fixture {
     const SpecUnitConfig c = specConfig(name);
     table = buildPromTable(PromRequest::fromContent(c.prom), c.rtl);
     prom_path = (std::filesystem::temp_directory_path() / fmt::format("bench_spec_{}.hex", name)).string();
-    writeFileAtomic(prom_path, renderProm(table, PromFormat::Hex));
+    writePromHexFiles(prom_path, table);
   }
 };
 
@@ -42,7 +42,7 @@ const char* kConfigs[] = {"default", "narrow", "wide", "cubic"};
 
 void BM_ModelEvaluate(benchmark::State& state) {
   const Fixture& f = fixture(kConfigs[state.range(0)]);
-  const SpecUnitModel m(f.table.unit, f.table.words);
+  const SpecUnitModel m(f.table.unit, f.table.words, f.table.seg_words);
   const uint32_t ncos = 2u << f.table.unit.CosFracBits, depth = static_cast<uint32_t>(f.table.unit.promDepth());
   uint32_t shin = 0, cos = 0;
   for (auto _ : state) {
@@ -77,7 +77,7 @@ void BM_ExhaustiveCosim(benchmark::State& state) {
   const Fixture& f = fixture(name);
   uint64_t vectors = 0, mismatches = 0;
   for (auto _ : state) {
-    SpecUnitModel m(f.table.unit, f.table.words);
+    SpecUnitModel m(f.table.unit, f.table.words, f.table.seg_words);
     ExhaustiveSpecStimulus stim(f.table.unit, 1);
     SpecCosimOptions o;
     o.prom_path = f.prom_path;

@@ -87,7 +87,7 @@ json specMeasure(const std::string& config) {
   const SpecUnitConfig cfg = specConfig(config);
   const SpecUnitParams& p = cfg.rtl;
   const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), p);
-  const SpecUnitModel model(p, table.words);
+  const SpecUnitModel model(p, table.words, table.seg_words);
   const int wc = p.CosFracBits, cf = p.CoefFracBits, wf = p.SpecFracBits;
   const int64_t one = p.cosOne();
   const uint32_t L = static_cast<uint32_t>(p.lightMax());

@@ -118,7 +118,7 @@ TEST(FixedShading, LobeTablesHoldTheLobeAtEveryCode) {
 TEST(FixedShading, SpecResultMemoEqualsTheUnitsModel) {
   const SpecUnitConfig cfg = specConfig("default");
   const PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
-  const SpecUnitModel unit(t.unit, t.words);
+  const SpecUnitModel unit(t.unit, t.words, t.seg_words);
   SpecResultMemo memo(unit);
   const uint32_t shin = static_cast<uint32_t>(t.addressOf(32));
   const std::array<uint32_t, 3> light{255, 200, 17};
@@ -138,7 +138,7 @@ TEST(FixedShading, SpecResultMemoEqualsTheUnitsModel) {
   wide.CosFracBits = SpecResultMemo::kMaxCosFracBits + 1;
   wide.SpecFracBits = std::max(wide.SpecFracBits, wide.CosFracBits);
   const PromTable wt = buildPromTable(PromRequest::fromContent(cfg.prom), wide);
-  const SpecUnitModel wunit(wt.unit, wt.words);
+  const SpecUnitModel wunit(wt.unit, wt.words, wt.seg_words);
   SpecResultMemo wmemo(wunit);
   EXPECT_EQ(wmemo.row(shin, light), nullptr);
   const uint32_t cos = 1u << 20;  // 0.5

@@ -35,7 +35,7 @@ CosimSetup setup(const std::string& name) {
   const fs::path dir = shd::testutil::freshTestDir("spec_cosim");
   fs::create_directories(dir);
   s.prom_path = (dir / fmt::format("spec_{}.hex", name)).string();
-  writeFileAtomic(s.prom_path, renderProm(s.table, PromFormat::Hex));
+  writePromHexFiles(s.prom_path, s.table);
   return s;
 }
 
@@ -53,13 +53,14 @@ void expectClean(const SpecCosimResult& r, const CosimSetup& s) {
 
 }  // namespace
 
-// Every input of the paper's device (default) and of each alternative kind (table, schlick, explog).
+// Every input of the paper's device (default) and of each alternative kind (table, schlick, explog,
+// piecewise).
 class SpecCosimExhaustive : public testing::TestWithParam<std::string> {};
 
 TEST_P(SpecCosimExhaustive, EveryInput) {
   const std::string name = GetParam();
   const CosimSetup s = setup(name);
-  SpecUnitModel model(s.table.unit, s.table.words);
+  SpecUnitModel model(s.table.unit, s.table.words, s.table.seg_words);
   const uint64_t seed = 1;
   ExhaustiveSpecStimulus stim(s.table.unit, seed);
   const SpecCosimResult r = runSpecCosim(name, model, stim, options(s));
@@ -71,13 +72,13 @@ TEST_P(SpecCosimExhaustive, EveryInput) {
   expectClean(r, s);
 }
 
-INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimExhaustive, testing::Values("default", "table", "schlick", "explog"));
+INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimExhaustive, testing::Values("default", "table", "schlick", "explog", "piecewise"));
 
 class SpecCosimRandom : public testing::TestWithParam<std::string> {};
 
 TEST_P(SpecCosimRandom, SeededWithValidGaps) {
   const CosimSetup s = setup(GetParam());
-  SpecUnitModel model(s.table.unit, s.table.words);
+  SpecUnitModel model(s.table.unit, s.table.words, s.table.seg_words);
   const uint64_t seed = 20261122;
   RandomSpecStimulus stim(s.table.unit, seed, 2'000'000, 0.2);
   const SpecCosimResult r = runSpecCosim(GetParam(), model, stim, options(s));
@@ -89,14 +90,15 @@ TEST_P(SpecCosimRandom, SeededWithValidGaps) {
   expectClean(r, s);
 }
 
-INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimRandom, testing::Values("narrow", "default", "wide", "cubic", "table", "schlick", "explog"));
+INSTANTIATE_TEST_SUITE_P(Configs, SpecCosimRandom, testing::Values("narrow", "default", "wide", "cubic", "table", "schlick", "explog",
+                                                                "piecewise"));
 
 TEST(SpecCosim, DetectsADatapathDifferenceAndDumpsTheWindow) {
   // The checker must be able to fail: the model truncates c^2 - c one bit earlier than the RTL.
   const CosimSetup s = setup("narrow");
   SpecUnitParams wrong = s.table.unit;
   wrong.DiffFracBits -= 1;
-  SpecUnitModel model(wrong, s.table.words);  // same PROM words, different datapath
+  SpecUnitModel model(wrong, s.table.words, s.table.seg_words);  // same PROM words, different datapath
   RandomSpecStimulus stim(s.table.unit, 5, 200000, 0.1);
   const SpecCosimResult r = runSpecCosim("narrow", model, stim, options(s));
   ASSERT_GT(r.mismatches, 0u);
@@ -146,7 +148,7 @@ TEST(SpecCosim, DetectsALatencyDifference) {
   const CosimSetup s = setup("narrow");
   SpecUnitParams wrong = s.table.unit;
   wrong.PipeStages += 1;
-  SpecUnitModel model(wrong, s.table.words);
+  SpecUnitModel model(wrong, s.table.words, s.table.seg_words);
   RandomSpecStimulus stim(s.table.unit, 9, 1000, 0.0);
   const SpecCosimResult r = runSpecCosim("narrow", model, stim, options(s));
   ASSERT_TRUE(r.first.has_value());
@@ -161,7 +163,7 @@ TEST(SpecCosim, DetectsALatencyDifference) {
 
 TEST(SpecCosim, CorruptShortOrMissingPromFailsLoudly) {
   const CosimSetup s = setup("narrow");
-  SpecUnitModel model(s.table.unit, s.table.words);
+  SpecUnitModel model(s.table.unit, s.table.words, s.table.seg_words);
   auto run = [&](const std::string& path) {
     SpecCosimOptions o = options(s);
     o.prom_path = path;

@@ -1,12 +1,14 @@
-// The alternative specular units (SpecKind table, schlick and explog): the model against the
-// functions they stand for, computed here another way (bucket edges found by scanning the codes,
-// the rational and the power in long double), at every input of small configurations; their
-// PROMs; their pipeline timing; and the checks that keep a kind and its parameters together.
+// The alternative specular units (SpecKind table, schlick, explog and piecewise): the model
+// against the functions they stand for, computed here another way (bucket edges found by scanning
+// the codes, the rational and the power in long double, the segments' real polynomials), at every
+// input of small configurations; their PROMs; their pipeline timing; and the checks that keep a
+// kind and its parameters together.
 #include "device/spec_unit.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <map>
 
 #include "approx/lobe_error.h"
@@ -53,9 +55,23 @@ SpecUnitParams expLogParams() {
   return p;
 }
 
+SpecUnitParams piecewiseParams() {
+  SpecUnitParams p;
+  p.Kind = static_cast<int>(SpecKind::Piecewise);
+  p.Degree = 2;
+  p.Segments = 4;
+  p.CosFracBits = 11;
+  p.ShinBits = 3;
+  p.CoefIntBits = 2;
+  p.CoefFracBits = 18;
+  p.SpecFracBits = 14;
+  p.PipeStages = 3;
+  return p;
+}
+
 PromTable build(const SpecUnitParams& p, const std::string& n_list) {
   PromRequest r;
-  r.fit = FitKind::Exact;
+  r.fit = p.kind() == SpecKind::Piecewise ? FitKind::Minimax : FitKind::Exact;
   r.n = NSpec::parse(n_list, true);
   return buildPromTable(r, p);
 }
@@ -67,7 +83,7 @@ const std::array<uint32_t, 3> kFull = {255, 255, 255};
 TEST(SpecKindTable, EveryInputReadsTheMinimaxValueOfItsBucket) {
   const SpecUnitParams p = tableParams();
   const PromTable t = build(p, "1,8,100");
-  const SpecUnitModel m(p, t.words);
+  const SpecUnitModel m(p, t.words, t.seg_words);
   ASSERT_EQ(p.promDepth(), 4 << 4);
   const double scale = std::ldexp(1.0, -p.CosFracBits);
   for (const PromEntry& e : t.entries) {
@@ -122,7 +138,7 @@ TEST(SpecKindTable, ApproximationErrorCoversEveryCode) {
 TEST(SpecKindSchlick, EveryInputIsTheTruncatedRational) {
   const SpecUnitParams p = schlickParams();
   const PromTable t = build(p, "1,1.5,37.25,1000");
-  const SpecUnitModel m(p, t.words);
+  const SpecUnitModel m(p, t.words, t.seg_words);
   const long double lsb = std::ldexp(1.0L, -p.SpecFracBits);
   for (const PromEntry& e : t.entries) {
     EXPECT_EQ(e.code.u, static_cast<int64_t>(std::ldexp(e.n - 1.0, p.CoefFracBits)));
@@ -196,7 +212,7 @@ TEST(SpecKindExpLog, EveryInputIsThePowerWithinItsBound) {
     SpecUnitParams p = expLogParams();
     p.TableBits = T;
     const PromTable t = build(p, "1,1.5,37.25,1000");
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     const double bound = expLogBoundLsb(p);
     double worst = 0;
     for (const PromEntry& e : t.entries) {
@@ -220,9 +236,70 @@ TEST(SpecKindExpLog, EveryInputIsThePowerWithinItsBound) {
   EXPECT_EQ(m.evaluate(7, 0, kFull).spec, 0u);
 }
 
+// Each segment's polynomial in the unit's integers against the real fit it came from, at every
+// cosine code: the difference is the final rounding (1/2 LSB of f), the coefficients' rounding
+// (half a unit of 2^-Kf each, u^j <= 1) and Horner's floors (one unit of 2^-Kf per step), so
+// at most 1/2 + 2^(Wf-Kf) ((d+1)/2 + d) LSB; below the cut both are 0. The whole-lobe error
+// against c^n (long double) is then within the fit's own error plus that bound.
+TEST(SpecKindPiecewise, EveryInputIsItsSegmentsPolynomialWithinItsBound) {
+  for (int segments : {1, 2, 4})
+    for (int degree : {1, 2, 3}) {
+      SpecUnitParams p = piecewiseParams();
+      p.Segments = segments;
+      p.Degree = degree;
+      p.PipeStages = 1;
+      p.CoefIntBits = 6;  // one segment, or a cubic, needs coefficients beyond [-2, 2) (up to 14)
+      const PromTable t = build(p, "1,8,100,1000");
+      const SpecUnitModel m(p, t.words, t.seg_words);
+      const double lsb = std::ldexp(1.0, -p.SpecFracBits);
+      const double bound = 0.5 + std::ldexp((degree + 1) / 2.0 + degree, p.SpecFracBits - p.CoefFracBits);
+      for (const PromEntry& e : t.entries) {
+        const PiecewiseFit& fit = *e.approx.pieces;
+        double worst = 0, worst_lobe = 0;
+        for (uint32_t c = 0; c <= static_cast<uint32_t>(p.cosOne()); ++c) {
+          const double x = std::ldexp(static_cast<double>(c), -p.CosFracBits);
+          const double f = m.evaluate(e.address, c, kFull).spec * lsb;
+          worst = std::max(worst, std::fabs(f - e.approx.eval(x)) / lsb);
+          worst_lobe = std::max(worst_lobe, static_cast<double>(std::fabs(f - std::pow(static_cast<long double>(x), e.n))));
+        }
+        EXPECT_LE(worst, bound) << "S " << segments << " d " << degree << " n " << e.n;
+        EXPECT_LE(worst_lobe, fit.err + bound * lsb) << "S " << segments << " d " << degree << " n " << e.n;
+        EXPECT_LE(fit.segments.size(), static_cast<size_t>(segments));
+      }
+    }
+}
+
+TEST(SpecKindPiecewise, MalformedSegmentWordsAreRefused) {
+  const SpecUnitParams p = piecewiseParams();
+  const PromTable t = build(p, "8,100");
+  EXPECT_NO_THROW(SpecUnitModel(p, t.words, t.seg_words));
+  EXPECT_THROW(SpecUnitModel(p, t.words), std::invalid_argument);  // no segment ROM
+  const int cw = p.CosFracBits + 1;
+  // First codes that decrease: B_1 above B_2 at address 1.
+  std::vector<PromWord> words = t.words;
+  const PromWord field = (PromWord{1} << cw) - 1;
+  const PromWord b2 = (words[1] >> (2 * cw)) & field;
+  words[1] = (words[1] & ~(field << cw)) | ((b2 + 1) << cw);
+  EXPECT_THROW(SpecUnitModel(p, words, t.seg_words), std::invalid_argument);
+  // A scale above CosFracBits, and one that carries u past 1.0 in the top segment.
+  std::vector<PromWord> seg = t.seg_words;
+  const PromWord scale = (PromWord{1} << p.segScaleBits()) - 1;
+  seg[4 * 1 + 3] = (seg[4 * 1 + 3] & ~scale) | PromWord{static_cast<uint64_t>(p.CosFracBits + 1)};
+  EXPECT_THROW(SpecUnitModel(p, t.words, seg), std::invalid_argument);
+  seg = t.seg_words;
+  const int e = static_cast<int>(static_cast<uint64_t>(seg[4 * 1 + 3] & scale));
+  ASSERT_LT(e, p.CosFracBits);
+  seg[4 * 1 + 3] = (seg[4 * 1 + 3] & ~scale) | PromWord{static_cast<uint64_t>(e + 1)};
+  EXPECT_THROW(SpecUnitModel(p, t.words, seg), std::invalid_argument);
+  // The padding words: every B = 0 and zero coefficients give f = 0.
+  const SpecUnitModel m(p, t.words, t.seg_words);
+  for (uint32_t c : {0u, 1u, 1000u, static_cast<uint32_t>(p.cosOne())}) EXPECT_EQ(m.evaluate(7, c, kFull).spec, 0u);
+}
+
 TEST(SpecKinds, PipelineLatencyIsTwoPlusPipeStages) {
-  for (const SpecUnitParams& p : {tableParams(), schlickParams(), expLogParams()}) {
-    SpecUnitModel m(p, build(p, "8").words);
+  for (const SpecUnitParams& p : {tableParams(), schlickParams(), expLogParams(), piecewiseParams()}) {
+    const PromTable t = build(p, "8");
+    SpecUnitModel m(p, t.words, t.seg_words);
     SpecIn in;
     in.valid = true;
     in.shin = 0;
@@ -255,6 +332,16 @@ TEST(SpecKinds, ParametersAndFitMustSuitTheKind) {
   EXPECT_THROW(p.validate(), std::invalid_argument);
   p.TableBits = p.SpecFracBits + 3;
   EXPECT_NO_THROW(p.validate());
+  for (auto [degree, segments, pipe, kf] : {std::array<int, 4>{4, 4, 1, 18}, {0, 4, 1, 18}, {2, 3, 1, 18},
+                                            {2, 8, 1, 18}, {2, 4, 0, 18}, {2, 4, 4, 18}, {2, 4, 1, 13}}) {
+    p = piecewiseParams();
+    p.Degree = degree;
+    p.Segments = segments;
+    p.PipeStages = pipe;
+    p.CoefFracBits = kf;
+    EXPECT_THROW(p.validate(), std::invalid_argument) << degree << " " << segments << " " << pipe << " " << kf;
+  }
+  EXPECT_NO_THROW(piecewiseParams().validate());
   // exact is the fit of the kinds other than poly, and only theirs.
   PromRequest r;
   r.n = NSpec::parse("8", true);
@@ -262,17 +349,39 @@ TEST(SpecKinds, ParametersAndFitMustSuitTheKind) {
   EXPECT_THROW(buildPromTable(r, schlickParams()), std::invalid_argument);
   r.fit = FitKind::Exact;
   EXPECT_THROW(buildPromTable(r, SpecUnitParams{}), std::invalid_argument);
+  EXPECT_THROW(buildPromTable(r, piecewiseParams()), std::invalid_argument);  // piecewise: minimax only
+  r.fit = FitKind::Minimax;
+  EXPECT_THROW(buildPromTable(r, expLogParams()), std::invalid_argument);
+  // Coefficients beyond [-1, 1): CoefIntBits 1 cannot hold the quadratics' (they need 2).
+  SpecUnitParams narrow = piecewiseParams();
+  narrow.CoefIntBits = 1;
+  r.n = NSpec::parse("1,8,100,1000", true);
+  EXPECT_THROW(buildPromTable(r, narrow), std::invalid_argument);
   // More n than shininess codes: the table's depth counts cosine buckets too, not more n.
   EXPECT_THROW(build(tableParams(), "1,2,3,4,5"), std::invalid_argument);
 }
 
 TEST(SpecKinds, PromFilesRoundTrip) {
-  for (const SpecUnitParams& p : {tableParams(), schlickParams(), expLogParams()}) {
+  for (const SpecUnitParams& p : {tableParams(), schlickParams(), expLogParams(), piecewiseParams()}) {
     const PromTable t = build(p, "1,8,100");
     const std::string csv = renderProm(t, PromFormat::Csv);
-    const size_t rows = p.kind() == SpecKind::Table ? 3u << p.TableBits : 3u;
+    size_t rows = p.kind() == SpecKind::Table ? 3u << p.TableBits : 3u;
+    if (p.kind() == SpecKind::Piecewise) {
+      rows = 0;
+      for (const PromEntry& e : t.entries) rows += e.approx.pieces->segments.size();
+    }
     EXPECT_EQ(static_cast<size_t>(std::count(csv.begin(), csv.end(), '\n')), rows + 1);
-    for (PromFormat f : {PromFormat::Hex, PromFormat::Mem, PromFormat::Coe, PromFormat::Mif})
-      EXPECT_NE(renderProm(t, f).find(specKindInfo(p.kind()).name), std::string::npos);
+    for (PromFormat f : {PromFormat::Hex, PromFormat::Mem, PromFormat::Coe, PromFormat::Mif}) {
+      const PromFiles files = renderPromFiles(t, f);
+      ASSERT_EQ(files.size(), p.kind() == SpecKind::Piecewise ? 2u : 1u);
+      for (const auto& [suffix, text] : files) EXPECT_NE(text.find(specKindInfo(p.kind()).name), std::string::npos);
+    }
   }
+  // The hex files of the piecewise kind read back to both memories' words.
+  const PromTable t = build(piecewiseParams(), "1,8,100");
+  const std::string path = ::testing::TempDir() + "/piecewise_roundtrip.hex";
+  writePromHexFiles(path, t);
+  EXPECT_EQ(romImageDiff(readPromHexFiles(path, t.unit), RomImage::of(t), t.unit), "");
+  std::remove(path.c_str());
+  std::remove((path + kSegRomSuffix).c_str());
 }

@@ -108,7 +108,8 @@ TEST(SpecUnitConfig, CoefficientThatDoesNotFitIsNamed) {
 TEST(SpecPromWord, EncodeDecodeRoundTrip) {
   for (const std::string& name : builtinConfigNames("spec")) {
     const PromTable t = tableFor(name);
-    if (t.unit.kind() == SpecKind::Table) continue;  // a row of words per entry: test_spec_kinds
+    // The table: a row of words per entry; piecewise: the segments' first codes (test_spec_kinds).
+    if (t.unit.kind() == SpecKind::Table || t.unit.kind() == SpecKind::Piecewise) continue;
     for (const PromEntry& e : t.entries) {
       const SpecCoef d = decodePromWord(t.words[e.address], t.unit);
       ASSERT_EQ(d.u, e.code.u);
@@ -123,7 +124,7 @@ TEST(SpecUnitModel, FastPathEqualsFixedFormulation) {
   // (shininess, cos) pair of the narrow configuration, a sample of the others.
   for (const std::string& name : builtinConfigNames("spec")) {
     const PromTable t = tableFor(name);
-    const SpecUnitModel m(t.unit, t.words);
+    const SpecUnitModel m(t.unit, t.words, t.seg_words);
     const uint32_t ncos = 2u << t.unit.CosFracBits;
     const bool exhaustive = name == "narrow";
     std::mt19937 rng(7);
@@ -144,7 +145,7 @@ TEST(SpecUnitModel, DatapathErrorWithinDerivedBound) {
   //   <= 2^-(Wf+1); the clamp only moves f toward the clamped ideal.
   for (const char* name : {"default", "narrow", "wide"}) {
     const PromTable t = tableFor(name);
-    const SpecUnitModel m(t.unit, t.words);
+    const SpecUnitModel m(t.unit, t.words, t.seg_words);
     const SpecUnitParams& p = t.unit;
     double worst = 0;
     for (const PromEntry& e : t.entries) {
@@ -166,7 +167,7 @@ TEST(SpecUnitModel, DatapathErrorWithinDerivedBound) {
 
 TEST(SpecUnitModel, ExactCasesAndSaturation) {
   const PromTable t = tableFor("default");
-  const SpecUnitModel m(t.unit, t.words);
+  const SpecUnitModel m(t.unit, t.words, t.seg_words);
   const SpecUnitParams& p = t.unit;
   const uint32_t one = static_cast<uint32_t>(p.cosOne()), spec_one = 1u << p.SpecFracBits;
   for (const PromEntry& e : t.entries) {
@@ -189,7 +190,7 @@ TEST(SpecUnitModel, ExactCasesAndSaturation) {
 TEST(SpecUnitModel, PipelineLatencyHoldAndReset) {
   for (const std::string& name : builtinConfigNames("spec")) {
     const PromTable t = tableFor(name);
-    SpecUnitModel m(t.unit, t.words);
+    SpecUnitModel m(t.unit, t.words, t.seg_words);
     const int lat = t.unit.latency();
     SpecIn in;
     in.valid = true;

@@ -183,8 +183,8 @@ std::vector<SpecIn> specInputs(const SpecUnitParams& p, const std::vector<std::p
 void expectRtlEqualsModel(const std::string& config, const PromTable& t, const std::vector<SpecIn>& inputs,
                           const fs::path& dir, const std::string& label) {
   const std::string prom = (dir / fmt::format("{}_{}.hex", config, label)).string();
-  writeFileAtomic(prom, renderProm(t, PromFormat::Hex));
-  SpecUnitModel model(t.unit, t.words);
+  writePromHexFiles(prom, t);
+  SpecUnitModel model(t.unit, t.words, t.seg_words);
   ListStimulus stim(inputs);
   SpecCosimOptions o;
   o.prom_path = prom;
@@ -414,7 +414,7 @@ TEST(Stiff, SpecShininessOneIsExactlyTheCosine) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
     ASSERT_EQ(t.entries.at(0).n, 1.0) << name;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     std::vector<std::pair<uint32_t, uint32_t>> points;
     for (uint32_t k = 0; k < (2u << p.CosFracBits); ++k) {
       const std::array<uint32_t, 3> light = lightsFor(p, k);
@@ -439,7 +439,7 @@ TEST(Stiff, SpecShininessNearOne) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = tableWithN(name, "1,1.0001,1.001,1.01,1.1,1.5");
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     std::vector<std::pair<uint32_t, uint32_t>> points;
     long double worst_1e4 = 0, worst_all = 0;
     for (const PromEntry& e : t.entries) {
@@ -470,7 +470,7 @@ TEST(Stiff, SpecCosZeroGivesNoLight) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     std::vector<std::pair<uint32_t, uint32_t>> points;
     for (uint32_t a = 0; a < static_cast<uint32_t>(p.promDepth()); ++a) {
       const SpecOut o = m.evaluate(a, 0, lightsFor(p, a));
@@ -491,7 +491,7 @@ TEST(Stiff, SpecCosOneLsbAboveZero) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     std::vector<std::pair<uint32_t, uint32_t>> points;
     long double worst_dp = 0, worst_total = 0;
     int zeros = 0;
@@ -524,7 +524,7 @@ TEST(Stiff, SpecCosOneLsbBelowOne) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     const uint32_t k = static_cast<uint32_t>(p.cosOne() - 1);
     std::vector<std::pair<uint32_t, uint32_t>> points;
     long double worst_dp = 0, worst_total = 0, total_max_n = 0;
@@ -554,7 +554,7 @@ TEST(Stiff, SpecCosOneGivesFullLight) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     const uint32_t one = static_cast<uint32_t>(p.cosOne()), max = static_cast<uint32_t>(p.lightMax());
     std::vector<SpecIn> inputs;
     for (uint32_t a = 0; a < static_cast<uint32_t>(p.promDepth()); ++a) {
@@ -576,7 +576,7 @@ TEST(Stiff, SpecCosAboveOneSaturates) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     const uint32_t one = static_cast<uint32_t>(p.cosOne());
     std::vector<std::pair<uint32_t, uint32_t>> points;
     for (uint32_t a = 0; a < static_cast<uint32_t>(p.promDepth()); ++a)
@@ -635,7 +635,7 @@ TEST(Stiff, SpecNarrowCancellationAtThousand) {
   for (const std::string name : {"narrow", "default", "wide"}) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     const int a1000 = t.addressOf(1000);
     ASSERT_GE(a1000, 0) << name;
     const PromEntry& e = t.entries[static_cast<size_t>(a1000)];
@@ -676,7 +676,7 @@ TEST(Stiff, SpecClampBoundaries) {
   for (const std::string& name : specConfigs()) {
     const PromTable t = registryTable(name);
     const SpecUnitParams& p = t.unit;
-    const SpecUnitModel m(p, t.words);
+    const SpecUnitModel m(p, t.words, t.seg_words);
     const int64_t one = p.cosOne();
     std::vector<std::pair<uint32_t, uint32_t>> points;
     long double worst_dp = 0;

@@ -106,7 +106,7 @@ TEST(SpecSweep, PointParamsAndTheirDerivations) {
   EXPECT_NE(e.find("point DiffFracBits=21"), std::string::npos) << e;
   EXPECT_NE(e.find("c^2 - c is exact at 2*CosFracBits"), std::string::npos) << e;
   const auto names = specParamNames();
-  EXPECT_EQ(names.size(), 12u);
+  EXPECT_EQ(names.size(), 13u);
   EXPECT_NE(std::find(names.begin(), names.end(), "SpecFracBits"), names.end());
 }
 
@@ -142,6 +142,7 @@ TEST(SpecSweep, EachKindNarrowsItsOwnWidths) {
       {"table", {"SpecFracBits", "TableBits"}},
       {"schlick", {"CoefIntBits", "CoefFracBits", "SpecFracBits"}},
       {"explog", {"CoefIntBits", "CoefFracBits", "SpecFracBits", "TableBits"}},
+      {"piecewise", {"CoefIntBits", "CoefFracBits", "SpecFracBits"}},
   };
   for (const auto& [name, widths] : want) {
     const SpecUnitConfig c = specConfig(name);

@@ -44,7 +44,7 @@ void spit(const fs::path& p, const std::string& text) { std::ofstream(p) << text
 fs::path specFile(const fs::path& dir, const std::string& config, uint64_t cycles, uint64_t seed) {
   const SpecUnitConfig cfg = specConfig(config);
   const PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
-  writeFileAtomic((dir / (config + ".hex")).string(), renderProm(t, PromFormat::Hex));
+  writePromHexFiles((dir / (config + ".hex")).string(), t);
   const fs::path vec = dir / ("spec_" + config + ".vec");
   writeSpecVectors(vec.string(), generateSpecVectors(specConfig(config), cycles, seed, (dir / (config + ".hex")).string(), dir.string()));
   return vec;
@@ -157,8 +157,8 @@ TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
     const fs::path path = fs::path(SHD_SOURCE_DIR) / "vectors/cycles" / ("spec_" + config + ".vec");
     const SpecVectors v = loadSpecVectors(path.string());
     const SpecUnitParams& p = v.params;
-    const std::vector<PromWord> words =
-        readPromHex((path.parent_path() / v.prom).string(), p.promWordBits(), p.promDepth());
+    const RomImage rom = readPromHexFiles((path.parent_path() / v.prom).string(), p);
+    const std::vector<PromWord>& words = rom.prom;
     const uint32_t one = static_cast<uint32_t>(p.cosOne()), lmax = static_cast<uint32_t>(p.lightMax());
     uint64_t shin0 = 0, shin_max = 0, cos0 = 0, cos_one = 0, cos_above = 0, cos_max = 0, dark = 0, full = 0;
     uint64_t gaps = 0, below_cut = 0, at_cut = 0;
@@ -199,6 +199,14 @@ TEST(VectorFile, CheckedInSpecFilesCoverTheCorners) {
       for (uint32_t k = 0; k <= static_cast<uint32_t>(p.CosFracBits); ++k) {
         const bool all = inputs.count({last, (1u << k) - 1}) && inputs.count({last, 1u << k}) && inputs.count({last, (1u << k) + 1});
         EXPECT_TRUE(all) << config << " 2^" << k;
+      }
+    }
+    if (p.kind() == SpecKind::Piecewise) {  // each segment's first code and its neighbours, every 8th n
+      for (uint32_t shin = 0; shin <= last; shin += 8) {
+        const PiecewiseCodes q = decodePiecewise(words[shin], &rom.seg[size_t{shin} * static_cast<size_t>(p.Segments)], p);
+        for (const PiecewiseCodes::Seg& g : q.segs)
+          for (int64_t c = std::max<int64_t>(g.B - 1, 0); c <= std::min<int64_t>(g.B + 1, 2 * int64_t{one} - 1); ++c)
+            EXPECT_TRUE(inputs.count({shin, static_cast<uint32_t>(c)})) << config << " n " << shin << " code " << c;
       }
     }
     if (p.kind() == SpecKind::Poly && p.Degree == 3) {

@@ -1,6 +1,7 @@
 #include "approx/fit.h"
 
 #include "approx/lobe_error.h"
+#include "approx/piecewise.h"
 
 #include <fmt/format.h>
 
@@ -69,6 +70,7 @@ double Approx::eval(double c) const {
   c = clamp01(c);
   if (form == Form::Schlick) return c / (n - n * c + c);
   if (form == Form::Power) return std::pow(c, n);
+  if (form == Form::Piecewise) return clamp01(pieces->eval(c));
   if (form == Form::Table) {
     const double scaled = std::floor(std::ldexp(c, tableBits()));
     return table[static_cast<size_t>(std::min(scaled, static_cast<double>(table.size() - 1)))];
@@ -80,6 +82,14 @@ double Approx::eval(double c) const {
 std::vector<double> Approx::kinks() const {
   std::vector<double> k;
   if (form == Form::Schlick || form == Form::Power) return k;
+  if (form == Form::Piecewise) {
+    if (pieces->cut > 0) k.push_back(pieces->cut);
+    for (const SegmentFit& s : pieces->segments)
+      if (s.a > 0) k.push_back(s.a);
+    std::sort(k.begin(), k.end());
+    k.erase(std::unique(k.begin(), k.end()), k.end());
+    return k;
+  }
   if (form == Form::Table) {
     for (size_t i = 1; i < table.size(); ++i) k.push_back(std::ldexp(static_cast<double>(i), -tableBits()));
     return k;
@@ -141,6 +151,15 @@ Approx Approx::power(double n) {
   Approx f;
   f.form = Form::Power;
   f.n = n;
+  return f;
+}
+
+Approx Approx::piecewise(PiecewiseFit fit) {
+  Approx f;
+  f.form = Form::Piecewise;
+  f.degree = fit.degree;
+  f.n = fit.n;
+  f.pieces = std::make_shared<const PiecewiseFit>(std::move(fit));
   return f;
 }
 

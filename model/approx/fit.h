@@ -44,6 +44,7 @@
 //               minimaxCubic.
 #pragma once
 
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -61,8 +62,10 @@ constexpr double kMaxShininess = 1000.0;
 // The ideal device in double precision. Form Poly: the polynomial with its clamp and cut (the
 // header comment). Form Table (the table kind): f(c) = table[min(floor(c 2^T), 2^T - 1)], a step
 // function of c. Form Schlick: f(c) = c / (n - n c + c). Form Power (the explog kind): f(c) = c^n.
+// Form Piecewise (the piecewise kind): the segments' polynomials, 0 below the cut (piecewise.h).
+struct PiecewiseFit;
 struct Approx {
-  enum class Form { Poly, Table, Schlick, Power };
+  enum class Form { Poly, Table, Schlick, Power, Piecewise };
   Form form = Form::Poly;
   int degree = 2;
   double a = 0.0;                      // degree 2 coefficient
@@ -70,13 +73,14 @@ struct Approx {
   double cut = 0.0;                    // degree 3 cut-off (0: none); always 0 for degree 2
   double n = 0.0;                      // Schlick, Power: the shininess
   std::vector<double> table;           // Table: 2^T values in [0, 1], bucket k = [k, k+1) / 2^T
+  std::shared_ptr<const PiecewiseFit> pieces;  // Piecewise
 
   // The ideal device: the rule of the header comment, exactly.
   double eval(double c) const;
   // The unclamped, uncut polynomial p(c) = c - c (1 - c) (a1 c + a1 + b1).
   double poly(double c) const;
   // Points in [0, 1] where f is not smooth: the cut, the roots of p and of p - 1 above it; the
-  // table's bucket edges.
+  // table's bucket edges; the segments' ends.
   std::vector<double> kinks() const;
 
   static Approx quadratic(double a);
@@ -84,6 +88,7 @@ struct Approx {
   static Approx cubic(double a1, double b1);
   static Approx schlick(double n);
   static Approx power(double n);
+  static Approx piecewise(PiecewiseFit fit);
   static Approx stepTable(std::vector<double> values);  // size a power of two
   int tableBits() const;  // T: log2 of the table's size
 };

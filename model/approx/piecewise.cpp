@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -142,33 +143,119 @@ double PiecewiseFit::eval(double c) const {
 
 namespace {
 
-// The segments for a target error E from c = 1 down; cut = where they end.
-bool layFor(double n, int count, int degree, double E, PiecewiseFit& out) {
+// A search on a non-decreasing h(v) over [lo, hi] that ends on the feasible side (h <= 0) next to
+// the root: at a v with h(v) in [-win, 0] (accepted), at a feasible v within minWidth of an
+// infeasible one, or at a bound. Each step aims at h = -win/2, the middle of the accepted window,
+// so a good one ends the search: Newton's from the latest point, along the slope (the caller's
+// h' there, else the latest secant's, at first a given one), at most maxStep; once bracketed,
+// when that leaves the bracket, regula falsi with the Illinois modification (an end kept twice
+// has its value halved), or bisection where an end's value is not finite. The caller evaluates
+// h at next() (or at a guess of its own first) and reports it by add(); as the feasible end only
+// moves up, the caller's latest feasible evaluation is the one the search ends on.
+struct FeasibleRoot {
+  double lo, hi, win, minWidth, slope, maxStep;
+  bool hasF = false, hasI = false, accepted = false;
+  double vF = 0, gF = 0, vI = 0, gI = 0;  // the ends, g = h + win/2 (Illinois-scaled)
+  double vLast = 0, hLast = NAN;
+  int side = 0;  // +1: the latest evaluation was feasible, -1: it was not
+
+  bool done() const {
+    return accepted || (hasF && hasI && vI - vF <= minWidth) || (hasF && !hasI && vF >= hi) ||
+           (hasI && !hasF && vI <= lo);
+  }
+  double next() const {
+    double step = -(hLast + 0.5 * win) / slope;
+    if (!std::isfinite(step)) step = hLast < 0 ? maxStep : -maxStep;
+    const double v = std::clamp(vLast + std::clamp(step, -maxStep, maxStep), lo, hi);
+    if (!(hasF && hasI) || (v > vF && v < vI)) return v;
+    if (std::isfinite(gF) && std::isfinite(gI)) {
+      const double rf = vF + (vI - vF) * (-gF / (gI - gF));
+      if (rf > vF && rf < vI) return rf;
+    }
+    return 0.5 * (vF + vI);
+  }
+  void add(double v, double h, double dh = NAN) {
+    if (std::isfinite(dh) && dh > 0) {
+      slope = dh;
+    } else if (std::isfinite(h) && std::isfinite(hLast) && v != vLast) {
+      const double s = (h - hLast) / (v - vLast);
+      if (s > 0 && std::isfinite(s)) slope = s;
+    }
+    vLast = v, hLast = h;
+    const double g = h + 0.5 * win;
+    if (h <= 0) {
+      accepted = h >= -win;
+      if (side == 1 && hasI) gI *= 0.5;
+      hasF = true, vF = v, gF = g, side = 1;
+    } else {
+      if (side == -1 && hasF) gF *= 0.5;
+      hasI = true, vI = v, gI = g, side = -1;
+    }
+  }
+};
+
+// Rounding in a segment's error, relative to the largest c^n on it, with a margin (the Remez
+// exchange stops below 1e-15): the searches' windows are kept wider than it.
+constexpr double kNoise = 1e-13;
+
+// A segment [a, top] in scale-free terms: the error of c^n on [k a, k top] is k^n times that on
+// [a, top], so err = top^n eps(a / top), and the segment meeting E solves ln eps = T = ln E -
+// n ln top. v = ln((top - a) / top); slope = d ln err / d v (0: nothing known yet).
+struct SegmentStart {
+  double v = 0, T = 0, slope = 0;
+};
+
+// The longest [a, top] with error at most E: its error within a relative 1e-7 below E (or its
+// relative length within 1e-12 of the shortest that exceeds E), a = 0 if [0, top] meets E. The
+// search is on v, where ln err is close to linear (err ~ length^(d+1) for short segments; the
+// error only grows with the length), from start (updated) moved to the new T along its slope.
+// false when even a segment of length top 2^-44 exceeds E.
+bool longestSegment(double n, int degree, double top, double E, SegmentStart& start, SegmentFit& out) {
+  const double lnE = std::log(E), T = lnE - n * std::log(top);
+  const double win = std::max(1e-7, kNoise * std::pow(top, n) / E);
+  FeasibleRoot root{-44 * std::log(2.0), 0, win, 1e-12, start.slope, 3.0};
+  double v = std::clamp(start.v + (T - start.T) / start.slope, root.lo, root.hi);
+  bool found = false;
+  for (int it = 0; it < 200 && !root.done(); ++it, v = root.next()) {
+    const double a = v >= 0 ? 0.0 : -top * std::expm1(v);
+    SegmentFit f = minimaxSegment(n, degree, a, top);
+    const double h = std::log(f.err) - lnE;  // -inf for an exact fit
+    if (h <= 0) out = std::move(f), found = true;
+    root.add(v, h);
+  }
+  if (found) start = {std::log1p(-out.a / top), T, root.slope};
+  return found;
+}
+
+struct Mismatch {
+  double h, dh;  // h = cut E^(-1/n) - 1 and its derivative in -ln E
+};
+
+// The segments for a target error E, each the longest that meets it, from c = 1 down; cut = where
+// they end. h <= 0 when the cut meets E too (cut^n <= E): -inf when the segments reach c = 0, +inf
+// when one cannot meet E. dh from the segments' slopes: with r = a / top, ln eps(r) = T moves
+// with ln E and with the top, which moves with the segments above (D = d ln top / d ln E).
+// starts[s] carries segment s's search from one E to the next.
+Mismatch layFor(double n, int count, int degree, double E, std::vector<SegmentStart>& starts, PiecewiseFit& out) {
+  constexpr double inf = std::numeric_limits<double>::infinity();
   out.segments.clear();
-  double top = 1;
+  double top = 1, D = 0;
   for (int s = 0; s < count && top > 0; ++s) {
-    SegmentFit whole = minimaxSegment(n, degree, 0, top);
-    if (whole.err <= E) {
-      out.segments.push_back(whole);
-      top = 0;
-      break;
+    if (starts[s].slope <= 0)  // first: from the whole [0, 1], or the one above (the same eps)
+      starts[s] = s == 0 ? SegmentStart{0.0, std::log(E), degree + 1.0} : starts[s - 1];
+    SegmentFit seg;
+    if (!longestSegment(n, degree, top, E, starts[s], seg)) return {inf, NAN};
+    if (seg.a > 0) {  // d ln eps / d ln r = slope dv / d ln r = -slope r / (1 - r)
+      const double r = seg.a / top;
+      D += (1 - n * D) / (-starts[s].slope * r / (1 - r));
     }
-    double lo = 0, hi = top;  // err(lo) > E; the shortest segments' error tends to 0
-    SegmentFit best;
-    bool found = false;
-    for (int it = 0; it < 44; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      if (mid >= top) break;
-      const SegmentFit f = minimaxSegment(n, degree, mid, top);
-      if (f.err <= E) hi = mid, best = f, found = true;
-      else lo = mid;
-    }
-    if (!found) return false;
-    out.segments.push_back(best);
-    top = best.a;
+    top = seg.a;
+    out.segments.push_back(std::move(seg));
   }
   out.cut = top;
-  return std::pow(top, n) <= E;
+  if (top <= 0) return {-inf, NAN};
+  const double h = top * std::pow(E, -1.0 / n) - 1;
+  return {h, (1 + h) * (1 / n - D)};
 }
 
 }  // namespace
@@ -176,17 +263,33 @@ bool layFor(double n, int count, int degree, double E, PiecewiseFit& out) {
 PiecewiseFit fitPiecewise(double n, int segments, int degree) {
   if (segments < 1 || segments > 64)
     throw std::invalid_argument(fmt::format("fitPiecewise: {} segments (1..64)", segments));
-  minimaxSegment(n, degree, 0, 1);  // validates n and degree
   PiecewiseFit best;
   best.n = n;
   best.degree = degree;
-  double lo = 0, hi = 1;
-  if (!layFor(n, segments, degree, hi, best)) throw std::logic_error("fitPiecewise: E = 1 must be reachable");
-  PiecewiseFit trial = best;
-  for (int it = 0; it < 36; ++it) {
-    const double mid = 0.5 * (lo + hi);
-    if (layFor(n, segments, degree, mid, trial)) hi = mid, best = trial;
-    else lo = mid;
+  best.segments = {minimaxSegment(n, degree, 0, 1)};  // validates n and degree; feasible at its error
+  best.cut = 0;
+  const double e0 = best.segments[0].err, floorE = std::ldexp(1.0, -36);
+  if (e0 > floorE) {
+    // On t = -E^(1/(d+1)), where the layout's mismatch rises as E falls, close to linearly (the
+    // segments' lengths go as E^(1/(d+1))). Accepted when the cut's error is within a relative
+    // 1e-5 of E (more where the segments' rounding shows): the least feasible E lies between the
+    // two. The first E: an empirical fit to (E / e0)^(1/(d+1)) S, which is 0.43..0.96 for
+    // S = 1..8, d = 1..3, n = 2..1000.
+    const double k = degree + 1.0, rho = std::pow(segments, 0.1) * (0.45 + 0.35 * k / (n + degree));
+    const double lo = -std::pow(e0, 1 / k), hi = -std::pow(floorE, 1 / k);
+    const double t0 = std::min(lo * std::min(0.9, rho / segments), hi);
+    const double b0 = std::pow(-t0, k / n);  // the cut at t0's fixed point, for a first slope
+    FeasibleRoot root{lo, hi, 0 /* set per E */, -1e-7 * t0, ((1 - b0) / (b0 * k) + 1 / n) * k / -t0, -0.5 * t0};
+    std::vector<SegmentStart> starts(static_cast<size_t>(segments));
+    PiecewiseFit trial = best;
+    double t = t0;
+    for (int it = 0; it < 200 && !root.done(); ++it, t = root.next()) {
+      const double E = std::pow(-t, k);
+      const Mismatch m = layFor(n, segments, degree, E, starts, trial);
+      if (m.h <= 0) best = trial;
+      root.win = std::max(1e-5, 100 * kNoise / E) / n;  // wider where the segments' rounding shows
+      root.add(t, m.h, m.dh * k / -t);  // dh/dt = dh/d(-ln E) (d+1) / -t
+    }
   }
   best.err = std::pow(best.cut, n);
   for (const SegmentFit& s : best.segments) best.err = std::max(best.err, s.err);

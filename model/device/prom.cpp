@@ -62,6 +62,29 @@ void fillTableEntry(PromEntry& e, const SpecUnitParams& unit, std::vector<PromWo
   e.u_real = std::nan("");  // no single stored quantity: the row's reals are e.approx.table
 }
 
+// The piecewise kind: the minimax segments of c^n, in the unit's integers (approx/piecewise.h);
+// the first codes go to the PROM word, the scales and coefficients to the segment ROM words
+// {address, 0 .. Segments-1}.
+void fillPiecewiseEntry(PromEntry& e, const SpecUnitParams& unit, PromTable& t) {
+  PiecewiseFit fit = fitPiecewise(e.n, unit.Segments, unit.Degree);
+  const PiecewiseCodes q = quantisePiecewise(fit, unit.CosFracBits, unit.SpecFracBits, unit.CoefFracBits);
+  const FixedFormat cf = unit.coefFormat();
+  for (const PiecewiseCodes::Seg& g : q.segs)
+    for (int64_t k : g.K)
+      if (!cf.holds(k))
+        throw std::invalid_argument(fmt::format(
+            "fit minimax: a segment coefficient {} at n = {} does not fit {} (range {} .. {}); widen CoefIntBits",
+            std::ldexp(static_cast<double>(k), -unit.CoefFracBits), e.n, cf.str(),
+            Fixed::fromRaw(cf.rawMin(), cf).toDouble(), Fixed::fromRaw(cf.rawMax(), cf).toDouble()));
+  e.cut_real = fit.cut;
+  e.code.cut = q.segs.front().B;
+  e.u_real = std::nan("");  // the segments' reals are e.approx.pieces
+  e.approx = Approx::piecewise(std::move(fit));
+  t.words[e.address] = encodePiecewiseBounds(q, unit);
+  const std::vector<PromWord> segs = encodePiecewiseSegments(q, unit);
+  std::copy(segs.begin(), segs.end(), t.seg_words.begin() + static_cast<std::ptrdiff_t>(e.address) * unit.Segments);
+}
+
 }  // namespace
 
 NSpec NSpec::parse(std::string_view text, bool is_list) {
@@ -122,11 +145,18 @@ int addressBitsFor(size_t count) {
 }
 
 void checkFitForKind(FitKind fit, const SpecUnitParams& unit) {
-  const bool exact = fit == FitKind::Exact;
-  if (exact != (unit.kind() != SpecKind::Poly))
+  bool ok = false;
+  switch (unit.kind()) {
+    case SpecKind::Poly: ok = fit != FitKind::Exact; break;
+    case SpecKind::Piecewise: ok = fit == FitKind::Minimax; break;
+    case SpecKind::Table:
+    case SpecKind::Schlick:
+    case SpecKind::ExpLog: ok = fit == FitKind::Exact; break;
+  }
+  if (!ok)
     throw std::invalid_argument(fmt::format(
         "fit {} does not apply to the {} kind (the poly kind takes inflection, level, shortcut or minimax; the "
-        "table, schlick and explog kinds take exact)",
+        "piecewise kind minimax; the table, schlick and explog kinds exact)",
         toString(fit), specKindInfo(unit.kind()).name));
 }
 
@@ -152,6 +182,7 @@ PromTable buildPromTable(const PromRequest& req, const SpecUnitParams& unit) {
     }
   };
   t.words.assign(static_cast<size_t>(unit.promDepth()), PromWord{0});
+  t.seg_words.assign(static_cast<size_t>(unit.segDepth()), PromWord{0});
   for (size_t i = 0; i < req.n.values.size(); ++i) {
     PromEntry e;
     e.address = static_cast<uint32_t>(i);
@@ -169,8 +200,9 @@ PromTable buildPromTable(const PromRequest& req, const SpecUnitParams& unit) {
         e.code.u = quantise(e.u_real, "n", e.n);
         break;
       case SpecKind::Table: fillTableEntry(e, unit, t.words); break;
+      case SpecKind::Piecewise: fillPiecewiseEntry(e, unit, t); break;
     }
-    if (unit.kind() != SpecKind::Table) t.words[i] = encodePromWord(e.code, unit);
+    if (unit.kind() != SpecKind::Table && unit.kind() != SpecKind::Piecewise) t.words[i] = encodePromWord(e.code, unit);
     t.entries.push_back(e);
   }
   return t;

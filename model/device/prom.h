@@ -6,9 +6,11 @@
 // lo, lo+step, ... up to hi; an explicit list "8,32,200" keeps the user's order. Addresses from
 // the number of entries up to 2^ShinBits - 1 are unused and hold the all-zero word (degree 2:
 // a = 0, f = c; degree 3: u = v = 0, no cut, f = c; schlick: m = 0, f = c; table: f = 0;
-// explog: n = 0, f = 1 above c = 0). Contents per kind: poly, the fitted coefficients; schlick,
-// m = n - 1; explog, n; table, the values of
-// c^n per cosine bucket (prom.cpp fillTableEntry).
+// explog: n = 0, f = 1 above c = 0; piecewise: every B = 0 and zero coefficients, f = 0).
+// Contents per kind: poly, the fitted coefficients; schlick, m = n - 1; explog, n; table, the
+// values of c^n per cosine bucket (prom.cpp fillTableEntry); piecewise, the first codes of the
+// segments in the PROM and their scales and coefficients in the segment ROM, address
+// {i, s} (fitPiecewise and quantisePiecewise of approx/piecewise.h).
 // Rounding of the coefficients: round-half-even to the coefficient format (the table is made
 // once, offline; half-even has no bias). A coefficient that does not fit the format is an
 // error naming the fit, n and the format. The degree 3 cut-off code is ceil(cut * 2^Wc), so the
@@ -59,13 +61,14 @@ struct PromTable {
   PromRequest request;
   std::vector<PromEntry> entries;  // address order
   std::vector<PromWord> words;     // unit.promDepth() words
+  std::vector<PromWord> seg_words; // unit.segDepth() words: the piecewise kind's segment ROM
 
   // Index of the entry for shininess n, or -1.
   int addressOf(double n) const;
 };
 
 // std::invalid_argument unless the fit applies to the unit's kind: exact for the table, schlick
-// and explog kinds, any other for the poly kind.
+// and explog kinds, minimax for the piecewise kind, any other for the poly kind.
 void checkFitForKind(FitKind fit, const SpecUnitParams& unit);
 
 // Smallest ShinBits whose PROM holds `count` codes (at least 1).

@@ -52,9 +52,31 @@ struct Provenance {
   int word_bits = 0, depth = 0, shin_bits = 0, cos_frac_bits = 0;
   std::vector<Field> layout;  // MSB first
   size_t used = 0;            // addresses 0 .. used-1 hold entries
+  RomPart part = RomPart::Prom;
+  int segments = 1;
 };
 
-Provenance provenanceOf(const PromTable& t) {
+// The piecewise kind's two memories: the PROM of first codes, the segment ROM of scales and
+// coefficients.
+void piecewiseLayout(const PromTable& t, Provenance& p) {
+  const SpecUnitParams& u = t.unit;
+  p.segments = u.Segments;
+  if (p.part == RomPart::Prom) {
+    const int cw = u.CosFracBits + 1;
+    for (int j = u.Segments - 1; j >= 0; --j)
+      p.layout.push_back({j == 0 ? "B_0 (cut)" : fmt::format("B_{}", j), p.cos_format, (j + 1) * cw - 1, j * cw});
+    return;
+  }
+  p.word_bits = u.segWordBits();
+  p.depth = u.segDepth();
+  p.used *= static_cast<size_t>(u.Segments);
+  const int eb = u.segScaleBits(), kw = u.coefFormat().width();
+  for (int j = u.Degree; j >= 0; --j)
+    p.layout.push_back({fmt::format("K_{}", j), p.coef_format, eb + (j + 1) * kw - 1, eb + j * kw});
+  p.layout.push_back({"e", fmt::format("u{}.0", eb), eb - 1, 0});
+}
+
+Provenance provenanceOf(const PromTable& t, RomPart part) {
   const SpecUnitParams& u = t.unit;
   Provenance p;
   p.tool = std::string("shadesim ") + SHD_VERSION;
@@ -77,7 +99,12 @@ Provenance provenanceOf(const PromTable& t) {
   const int cw = u.coefFormat().width();
   p.used = t.entries.size();
   p.table_bits = u.TableBits;
-  if (p.kind == SpecKind::Table) {
+  p.part = part;
+  if (part == RomPart::Segments && p.kind != SpecKind::Piecewise)
+    throw std::invalid_argument(fmt::format("the {} kind has no segment ROM", specKindInfo(p.kind).name));
+  if (p.kind == SpecKind::Piecewise) {
+    piecewiseLayout(t, p);
+  } else if (p.kind == SpecKind::Table) {
     p.used <<= u.TableBits;
     p.layout.push_back({"f = c^n", p.spec_format, u.SpecFracBits, 0});
   } else if (p.kind == SpecKind::Schlick) {
@@ -108,7 +135,10 @@ std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std
   const bool table = p.kind == SpecKind::Table;
   l.push_back(fmt::format("kind: {}, fit: {}", specKindInfo(p.kind).name, p.fit));
   l.push_back(fmt::format("n: {} '{}', {} codes; {} i holds the i-th n{}", p.n_is_list ? "list" : "range",
-                          p.n_text, p.n_count, table ? "row" : "address",
+                          p.n_text, p.n_count,
+                          table ? "row"
+                          : p.part == RomPart::Segments ? fmt::format("addresses i*{0}..i*{0}+{1}", p.segments, p.segments - 1)
+                                                        : "address",
                           p.n_is_list ? " of the list (address map: <file>.map.csv)" : ""));
   if (table)
     l.push_back(fmt::format("content: row i is addresses i*{0}..i*{0}+{1}, word k the minimax value of c^n over the "
@@ -118,6 +148,15 @@ std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std
   else if (p.kind == SpecKind::Schlick)
     l.push_back(fmt::format("content: m = n - 1 {}, {}; f = c / (m (1 - c) + 1); cos: {}", p.coef_format,
                             p.coef_round, p.cos_format));
+  else if (p.kind == SpecKind::Piecewise && p.part == RomPart::Prom)
+    l.push_back(fmt::format("content: the first cos codes ({}) of the {} segments of degree {}, B_0 the cut (f = 0 "
+                            "below); the segment ROM <file>{} holds each segment's scale and coefficients",
+                            p.cos_format, p.segments, p.degree, kSegRomSuffix));
+  else if (p.kind == SpecKind::Piecewise)
+    l.push_back(fmt::format("content: segment ROM of the PROM <file> (without {}): address i*{} + s holds segment s "
+                            "of the i-th n: the scale e and K_j {} (round-half-even), f = sum K_j u^j, u = (c - B_s) "
+                            "2^e / 2^{}",
+                            kSegRomSuffix, p.segments, p.coef_format, p.cos_frac_bits));
   else
     l.push_back(fmt::format("content: n {}, {}; f = 2^(n log2 c) by the unit's fixed log and exp tables (2^{} "
                             "intervals each); cos: {}",
@@ -127,7 +166,10 @@ std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std
   if (p.used < static_cast<size_t>(p.depth))
     l.push_back(fmt::format("padding: addresses {}..{} are unused and hold the all-zero word ({})", p.used,
                             p.depth - 1,
-                            table ? "f = 0" : p.kind == SpecKind::Schlick ? "m = 0: f = c" : "n = 0: f = 1 above c = 0"));
+                            table                                ? "f = 0"
+                            : p.kind == SpecKind::Schlick        ? "m = 0: f = c"
+                            : p.kind == SpecKind::Piecewise ? "every B = 0 and K = 0: f = 0"
+                                                                 : "n = 0: f = 1 above c = 0"));
   else
     l.push_back("padding: none, every address holds a code");
   return l;
@@ -136,7 +178,9 @@ std::vector<std::string> altProvenanceLines(const Provenance& p, std::vector<std
 // The provenance as comment lines without the comment marker.
 std::vector<std::string> provenanceLines(const Provenance& p) {
   std::vector<std::string> l;
-  l.push_back(fmt::format("{}: specular unit coefficient PROM (rtl/shd_coef_rom.v)", p.tool));
+  l.push_back(p.part == RomPart::Segments
+                  ? fmt::format("{}: piecewise specular unit segment ROM (rtl/shd_spec_piecewise.v)", p.tool)
+                  : fmt::format("{}: specular unit coefficient PROM (rtl/shd_coef_rom.v)", p.tool));
   if (p.kind != SpecKind::Poly) return altProvenanceLines(p, l);
   l.push_back(fmt::format("fit: {}, degree {}, level {}{}", p.fit, p.degree, p.level,
                           p.level_used ? "" : " (not used by this fit)"));
@@ -180,6 +224,9 @@ void checkTable(const PromTable& t) {
   if (t.words.size() != depth)
     throw std::invalid_argument(fmt::format("PROM table holds {} words, the unit addresses {}",
                                             t.words.size(), depth));
+  if (t.seg_words.size() != static_cast<size_t>(t.unit.segDepth()))
+    throw std::invalid_argument(fmt::format("segment ROM holds {} words, the unit addresses {}",
+                                            t.seg_words.size(), t.unit.segDepth()));
   if (t.entries.empty())
     throw std::invalid_argument("PROM table has no entries");
   // hexWord checks each word's width when the data is rendered.
@@ -195,6 +242,23 @@ std::string csvTable(const PromTable& t) {
         out += fmt::format("{},{},{},{},{}\n", real17(e.n), a, k, real17(e.approx.table[k]),
                            decodePromWord(t.words[a], t.unit).u);
       }
+  } else if (t.unit.kind() == SpecKind::Piecewise) {
+    const SpecUnitParams& u = t.unit;
+    out += "n,address,segment,segment_address,first_code,scale";
+    for (int j = 0; j <= u.Degree; ++j) out += fmt::format(",K{}_code", j);
+    out += ",a_real,b_real\n";
+    for (const PromEntry& e : t.entries) {
+      const size_t base = static_cast<size_t>(e.address) * static_cast<size_t>(u.Segments);
+      const PiecewiseCodes q = decodePiecewise(t.words[e.address], &t.seg_words[base], u);
+      const auto& fit = e.approx.pieces->segments;  // from the top down; q.segs ascending
+      for (size_t s = 0; s < fit.size(); ++s) {
+        const PiecewiseCodes::Seg& g = q.segs[s];
+        const SegmentFit& r = fit[fit.size() - 1 - s];
+        out += fmt::format("{},{},{},{},{},{}", real17(e.n), e.address, s, base + s, g.B, g.e);
+        for (int64_t k : g.K) out += fmt::format(",{}", k);
+        out += fmt::format(",{},{}\n", real17(r.a), real17(r.b));
+      }
+    }
   } else if (t.unit.kind() != SpecKind::Poly) {  // schlick, explog: one code per n
     out += t.unit.kind() == SpecKind::Schlick ? "n,address,m_real,m_code\n" : "n,address,n_real,n_code\n";
     for (const PromEntry& e : t.entries)
@@ -262,9 +326,10 @@ std::string hexWord(PromWord w, int bits) {
   return s;
 }
 
-std::string renderProm(const PromTable& t, PromFormat f) {
+std::string renderProm(const PromTable& t, PromFormat f, RomPart part) {
   checkTable(t);
-  const Provenance p = provenanceOf(t);
+  const Provenance p = provenanceOf(t, part);
+  const std::vector<PromWord>& words = part == RomPart::Prom ? t.words : t.seg_words;
   const int bits = p.word_bits;
   std::string out;
   switch (f) {
@@ -272,7 +337,7 @@ std::string renderProm(const PromTable& t, PromFormat f) {
       out += commentBlock(p, "//");
       out += fmt::format("// $readmemh: {} words of {} hex digits follow, address 0 first\n",
                          p.depth, (bits + 3) / 4);
-      for (PromWord w : t.words) out += hexWord(w, bits) + "\n";
+      for (PromWord w : words) out += hexWord(w, bits) + "\n";
       break;
     case PromFormat::Mem:
       if (p.depth > kLatticeMaxDepth || bits > kLatticeMaxWidth)
@@ -283,27 +348,42 @@ std::string renderProm(const PromTable& t, PromFormat f) {
       out += fmt::format("#Format=Hex\n#Depth={}\n#Width={}\n#AddrRadix=3\n#DataRadix=3\n#Data\n",
                          p.depth, bits);
       out += commentBlock(p, "//");
-      for (PromWord w : t.words) out += hexWord(w, bits) + "\n";
+      for (PromWord w : words) out += hexWord(w, bits) + "\n";
       break;
     case PromFormat::Coe:
       out += commentBlock(p, ";");
       out += "memory_initialization_radix=16;\nmemory_initialization_vector=\n";
-      for (size_t i = 0; i < t.words.size(); ++i)
-        out += hexWord(t.words[i], bits) + (i + 1 < t.words.size() ? ",\n" : ";\n");
+      for (size_t i = 0; i < words.size(); ++i)
+        out += hexWord(words[i], bits) + (i + 1 < words.size() ? ",\n" : ";\n");
       break;
     case PromFormat::Mif:
       out += commentBlock(p, "--");
       out += fmt::format("WIDTH={};\nDEPTH={};\nADDRESS_RADIX=UNS;\nDATA_RADIX=HEX;\n\nCONTENT BEGIN\n",
                          bits, p.depth);
-      for (size_t i = 0; i < t.words.size(); ++i)
-        out += fmt::format("  {} : {};\n", i, hexWord(t.words[i], bits));
+      for (size_t i = 0; i < words.size(); ++i)
+        out += fmt::format("  {} : {};\n", i, hexWord(words[i], bits));
       out += "END;\n";
       break;
     case PromFormat::Csv:
+      if (part == RomPart::Segments)
+        throw std::invalid_argument("the csv table holds the segment ROM's contents with the PROM's (one file)");
       out += csvTable(t);
       break;
   }
   return out;
+}
+
+PromFiles renderPromFiles(const PromTable& t, PromFormat f) {
+  PromFiles files = {{"", renderProm(t, f)}};
+  if (t.unit.segDepth() > 0 && f != PromFormat::Csv)
+    files.emplace_back(kSegRomSuffix, renderProm(t, f, RomPart::Segments));
+  return files;
+}
+
+void writePromHexFiles(const std::string& path, const PromTable& t) {
+  OutputFiles out;
+  for (const auto& [suffix, text] : renderPromFiles(t, PromFormat::Hex)) out.add(path + suffix, text);
+  out.commit();
 }
 
 std::string renderAddressMap(const PromTable& t) {
@@ -314,7 +394,7 @@ std::string renderAddressMap(const PromTable& t) {
 
 std::string renderProvenanceJson(const PromTable& t) {
   checkTable(t);
-  const Provenance p = provenanceOf(t);
+  const Provenance p = provenanceOf(t, RomPart::Prom);
   nlohmann::ordered_json j;
   j["tool"] = p.tool;
   j["content"] = "specular unit coefficient PROM";
@@ -330,10 +410,21 @@ std::string renderProvenanceJson(const PromTable& t) {
   if (p.degree == 3) j["cut_code"] = fmt::format("ceil(cut * 2^{})", p.cos_frac_bits);
   j["word_bits"] = p.word_bits;
   j["depth"] = p.depth;
-  nlohmann::ordered_json layout = nlohmann::ordered_json::array();
-  for (const Field& f : p.layout)
-    layout.push_back({{"field", f.name}, {"format", f.format}, {"msb", f.msb}, {"lsb", f.lsb}});
-  j["layout_msb_first"] = layout;
+  const auto layoutJson = [](const Provenance& q) {
+    nlohmann::ordered_json layout = nlohmann::ordered_json::array();
+    for (const Field& f : q.layout)
+      layout.push_back({{"field", f.name}, {"format", f.format}, {"msb", f.msb}, {"lsb", f.lsb}});
+    return layout;
+  };
+  j["layout_msb_first"] = layoutJson(p);
+  if (p.kind == SpecKind::Piecewise) {
+    const Provenance s = provenanceOf(t, RomPart::Segments);
+    j["segment_rom"] = {{"file", std::string("<file>") + kSegRomSuffix},
+                        {"address", fmt::format("i*{} + s", s.segments)},
+                        {"word_bits", s.word_bits},
+                        {"depth", s.depth},
+                        {"layout_msb_first", layoutJson(s)}};
+  }
   j["used_addresses"] = {0, p.used - 1};
   if (p.used < static_cast<size_t>(p.depth))
     j["padding"] = {{"first", p.used}, {"last", p.depth - 1}, {"word", "all-zero"}};
@@ -409,6 +500,27 @@ std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int de
                                          "(file ends at line {})",
                                          path, words.size(), depth, line_no));
   return words;
+}
+
+RomImage readPromHexFiles(const std::string& path, const SpecUnitParams& p) {
+  RomImage r;
+  r.prom = readPromHex(path, p.promWordBits(), p.promDepth());
+  if (p.segDepth() > 0) r.seg = readPromHex(path + kSegRomSuffix, p.segWordBits(), p.segDepth());
+  return r;
+}
+
+std::string romImageDiff(const RomImage& got, const RomImage& want, const SpecUnitParams& p) {
+  const auto diff = [](const char* what, const std::vector<PromWord>& g, const std::vector<PromWord>& w,
+                       int bits) -> std::string {
+    if (g.size() != w.size()) return fmt::format("{} has {} words, expected {}", what, g.size(), w.size());
+    for (size_t i = 0; i < g.size(); ++i)
+      if (g[i] != w[i])
+        return fmt::format("{} word {} is 0x{}, expected 0x{}", what, i, hexWord(g[i], bits), hexWord(w[i], bits));
+    return "";
+  };
+  std::string d = diff("PROM", got.prom, want.prom, p.promWordBits());
+  if (d.empty() && p.segDepth() > 0) d = diff("segment ROM", got.seg, want.seg, p.segWordBits());
+  return d;
 }
 
 }  // namespace shd

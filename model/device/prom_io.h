@@ -21,11 +21,16 @@
 //          degree 3: n,address,a1_real,a1_code,v_real,v_code,cut_real,cut_code
 //          schlick:  n,address,m_real,m_code                (m = n - 1)
 //          table:    n,address,bucket,value_real,value_code (one row per word of the n's row)
+//          piecewise: n,address,segment,segment_address,first_code,scale,K0_code..Kd_code,a_real,b_real
+//                    (one row per segment of the fit, [a_real, b_real] its real interval)
 //        v = a1 + b1 is the second word field (the Horner form p = c - c(1-c)(a1 c + v)); cut is
 //        the cut-off cosine and cut_code = ceil(cut * 2^Wc) the stored uQ1.Wc code. Reals carry
 //        17 significant digits (they round-trip to the same double), codes are signed decimal.
 //        CSV has no comment syntax, so its provenance is the JSON sidecar
 //        (renderProvenanceJson), which the other formats' comments restate.
+// The piecewise kind has a second memory, the segment ROM (RomPart::Segments), written beside the
+// PROM as <file>.seg in the same format (hex, mem, coe, mif; the csv table holds both); the
+// RTL loads it from the PROM's path with that suffix (rtl/shd_coef_rom.v Suffix).
 // Provenance: tool and version, fit, degree, level, n spec and count, coefficient format and
 // rounding, cos format, word width and layout, depth, and which addresses are unused padding
 // (they hold the all-zero word). No timestamps or paths: the output is a pure function of the
@@ -34,6 +39,7 @@
 
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "device/prom.h"
@@ -42,6 +48,8 @@
 namespace shd {
 
 enum class PromFormat { Hex, Mem, Coe, Mif, Csv };
+enum class RomPart { Prom, Segments };
+constexpr const char* kSegRomSuffix = ".seg";
 
 // "hex", "mem", "coe", "mif", "csv"; std::invalid_argument("unknown PROM format 'x' (expected
 // hex, mem, coe, mif or csv)") otherwise.
@@ -55,7 +63,17 @@ std::string hexWord(PromWord w, int bits);
 // The whole file text in format f. std::invalid_argument if t.words does not hold
 // unit.promDepth() words of unit.promWordBits() bits, or (mem) the depth or width exceeds what
 // the Lattice format allows.
-std::string renderProm(const PromTable& t, PromFormat f);
+// RomPart::Segments: the piecewise kind's segment ROM (std::invalid_argument for the other kinds
+// and for csv).
+std::string renderProm(const PromTable& t, PromFormat f, RomPart part = RomPart::Prom);
+
+// Every file of a table in format f as {suffix of the PROM's path, text}: the PROM ("") and, for
+// the piecewise kind, its segment ROM (kSegRomSuffix; not for csv).
+using PromFiles = std::vector<std::pair<std::string, std::string>>;
+PromFiles renderPromFiles(const PromTable& t, PromFormat f);
+
+// The hex files the RTL loads from `path` (renderPromFiles), written together or not at all.
+void writePromHexFiles(const std::string& path, const PromTable& t);
 
 // CSV "address,n", one row per entry (n with 17 significant digits): the address map of an
 // n list, written beside the PROM as <file>.map.csv.
@@ -70,5 +88,17 @@ std::string renderProvenanceJson(const PromTable& t);
 // no underscores, no @address directives) and fit word_bits; the file must hold exactly `depth`
 // words. std::runtime_error with the path, the line number and what is wrong otherwise.
 std::vector<PromWord> readPromHex(const std::string& path, int word_bits, int depth);
+
+// The contents of a unit's memories: the PROM and, for the piecewise kind, the segment ROM
+// (empty for the other kinds).
+struct RomImage {
+  std::vector<PromWord> prom, seg;
+  static RomImage of(const PromTable& t) { return {t.words, t.seg_words}; }
+};
+// readPromHex of path and, when the unit has a segment ROM, of path + kSegRomSuffix.
+RomImage readPromHexFiles(const std::string& path, const SpecUnitParams& p);
+// "" when equal, else the first difference: "PROM word 7 is 0x..., expected 0x..." (or
+// "segment ROM ..."; or the depths).
+std::string romImageDiff(const RomImage& got, const RomImage& want, const SpecUnitParams& p);
 
 }  // namespace shd

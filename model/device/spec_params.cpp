@@ -23,7 +23,15 @@ constexpr ParamMember<SpecUnitParams> kMembers[] = {
     {"PipeStages", &SpecUnitParams::PipeStages},
     {"Kind", &SpecUnitParams::Kind, true},
     {"TableBits", &SpecUnitParams::TableBits, true},
+    {"Segments", &SpecUnitParams::Segments, true},
 };
+
+// Bits of a count up to n - 1, at least 1 (Verilog's $clog2 for n >= 2).
+int clog2(int n) {
+  int bits = 1;
+  while ((1 << bits) < n) ++bits;
+  return bits;
+}
 
 void require(bool ok, const char* param, int value, const std::string& rule) {
   if (!ok)
@@ -69,6 +77,23 @@ void validateExpLog(const SpecUnitParams& p) {
   requireModelWidth(p.CosFracBits + 1 + w.gBits(), "P = D * G");
 }
 
+void validatePiecewise(const SpecUnitParams& p) {
+  require(p.Degree >= 1 && p.Degree <= 3, "Degree", p.Degree, "must be in 1..3 for piecewise");
+  require(p.Segments == 1 || p.Segments == 2 || p.Segments == 4, "Segments", p.Segments,
+          "must be 1, 2 or 4 for piecewise");
+  require(p.PipeStages >= 1 && p.PipeStages <= p.Degree + 1, "PipeStages", p.PipeStages,
+          fmt::format("must be in 1..Degree+1 = {} for piecewise (the segment ROM's read, then one rank per "
+                      "Horner step at most)",
+                      p.Degree + 1));
+  require(p.CoefFracBits >= p.SpecFracBits, "CoefFracBits", p.CoefFracBits,
+          fmt::format("must be at least SpecFracBits = {} (f is rounded from the coefficients' fraction bits)",
+                      p.SpecFracBits));
+  require(p.segWordBits() <= 128, "CoefIntBits", p.CoefIntBits,
+          fmt::format("makes the segment ROM word {} bits, more than 128", p.segWordBits()));
+  // The Horner accumulator (Ci + Cf + 3 bits, rtl/shd_spec_piecewise.v) times u (Wc + 1 bits).
+  requireModelWidth(p.CoefIntBits + p.CoefFracBits + 3 + p.CosFracBits + 1, "the Horner product acc * u");
+}
+
 void validatePoly(const SpecUnitParams& p) {
   require(p.Degree == 2 || p.Degree == 3, "Degree", p.Degree, "must be 2 or 3");
   require(p.DiffFracBits >= 2 && p.DiffFracBits <= 2 * p.CosFracBits, "DiffFracBits", p.DiffFracBits,
@@ -106,6 +131,7 @@ const std::vector<SpecKindInfo>& specKinds() {
       {SpecKind::Table, "table", "c^n read from a table over shininess and cosine codes"},
       {SpecKind::Schlick, "schlick", "Schlick's rational c / (n - n c + c), with a divider"},
       {SpecKind::ExpLog, "explog", "c^n = 2^(n log2 c) by logarithm and exponent tables, interpolated"},
+      {SpecKind::Piecewise, "piecewise", "a minimax polynomial per cosine segment, 1, 2 or 4 segments per n"},
   };
   return kinds;
 }
@@ -121,16 +147,22 @@ int SpecUnitParams::promWordBits() const {
     case SpecKind::Table: return SpecFracBits + 1;
     case SpecKind::Schlick:
     case SpecKind::ExpLog: return coefFormat().width();
+    case SpecKind::Piecewise: return Segments * (CosFracBits + 1);
     case SpecKind::Poly: break;
   }
   return Degree == 2 ? coefFormat().width() : 2 * coefFormat().width() + CosFracBits + 1;
 }
 
+int SpecUnitParams::segAddrBits() const { return ShinBits + (Segments >= 4 ? 2 : Segments >= 2 ? 1 : 0); }
+
+int SpecUnitParams::segScaleBits() const { return clog2(CosFracBits + 1); }
+
+int SpecUnitParams::segWordBits() const { return segScaleBits() + (Degree + 1) * coefFormat().width(); }
+
 ExpLogWidths SpecUnitParams::expLogWidths() const {
   const int wf = SpecFracBits;
-  int li = 1;  // clog2(CosFracBits + 1)
-  while ((1 << li) < CosFracBits + 1) ++li;
-  return {wf + 6 + std::max(0, CoefIntBits - CosFracBits - 4), wf + CoefIntBits + 3, wf + 4, wf + 3, li};
+  return {wf + 6 + std::max(0, CoefIntBits - CosFracBits - 4), wf + CoefIntBits + 3, wf + 4, wf + 3,
+          clog2(CosFracBits + 1)};
 }
 
 int64_t SpecUnitParams::fixedRomBits() const {
@@ -159,6 +191,7 @@ void SpecUnitParams::validate() const {
     case SpecKind::Table: validateTable(*this); break;
     case SpecKind::Schlick: validateSchlick(*this); break;
     case SpecKind::ExpLog: validateExpLog(*this); break;
+    case SpecKind::Piecewise: validatePiecewise(*this); break;
   }
   requireModelWidth(LightBits + 1 + SpecFracBits, "MUL3..MUL5 f*L");
   if (promWordBits() > 128)

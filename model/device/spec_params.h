@@ -14,10 +14,10 @@ namespace shd {
 
 // The kinds of specular unit (the parameter Kind), one list: the paper's polynomial device and the
 // alternatives a designer would weigh against it (rtl/shd_spec_unit.v describes each datapath).
-enum class SpecKind { Poly = 0, Table = 1, Schlick = 2, ExpLog = 3 };
+enum class SpecKind { Poly = 0, Table = 1, Schlick = 2, ExpLog = 3, Piecewise = 4 };
 struct SpecKindInfo {
   SpecKind kind;
-  const char* name;   // "poly", "table", "schlick", "explog"
+  const char* name;   // "poly", "table", "schlick", "explog", "piecewise"
   const char* what;   // one line for tables and --help
 };
 const std::vector<SpecKindInfo>& specKinds();
@@ -36,7 +36,8 @@ struct ExpLogWidths {
 };
 
 struct SpecUnitParams {
-  int Degree = 2;           // 2: a c^2 + (1-a) c ; 3: cubic, Horner form, with cut-off
+  int Degree = 2;           // poly: 2 a c^2 + (1-a) c, 3 cubic in Horner form with cut-off;
+                            // piecewise: each segment's degree, 1..3
   int CosFracBits = 15;     // Wc: cos_i is uQ1.Wc; codes above 1.0 saturate to 1.0
   int ShinBits = 10;        // PROM address width: 2^ShinBits shininess codes
   int CoefIntBits = 10;     // Ci: coefficient uQCi.Cf (degree 2) or sQCi.Cf (degree 3)
@@ -46,16 +47,20 @@ struct SpecUnitParams {
   int SpecFracBits = 16;    // Wf: the specular value f leaves Sm2 as uQ1.Wf
   int LightBits = 8;        // light channels (k_s * L) and colour out: unorm LightBits
   int PipeStages = 1;       // internal pipeline registers (poly 0..3, table 0..1, schlick 0..Wf+1,
-                            // explog 1..3); latency = 2 + PipeStages
-  int Kind = 0;             // SpecKind: 0 poly (Degree 2 or 3), 1 table, 2 schlick, 3 explog
+                            // explog 1..3, piecewise 1..Degree+1); latency = 2 + PipeStages
+  int Kind = 0;             // SpecKind: 0 poly (Degree 2 or 3), 1 table, 2 schlick, 3 explog,
+                            // 4 piecewise
   int TableBits = 8;        // table: cosine address bits T, 1..CosFracBits; explog: the log and
                             // exp tables have 2^T intervals each, 1..min(CosFracBits, Wf+3)
+  int Segments = 1;         // piecewise: cosine segments per n, 1, 2 or 4
 
   SpecKind kind() const { return static_cast<SpecKind>(Kind); }
 
   // Derived formats (see rtl/shd_spec_unit.v for the width derivations).
   FixedFormat cosFormat() const { return FixedFormat::u(1, CosFracBits); }
-  FixedFormat coefFormat() const { return {kind() == SpecKind::Poly && Degree == 3, CoefIntBits, CoefFracBits}; }
+  FixedFormat coefFormat() const {
+    return {(kind() == SpecKind::Poly && Degree == 3) || kind() == SpecKind::Piecewise, CoefIntBits, CoefFracBits};
+  }
   FixedFormat diffFormat() const { return FixedFormat::s(1, DiffFracBits); }
   FixedFormat hornerFormat() const { return FixedFormat::s(CoefIntBits + 1, HornerFracBits); }
   FixedFormat specFormat() const { return FixedFormat::u(1, SpecFracBits); }
@@ -66,12 +71,23 @@ struct SpecUnitParams {
   int promAddrBits() const { return ShinBits + (kind() == SpecKind::Table ? TableBits : 0); }
   int promDepth() const { return 1 << promAddrBits(); }
   // PROM word: poly degree 2 {a}; poly degree 3 {cut[Wc:0], v, u} (u in the LSBs); table {f}
-  // (uQ1.Wf); schlick {m = n - 1} (uQCi.Cf, unsigned); explog {n} (uQCi.Cf, unsigned).
+  // (uQ1.Wf); schlick {m = n - 1} (uQCi.Cf, unsigned); explog {n} (uQCi.Cf, unsigned);
+  // piecewise {B_S-1, ..., B_1, B_0}, the segments' first cosine codes (uQ1.Wc; B_0 the cut).
   int promWordBits() const;
+  // The piecewise kind's segment ROM (file <RomFile>.seg), address {shin, s}: word
+  // {K_Degree, ..., K_0, e} with e the scale (segScaleBits() bits) and K_j sQCi.Cf. Depth 0 for
+  // the other kinds, which have no segment ROM.
+  int segAddrBits() const;  // ShinBits + log2(Segments)
+  int segDepth() const { return kind() == SpecKind::Piecewise ? 1 << segAddrBits() : 0; }
+  int segScaleBits() const;  // clog2(CosFracBits + 1)
+  int segWordBits() const;
   ExpLogWidths expLogWidths() const;
   // Bits of the fixed ROMs beside the PROM: the explog kind's log and exp tables, 0 otherwise.
   int64_t fixedRomBits() const;
-  int64_t promBits() const { return int64_t{promDepth()} * promWordBits(); }
+  // Bits of the memories that hold per-n contents: the PROM and the piecewise kind's segment ROM.
+  int64_t promBits() const {
+    return int64_t{promDepth()} * promWordBits() + (segDepth() > 0 ? int64_t{segDepth()} * segWordBits() : 0);
+  }
   int64_t cosOne() const { return int64_t{1} << CosFracBits; }
   int64_t lightMax() const { return (int64_t{1} << LightBits) - 1; }
 

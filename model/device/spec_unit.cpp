@@ -55,8 +55,69 @@ SpecCoef decodePromWord(PromWord word, const SpecUnitParams& p) {
   return c;
 }
 
-SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
-    : p_(params), prom_(std::move(prom)) {
+PromWord encodePiecewiseBounds(const PiecewiseCodes& q, const SpecUnitParams& p) {
+  const int cw = p.CosFracBits + 1;
+  if (q.segs.size() > static_cast<size_t>(p.Segments))
+    throw std::out_of_range(fmt::format("{} segments, the unit holds {}", q.segs.size(), p.Segments));
+  PromWord w = 0;
+  for (int j = 0; j < p.Segments; ++j) {
+    const int64_t b = j < static_cast<int>(q.segs.size()) ? q.segs[static_cast<size_t>(j)].B : p.cosOne() + 1;
+    if (b < 0 || b > p.cosOne() + 1) throw std::out_of_range(fmt::format("segment first code {} outside 0..{}", b, p.cosOne() + 1));
+    w |= static_cast<PromWord>(static_cast<uint64_t>(b)) << (j * cw);
+  }
+  return w;
+}
+
+std::vector<PromWord> encodePiecewiseSegments(const PiecewiseCodes& q, const SpecUnitParams& p) {
+  const FixedFormat cf = p.coefFormat();
+  const int eb = p.segScaleBits(), kw = cf.width();
+  std::vector<PromWord> words(static_cast<size_t>(p.Segments), PromWord{0});
+  for (size_t j = 0; j < q.segs.size() && j < words.size(); ++j) {
+    const PiecewiseCodes::Seg& g = q.segs[j];
+    if (g.e < 0 || g.e > p.CosFracBits || g.K.size() != static_cast<size_t>(p.Degree) + 1)
+      throw std::out_of_range(fmt::format("segment {}: scale {} or {} coefficients do not fit the unit", j, g.e, g.K.size()));
+    PromWord w = static_cast<uint64_t>(g.e);
+    for (size_t i = 0; i < g.K.size(); ++i) {
+      if (!cf.holds(g.K[i])) throw std::out_of_range(fmt::format("coefficient code {} outside {}", g.K[i], cf.str()));
+      w |= static_cast<PromWord>(static_cast<uint64_t>(g.K[i]) & lowMask(kw)) << (eb + static_cast<int>(i) * kw);
+    }
+    words[j] = w;
+  }
+  return words;
+}
+
+PiecewiseCodes decodePiecewise(PromWord bounds, const PromWord* segs, const SpecUnitParams& p) {
+  const int cw = p.CosFracBits + 1, eb = p.segScaleBits(), kw = p.coefFormat().width();
+  PiecewiseCodes q;
+  q.wc = p.CosFracBits;
+  q.wf = p.SpecFracBits;
+  q.kf = p.CoefFracBits;
+  for (int j = 0; j < p.Segments; ++j) {
+    PiecewiseCodes::Seg g;
+    g.B = static_cast<int64_t>(static_cast<uint64_t>(bounds >> (j * cw)) & lowMask(cw));
+    g.e = static_cast<int>(static_cast<uint64_t>(segs[j]) & lowMask(eb));
+    for (int i = 0; i <= p.Degree; ++i)
+      g.K.push_back(signExtend(static_cast<uint64_t>(segs[j] >> (eb + i * kw)) & lowMask(kw), kw));
+    if (j > 0 && g.B < q.segs.back().B)
+      throw std::invalid_argument(fmt::format("segment {} begins at cosine code {}, below segment {}'s {}", j, g.B, j - 1,
+                                              q.segs.back().B));
+    if (g.e > p.CosFracBits)
+      throw std::invalid_argument(fmt::format("segment {} has the scale {}, above CosFracBits = {}", j, g.e, p.CosFracBits));
+    q.segs.push_back(std::move(g));
+  }
+  // u = (c - B_j) 2^e must stay at most 1.0 (2^Wc) over the codes the segment is selected for.
+  for (size_t j = 0; j < q.segs.size(); ++j) {
+    const int64_t end = std::min(j + 1 < q.segs.size() ? q.segs[j + 1].B : p.cosOne() + 1, p.cosOne() + 1);
+    const int64_t last = end - 1 - q.segs[j].B;  // C - B of the segment's last code
+    if (last > 0 && (last << q.segs[j].e) > p.cosOne())
+      throw std::invalid_argument(fmt::format("segment {} (codes {}..{}) with the scale {} carries u past 1.0", j,
+                                              q.segs[j].B, end - 1, q.segs[j].e));
+  }
+  return q;
+}
+
+SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom, std::vector<PromWord> seg)
+    : p_(params), prom_(std::move(prom)), seg_(std::move(seg)) {
   p_.validate();
   if (prom_.size() != static_cast<size_t>(p_.promDepth()))
     throw std::invalid_argument(fmt::format("PROM has {} words, the unit addresses {} ({} address bits)",
@@ -71,6 +132,21 @@ SpecUnitModel::SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom)
     coef_.push_back(decodePromWord(prom_[i], p_));
   }
   if (p_.kind() == SpecKind::ExpLog) explog_ = makeExpLogTables(p_);
+  if (seg_.size() != static_cast<size_t>(p_.segDepth()))
+    throw std::invalid_argument(fmt::format("segment ROM has {} words, the unit addresses {}", seg_.size(), p_.segDepth()));
+  if (p_.kind() == SpecKind::Piecewise) {
+    const int sb = p_.segWordBits();
+    for (size_t i = 0; i < seg_.size(); ++i)
+      if (sb < 128 && (seg_[i] >> sb) != 0)
+        throw std::invalid_argument(fmt::format("segment ROM word {} has bits above its {}-bit width", i, sb));
+    for (size_t a = 0; a < prom_.size(); ++a) {
+      try {
+        pieces_.push_back(decodePiecewise(prom_[a], &seg_[a * static_cast<size_t>(p_.Segments)], p_));
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument(fmt::format("PROM address {}: {}", a, e.what()));
+      }
+    }
+  }
   reset();
 }
 
@@ -90,6 +166,7 @@ int64_t SpecUnitModel::altSpec(uint32_t shin, int64_t c) const {
   if (p_.kind() == SpecKind::Table)  // one ROM read at {shin, index}
     return static_cast<int64_t>(prom_[(static_cast<size_t>(shin) << p_.TableBits) | static_cast<size_t>(tableIndex(c))]);
   if (p_.kind() == SpecKind::ExpLog) return expLogSpec(p_, explog_, coef_[shin].u, c);
+  if (p_.kind() == SpecKind::Piecewise) return pieces_[shin].eval(c);
   // Schlick: f = floor(c 2^(Cf+Wf) / (m (1 - c) + 1)), den >= 1 and f <= 1 (rtl/shd_spec_schlick.v).
   const int wc = p_.CosFracBits, cf = p_.CoefFracBits;
   const int64_t den = coef_[shin].u * ((int64_t{1} << wc) - c) + (int64_t{1} << (cf + wc));

@@ -16,6 +16,11 @@
 //                   PROM[shin]: c / (n - n c + c) truncated to uQ1.Wf (a restoring divider)
 // The explog kind:  f = 2^(-n L), L = -log2 c, n from PROM[shin], both by interpolated tables
 //                   (device/spec_explog.h)
+// The piecewise kind: PROM[shin] holds the segments' first codes B_0 (the cut) .. B_S-1; the
+//                   segment s = #{j >= 1 : c >= B_j} selects the segment ROM's word {K, e} at
+//                   {shin, s}; f = Horner's scheme in u = (c - B_s) 2^e / 2^Wc with floors,
+//                   rounded half up to Wf bits and clamped to [0, 1]; 0 below B_0
+//                   (approx/piecewise.h PiecewiseCodes::eval, rtl/shd_spec_piecewise.v)
 // Every kind ends in the same MUL3..MUL5.
 // Pipeline: registered inputs and PROM read (cycle 1), PipeStages optional registers, registered
 // outputs; latency 2 + PipeStages, one result per cycle. The output registers load only when
@@ -26,6 +31,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "approx/piecewise.h"
 #include "device/spec_explog.h"
 #include "device/spec_params.h"
 #include "fixed/fixed.h"
@@ -44,6 +50,15 @@ struct SpecCoef {
 };
 PromWord encodePromWord(const SpecCoef& coef, const SpecUnitParams& p);
 SpecCoef decodePromWord(PromWord word, const SpecUnitParams& p);
+
+// The piecewise kind's words for one shininess code: the PROM word of the first codes (unused
+// segments above the fit's get B = 2^Wc + 1, which no cosine reaches) and the Segments words of
+// the segment ROM (unused: 0). std::out_of_range if a code does not fit its field.
+PromWord encodePiecewiseBounds(const PiecewiseCodes& q, const SpecUnitParams& p);
+std::vector<PromWord> encodePiecewiseSegments(const PiecewiseCodes& q, const SpecUnitParams& p);
+// The codes of one shininess code back from its PROM word and its Segments segment ROM words;
+// std::invalid_argument if the words are not well formed (see SpecUnitModel).
+PiecewiseCodes decodePiecewise(PromWord bounds, const PromWord* segs, const SpecUnitParams& p);
 
 struct SpecIn {
   bool valid = false;
@@ -71,12 +86,15 @@ struct SpecTrace {
 
 class SpecUnitModel {
  public:
-  // prom holds promDepth() words; std::invalid_argument if not, or if a word has bits above
-  // promWordBits() (the table kind: a word above 1.0).
-  SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom);
+  // prom holds promDepth() words and seg (the piecewise kind's segment ROM) segDepth() words;
+  // std::invalid_argument if not, or if a word has bits above its width (the table kind: a
+  // word above 1.0; the piecewise kind: first codes that decrease, a scale above CosFracBits or
+  // one that would carry u past 1.0 in its segment).
+  SpecUnitModel(SpecUnitParams params, std::vector<PromWord> prom, std::vector<PromWord> seg = {});
 
   const SpecUnitParams& params() const { return p_; }
   const std::vector<PromWord>& prom() const { return prom_; }
+  const std::vector<PromWord>& segRom() const { return seg_; }
 
   // The combinational function the pipeline delivers latency() cycles later, on raw integers
   // (the fast path the co-simulation runs). Inputs must fit their ports (std::out_of_range).
@@ -104,6 +122,8 @@ class SpecUnitModel {
   std::vector<PromWord> prom_;
   std::vector<SpecCoef> coef_;  // decoded prom_
   ExpLogTables explog_;         // the explog kind's fixed tables
+  std::vector<PromWord> seg_;   // the piecewise kind's segment ROM
+  std::vector<PiecewiseCodes> pieces_;  // decoded per shininess code
   std::vector<Stage> pipe_;     // ring buffer, latency() entries
   size_t head_ = 0;
   SpecOut out_;

@@ -110,7 +110,7 @@ inline uint64_t batchCycles(size_t n, int latency) { return n == 0 ? 0 : n + sta
 
 class ModelSpecEngine final : public SpecEngine {
  public:
-  explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words), memo_(unit_) {}
+  explicit ModelSpecEngine(PromTable t) : t_(std::move(t)), unit_(t_.unit, t_.words, t_.seg_words), memo_(unit_) {}
   ModelSpecEngine(const ModelSpecEngine&) = delete;  // memo_ refers to unit_
   ModelSpecEngine& operator=(const ModelSpecEngine&) = delete;
   const PromTable& table() const override { return t_; }

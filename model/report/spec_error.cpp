@@ -27,7 +27,7 @@ SpecErrorReport computeSpecError(const std::string& config, const PromTable& tab
   r.config = config;
   r.table = table;
   const SpecUnitParams& p = table.unit;
-  const SpecUnitModel model(p, table.words);
+  const SpecUnitModel model(p, table.words, table.seg_words);
   const double out_scale = static_cast<double>(p.lightMax());
   const uint32_t lmax = static_cast<uint32_t>(p.lightMax());
   const double f_lsb = std::ldexp(1.0, -p.SpecFracBits);
@@ -164,6 +164,9 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
       : p.kind() == SpecKind::Schlick
           ? fmt::format("Schlick's rational with a divider, cos uQ1.{}, m = n - 1 {}", p.CosFracBits,
                         p.coefFormat().str())
+      : p.kind() == SpecKind::Piecewise
+          ? fmt::format("{} segments of degree {} per n, cos uQ1.{}, coefficients {}", p.Segments, p.Degree,
+                        p.CosFracBits, p.coefFormat().str())
           : fmt::format("2^(n log2 c) by log and exp tables of 2^{} intervals, cos uQ1.{}, n {}", p.TableBits,
                         p.CosFracBits, p.coefFormat().str());
   std::string out = fmt::format(
@@ -202,7 +205,7 @@ std::string renderSpecErrorTable(const SpecErrorReport& primary, const SpecError
         s.total_max_lsb.value, s.total_max_lsb.n, s.total_peak_max_lsb.value, s.total_peak_max_lsb.n, r->seconds);
   }
   out +=
-      "Columns: coef = a (degree 2), a1 (degree 3), m = n - 1 (schlick), n (explog), nan (table); lobe = c in [0,1]; peak = c^n >= 0.5; infl = c from the "
+      "Columns: coef = a (degree 2), a1 (degree 3), m = n - 1 (schlick), n (explog), nan (table, piecewise); lobe = c in [0,1]; peak = c^n >= 0.5; infl = c from the "
       "inflection point to 1;\n"
       "dp = datapath vs ideal device (LSB of the output, fLSB of f = spec_o); tot = unit vs cos^n; peak LSB = tot "
       "where c^n >= 0.5.\n";

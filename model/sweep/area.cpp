@@ -105,11 +105,13 @@ namespace {
 // being "python3 <script> <configuration file> --unit <unit> [--prom <file>]" in a private
 // directory `tmp` of the cache (removed after).
 nlohmann::json cachedUnitRun(const std::string& stem, const std::string& member, const std::string& unit,
-                             const nlohmann::json& rtl, const std::string& prom, const nlohmann::json& prom_desc,
+                             const nlohmann::json& rtl, const PromFiles& prom, const nlohmann::json& prom_desc,
                              const std::string& script, const std::string& cache_dir, const std::string& tools,
                              const std::string& what,
                              const std::function<nlohmann::json(std::vector<std::string>, const fs::path&)>& produce) {
-  const std::string key = textHash(fmt::format("{} {} {} {} {}", unit, rtl.dump(), what, tools, prom));
+  std::string prom_text;  // every file's text (one file: the key the caches had before the segment ROM)
+  for (const auto& f : prom) prom_text += f.second;
+  const std::string key = textHash(fmt::format("{} {} {} {} {}", unit, rtl.dump(), what, tools, prom_text));
   const fs::path cached = fs::path(cache_dir) / fmt::format("{}-{}.json", stem, key);
   std::error_code ec;
   if (fs::is_regular_file(cached, ec)) {
@@ -127,7 +129,7 @@ nlohmann::json cachedUnitRun(const std::string& stem, const std::string& member,
   if (unit == "spec") {
     cfg["prom"] = prom_desc;
     const std::string hex = (tmp / "spec_sweep.hex").string();
-    writeFileAtomic(hex, prom);
+    for (const auto& [suffix, text] : prom) writeFileAtomic(hex + suffix, text);
     argv.insert(argv.end(), {"--prom", hex});
   }
   writeFileAtomic(cfg_file, cfg.dump(2) + "\n");
@@ -156,7 +158,7 @@ nlohmann::json deviceFigures(const nlohmann::json& d, const std::string& flow) {
 
 }  // namespace
 
-nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const PromFiles& prom,
                              const nlohmann::json& prom_desc, const SynthTool& tool) {
   // The stem and key as before the place and route was added: existing caches stay valid.
   return cachedUnitRun(unit, "area", unit, rtl, prom, prom_desc, tool.script, tool.cache_dir, tool.version,
@@ -183,7 +185,7 @@ std::string pnrToolVersion(const std::string& script) {
   return synthToolVersion(synth) + " " + v + " pnr " + textHash(readInputFile(script, kMaxAreaFileBytes));
 }
 
-nlohmann::json unitPointPnr(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+nlohmann::json unitPointPnr(const std::string& unit, const nlohmann::json& rtl, const PromFiles& prom,
                             const nlohmann::json& prom_desc, const PnrTool& tool) {
   return cachedUnitRun(
       unit + "-pnr", "pnr", unit, rtl, prom, prom_desc, tool.script, tool.cache_dir, tool.version, "up5k hx8k-nodsp",
@@ -233,11 +235,11 @@ nlohmann::json promDesc(const PromTable& table) {
 }  // namespace
 
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool) {
-  return unitPointArea("spec", table.unit.toJson(), renderProm(table, PromFormat::Hex), promDesc(table), tool);
+  return unitPointArea("spec", table.unit.toJson(), renderPromFiles(table, PromFormat::Hex), promDesc(table), tool);
 }
 
 nlohmann::json specPointPnr(const PromTable& table, const PnrTool& tool) {
-  return unitPointPnr("spec", table.unit.toJson(), renderProm(table, PromFormat::Hex), promDesc(table), tool);
+  return unitPointPnr("spec", table.unit.toJson(), renderPromFiles(table, PromFormat::Hex), promDesc(table), tool);
 }
 
 }  // namespace shd

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "device/prom.h"
+#include "device/prom_io.h"
 
 namespace shd {
 
@@ -32,11 +33,12 @@ std::string findShareFile(const std::string& relative);
 
 // {"<target>": {"luts", "ffs", "carries", "dsps", "brams", "bram_kbits", "cells"}} of the
 // configuration {"rtl": rtl} of `unit` ("spec" or "span"); a specular unit's also `prom`, its
-// PROM ($readmemh text) and `prom_desc`, the configuration's "prom" member. From the cache when
+// PROM files ($readmemh texts by suffix, renderPromFiles: the piecewise kind's segment ROM too)
+// and `prom_desc`, the configuration's "prom" member. From the cache when
 // it holds the key; otherwise synthesised (in a temporary directory inside the cache, removed
 // after) and cached. std::runtime_error naming the point's hash, with the end of synth.py's
 // output, when it fails.
-nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+nlohmann::json unitPointArea(const std::string& unit, const nlohmann::json& rtl, const PromFiles& prom,
                              const nlohmann::json& prom_desc, const SynthTool& tool);
 
 // Per point (`rtl`, the parameters of each), the DSP count each of the tool's targets maps its
@@ -76,7 +78,7 @@ const std::vector<PnrDevice>& pnrDevices();
 // entry (pnr.py's summary, docs/place-and-route.md; fmax_mhz and fmax_kind null and why_not set
 // when it does not fit). Arguments and cache as unitPointArea; std::runtime_error when pnr.py
 // fails (not fitting is a result, not a failure).
-nlohmann::json unitPointPnr(const std::string& unit, const nlohmann::json& rtl, const std::string& prom,
+nlohmann::json unitPointPnr(const std::string& unit, const nlohmann::json& rtl, const PromFiles& prom,
                             const nlohmann::json& prom_desc, const PnrTool& tool);
 nlohmann::json specPointPnr(const PromTable& table, const PnrTool& tool);
 

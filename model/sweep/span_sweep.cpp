@@ -604,7 +604,7 @@ SweepUnit spanSweepUnit(const nlohmann::json& base_json) {
     return evaluateSpanPoint(index, pointOf(b, values, "point " + describePoint(values)), b, *scenes);
   };
   u.area = [b](const PointValues& values, const SynthTool& tool) {
-    return unitPointArea("span", pointOf(b, values, "point " + describePoint(values)).rtl.toJson(), "",
+    return unitPointArea("span", pointOf(b, values, "point " + describePoint(values)).rtl.toJson(), {},
                          nlohmann::json::object(), tool);
   };
   u.rtl = [b](const PointValues& values) { return pointOf(b, values, "point " + describePoint(values)).rtl.toJson(); };

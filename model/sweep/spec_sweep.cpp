@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <set>
-#include <tuple>
 
 #include <fmt/format.h>
 
@@ -102,12 +101,11 @@ SweepUnit specSweepUnit(const nlohmann::json& base_json) {
   u.front_error = "datapath_max_lsb";
   u.front_costs = {"latency", "rom_bits"};
   u.validate = [base, req](const Grid& grid) {
-    std::set<std::tuple<int, int, int, int, int>> tables;  // the coefficient formats built
+    std::set<std::string> tables;  // the parameter sets whose PROM was built
     for (uint64_t k = 0; k < grid.size(); ++k) {
       const PointValues values = grid.point(k);
       const SpecUnitParams p = specPointParams(base, values);
-      if (!tables.insert(std::make_tuple(p.Degree, p.CosFracBits, p.ShinBits, p.CoefIntBits, p.CoefFracBits)).second)
-        continue;
+      if (!tables.insert(p.toJson().dump()).second) continue;
       try {
         buildPromTable(req, p);
       } catch (const std::invalid_argument& e) {
@@ -132,7 +130,7 @@ SweepUnit specSweepUnit(const nlohmann::json& base_json) {
   // inputs' formats and the PROM's depth), PipeStages and Degree no widths. Each kind has its
   // own: HornerFracBits only at degree 3 (the quadratic unit has no Horner step); the other kinds
   // use neither DiffFracBits nor HornerFracBits, and TableBits is the resolution of the table's
-  // and explog's tables.
+  // and explog's tables (Segments, like Degree, shapes the piecewise unit rather than a width).
   switch (base.kind()) {
     case SpecKind::Poly:
       u.widths = {"CoefIntBits", "CoefFracBits", "DiffFracBits", "SpecFracBits"};
@@ -141,6 +139,7 @@ SweepUnit specSweepUnit(const nlohmann::json& base_json) {
     case SpecKind::Table: u.widths = {"SpecFracBits", "TableBits"}; break;
     case SpecKind::Schlick: u.widths = {"CoefIntBits", "CoefFracBits", "SpecFracBits"}; break;
     case SpecKind::ExpLog: u.widths = {"CoefIntBits", "CoefFracBits", "SpecFracBits", "TableBits"}; break;
+    case SpecKind::Piecewise: u.widths = {"CoefIntBits", "CoefFracBits", "SpecFracBits"}; break;
   }
   return u;
 }

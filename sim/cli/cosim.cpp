@@ -147,10 +147,10 @@ int CosimCmd::runSpec() {
     tmp_dir = fs::temp_directory_path() / fmt::format("shadesim-{}", getpid());
     fs::create_directories(tmp_dir);
     prom_path = (tmp_dir / fmt::format("spec_{}.hex", cfg.name)).string();
-    writeFileAtomic(prom_path, renderProm(t, PromFormat::Hex));
+    writePromHexFiles(prom_path, t);
   }
   prom_path = fs::absolute(prom_path).string();
-  SpecUnitModel model(t.unit, t.words);
+  SpecUnitModel model(t.unit, t.words, t.seg_words);
   std::unique_ptr<SpecStimulus> stim;
   if (exhaustive_) stim = std::make_unique<ExhaustiveSpecStimulus>(t.unit, seed_);
   else stim = std::make_unique<RandomSpecStimulus>(t.unit, seed_, vectors_, gap_);

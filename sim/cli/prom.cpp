@@ -19,7 +19,8 @@ class PromCmd final : public Command {
         ->required()
         ->check(CLI::IsMember({"hex", "mem", "coe", "mif", "csv"}));
     app.add_option("-o,--output", output_, "output file (default stdout); with --n-list also <file>.map.csv, "
-                                           "with csv also <file>.json (provenance)");
+                                           "with csv also <file>.json (provenance), for the piecewise kind "
+                                           "also <file>.seg (its segment ROM)");
   }
 
   int run(const CLI::App& app) override {
@@ -27,19 +28,25 @@ class PromCmd final : public Command {
     const PromTable t = table_.build(cfg, app.count("--config") == 0);
     const PromFormat f = parsePromFormat(format_);
     // Render everything first, then write: an error leaves no file behind.
-    const std::string body = renderProm(t, f);
+    const auto bodies = renderPromFiles(t, f);
     const std::string map = t.request.n.is_list ? renderAddressMap(t) : "";
     const std::string side = f == PromFormat::Csv ? renderProvenanceJson(t) : "";
     if (output_.empty() || output_ == "-") {
-      std::fwrite(body.data(), 1, body.size(), stdout);
+      if (bodies.size() > 1)
+        throw std::invalid_argument(fmt::format("the {} kind has a segment ROM beside the PROM: name the files with -o",
+                                                specKindInfo(t.unit.kind()).name));
+      std::fwrite(bodies[0].second.data(), 1, bodies[0].second.size(), stdout);
     } else {
       OutputFiles files;  // the table and its sidecars together, or none of them
-      files.add(output_, body);
+      for (const auto& [suffix, body] : bodies) files.add(output_ + suffix, body);
       if (!map.empty()) files.add(output_ + ".map.csv", map);
       if (!side.empty()) files.add(output_ + ".json", side);
       files.commit();
       std::fprintf(stderr, "wrote %s: %zu codes, %d words of %d bits (%s)\n", output_.c_str(), t.entries.size(),
                    t.unit.promDepth(), t.unit.promWordBits(), t.request.describe().c_str());
+      if (t.unit.segDepth() > 0 && f != PromFormat::Csv)
+        std::fprintf(stderr, "wrote %s%s: the segment ROM, %d words of %d bits\n", output_.c_str(), kSegRomSuffix,
+                     t.unit.segDepth(), t.unit.segWordBits());
     }
     return 0;
   }

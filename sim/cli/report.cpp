@@ -329,10 +329,10 @@ json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measur
     const json rtl = c.rtl.toJson();
     if (hw.synth)
       area_jobs.push_back({"span", c.name, "area", "area of " + what,
-                      [rtl, t = *hw.synth] { return unitPointArea("span", rtl, "", json::object(), t); }});
+                      [rtl, t = *hw.synth] { return unitPointArea("span", rtl, {}, json::object(), t); }});
     if (hw.pnr)
       jobs.push_back({"span", c.name, "pnr", "place and route of " + what,
-                      [rtl, t = *hw.pnr] { return unitPointPnr("span", rtl, "", json::object(), t); }});
+                      [rtl, t = *hw.pnr] { return unitPointPnr("span", rtl, {}, json::object(), t); }});
   }
   // The specular configurations a row may name, each with the lobe group it evaluates.
   std::vector<std::pair<SpecUnitConfig, std::string>> spec = {{lobes.load(Lobe::Quadratic), toString(Lobe::Quadratic)},

@@ -103,13 +103,13 @@ RtlSpecEngine::RtlSpecEngine(const SpecUnitConfig& config, PromTable table, cons
     : config_(config.name),
       fail_dir_(std::move(fail_dir)),
       t_(std::move(table)),
-      model_(t_.unit, model_words ? *model_words : t_.words) {
+      model_(t_.unit, model_words ? *model_words : t_.words, t_.seg_words) {
   if (t_.unit.toJson() != config.rtl.toJson())
     throw std::invalid_argument(fmt::format("RtlSpecEngine: the table's unit {} is not configuration {}'s {}",
                                             t_.unit.toJson().dump(), config.name, config.rtl.toJson().dump()));
-  writeFileAtomic(prom_path, renderProm(t_, PromFormat::Hex));
+  writePromHexFiles(prom_path, t_);
   dut_ = makeSpecDut(config, SpecDutOptions{prom_path, ""});
-  verifyLoadedProm(*dut_, t_.words, prom_path, t_.unit);
+  verifyLoadedProm(*dut_, RomImage::of(t_), prom_path, t_.unit);
   dut_->reset();
 }
 
@@ -139,13 +139,13 @@ uint64_t RtlSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector
         const std::string vec = fmt::format("{}/render_spec_{}_fail.vec", fail_dir_, config_);
         const std::string fst = fmt::format("{}/render_spec_{}_fail.fst", fail_dir_, config_);
         const std::string hex = fmt::format("{}/render_spec_{}_fail.hex", fail_dir_, config_);
-        writeFileAtomic(hex, renderProm(t_, PromFormat::Hex));
+        writePromHexFiles(hex, t_);
         SpecVectors sv;
         sv.config = config_;
         sv.params = t_.unit;
         sv.prom = fs::path(hex).filename().string();
         sv.source = "shadesim render --rtl: the specular request the RTL and the model disagree on, alone, from reset";
-        SpecUnitModel replay(t_.unit, model_.prom());
+        SpecUnitModel replay(t_.unit, model_.prom(), model_.segRom());
         for (int c = 0; c < t_.unit.latency(); ++c) {
           SpecIn si;
           if (c == 0) si = {true, r.shin, r.cos, r.light};

@@ -73,7 +73,7 @@ ReplayResult replaySpec(const std::string& path, const ReplayOptions& opts) {
   std::string prom = opts.prom_path.empty() ? v.prom : opts.prom_path;
   if (opts.prom_path.empty() && fs::path(prom).is_relative()) prom = (fs::absolute(path).parent_path() / prom).string();
   prom = fs::absolute(prom).lexically_normal().string();
-  const std::vector<PromWord> words = readPromHex(prom, p.promWordBits(), p.promDepth());
+  const RomImage words = readPromHexFiles(prom, p);
   // Every input is read: the waveform (written as it runs, not atomically) may replace none.
   if (!opts.fst_path.empty()) outputTarget(opts.fst_path);
   auto dut = makeSpecDut(v.config, SpecDutOptions{prom, opts.fst_path});

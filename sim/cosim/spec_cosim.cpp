@@ -27,17 +27,12 @@ std::string SpecMismatch::describe(const SpecUnitParams& p) const {
   return fmt::format("cycle {}: input {}\n  model: {}\n  rtl:   {}", cycle, in, out(expected), out(got));
 }
 
-void verifyLoadedProm(SpecDut& dut, const std::vector<PromWord>& expected, const std::string& prom_path,
-                      const SpecUnitParams& p) {
-  const std::vector<PromWord> got = dut.romWords();
-  if (got.size() != expected.size())
-    throw std::runtime_error(fmt::format("PROM depth {} in the RTL, {} expected", got.size(), expected.size()));
-  for (size_t i = 0; i < got.size(); ++i)
-    if (got[i] != expected[i])
-      throw std::runtime_error(fmt::format(
-          "the simulator loaded PROM word {} = 0x{} from {}, the table holds 0x{}: the PROM file is missing, "
-          "short, corrupt or made for another fit",
-          i, hexWord(got[i], p.promWordBits()), prom_path, hexWord(expected[i], p.promWordBits())));
+void verifyLoadedProm(SpecDut& dut, const RomImage& expected, const std::string& prom_path, const SpecUnitParams& p) {
+  const std::string d = romImageDiff({dut.romWords(), dut.segRomWords()}, expected, p);
+  if (!d.empty())
+    throw std::runtime_error(fmt::format("the simulator loaded from {}: {}: the PROM file is missing, short, corrupt or "
+                                         "made for another fit",
+                                         prom_path, d));
 }
 
 SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, SpecStimulus& stim,
@@ -47,15 +42,14 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
   res.config = config;
   // The file first (strict parse: clear messages for missing, short or corrupt files), then
   // what the simulator made of it.
-  const std::vector<PromWord> file_words = readPromHex(opts.prom_path, p.promWordBits(), p.promDepth());
-  for (size_t i = 0; i < file_words.size(); ++i)
-    if (file_words[i] != model.prom()[i])
-      throw std::runtime_error(fmt::format("PROM file {} holds word {} = 0x{}, the model's table 0x{}: the file is "
-                                           "corrupt or made for another fit or format",
-                                           opts.prom_path, i, hexWord(file_words[i], p.promWordBits()),
-                                           hexWord(model.prom()[i], p.promWordBits())));
+  const RomImage want{model.prom(), model.segRom()};
+  const std::string d = romImageDiff(readPromHexFiles(opts.prom_path, p), want, p);
+  if (!d.empty())
+    throw std::runtime_error(fmt::format("PROM file {}: {} (the model's table): the file is corrupt or made for another "
+                                         "fit or format",
+                                         opts.prom_path, d));
   auto dut = makeSpecDut(config, SpecDutOptions{opts.prom_path, ""});
-  verifyLoadedProm(*dut, model.prom(), opts.prom_path, p);
+  verifyLoadedProm(*dut, want, opts.prom_path, p);
 
   const size_t window = static_cast<size_t>(p.latency()) + 8;
   std::vector<SpecIn> history(window);  // ring: the inputs of the last `window` cycles
@@ -111,7 +105,7 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
     res.vector_path = fmt::format("{}/spec_{}_fail.vec", opts.fail_dir, config);
     res.prom_copy_path = fmt::format("{}/spec_{}_fail.hex", opts.fail_dir, config);
     auto traced = makeSpecDut(config, SpecDutOptions{opts.prom_path, res.fst_path});
-    SpecUnitModel replay(p, model.prom());
+    SpecUnitModel replay(p, model.prom(), model.segRom());
     traced->reset();
     SpecVectors v;
     v.config = config;
@@ -128,10 +122,14 @@ SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, Sp
     }
     traced->finish();
     // The PROM the simulator loaded (the run's file may be a temporary one), then the vectors.
-    std::ifstream prom_in(opts.prom_path, std::ios::binary);
-    if (!prom_in) throw std::runtime_error(fmt::format("cannot read back PROM file {}", opts.prom_path));
-    const std::string prom_text((std::istreambuf_iterator<char>(prom_in)), std::istreambuf_iterator<char>());
-    writeFileAtomic(res.prom_copy_path, prom_text);
+    for (const char* suffix : {"", kSegRomSuffix}) {
+      if (*suffix != '\0' && p.segDepth() == 0) continue;
+      const std::string from = opts.prom_path + suffix;
+      std::ifstream prom_in(from, std::ios::binary);
+      if (!prom_in) throw std::runtime_error(fmt::format("cannot read back PROM file {}", from));
+      const std::string prom_text((std::istreambuf_iterator<char>(prom_in)), std::istreambuf_iterator<char>());
+      writeFileAtomic(res.prom_copy_path + suffix, prom_text);
+    }
     writeSpecVectors(res.vector_path, v);
   }
   return res;

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "device/prom.h"
+#include "device/prom_io.h"
 #include "device/spec_stimulus.h"
 #include "device/spec_unit.h"
 #include "harness/spec_dut.h"
@@ -56,8 +57,7 @@ struct SpecCosimResult {
 
 // Compares the words the simulator loaded with `expected`; throws std::runtime_error naming the
 // first differing address, both words and the file.
-void verifyLoadedProm(SpecDut& dut, const std::vector<PromWord>& expected, const std::string& prom_path,
-                      const SpecUnitParams& p);
+void verifyLoadedProm(SpecDut& dut, const RomImage& expected, const std::string& prom_path, const SpecUnitParams& p);
 
 SpecCosimResult runSpecCosim(const std::string& config, SpecUnitModel& model, SpecStimulus& stim,
                              const SpecCosimOptions& opts);

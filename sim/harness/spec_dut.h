@@ -28,6 +28,8 @@ class SpecDut {
   virtual SpecOut tick(const SpecIn& in) = 0;
   // The words the simulator loaded into the PROM (read through a public signal).
   virtual std::vector<PromWord> romWords() = 0;
+  // The piecewise kind's segment ROM as loaded (empty for the other kinds).
+  virtual std::vector<PromWord> segRomWords() = 0;
   virtual uint64_t cycle() const = 0;
   // Runs final blocks and closes the waveform. Called by the destructor too.
   virtual void finish() = 0;

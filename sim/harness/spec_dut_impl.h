@@ -14,11 +14,14 @@
 
 namespace shd {
 
+// SegRom reads the segment ROM of a piecewise model (a generated function: the signal exists in
+// those models only).
 template <class V>
 class SpecDutImpl final : public SpecDut {
  public:
-  SpecDutImpl(std::string name, const SpecDutOptions& opts)
-      : name_(std::move(name)), h_({"+prom=" + opts.prom_path}, opts.fst_path) {
+  using SegRom = std::vector<PromWord> (*)(const V&);
+  SpecDutImpl(std::string name, const SpecDutOptions& opts, SegRom seg_rom)
+      : name_(std::move(name)), h_({"+prom=" + opts.prom_path}, opts.fst_path), seg_rom_(seg_rom) {
     h_.dut().valid_i = 0;
     h_.settle();
   }
@@ -51,6 +54,7 @@ class SpecDutImpl final : public SpecDut {
   }
 
   std::vector<PromWord> romWords() override { return ports::romWords(h_.dut().rootp->shd_spec_unit__DOT__u_rom__DOT__rom); }
+  std::vector<PromWord> segRomWords() override { return seg_rom_(h_.dut()); }
 
   uint64_t cycle() const override { return h_.cycle(); }
   void finish() override { h_.finish(); }
@@ -58,6 +62,7 @@ class SpecDutImpl final : public SpecDut {
  private:
   std::string name_;
   VerilatedHarness<V> h_;
+  SegRom seg_rom_;
 };
 
 }  // namespace shd

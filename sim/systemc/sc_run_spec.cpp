@@ -72,33 +72,29 @@ std::string promFile(const ScOptions& o, const SpecVectors* file, const PromTabl
     return (p.is_absolute() ? p : fs::absolute(o.vector_file).parent_path() / p).lexically_normal().string();
   }
   temp.path = (fs::temp_directory_path() / fmt::format("shadesim_systemc-{}-spec_{}.hex", getpid(), o.config)).string();
-  writeFileAtomic(temp.path, renderProm(table, PromFormat::Hex));
+  writePromHexFiles(temp.path, table);
   return temp.path;
 }
 
 // The PROM must hold the configuration's table: the file first, strictly (the simulators only
 // warn about a missing or short file) ...
 void checkPromFile(const ScOptions& o, const std::string& prom, const SpecUnitConfig& cfg, const PromTable& table) {
-  std::vector<PromWord> file_words;
+  RomImage file_words;
   try {
-    file_words = readPromHex(prom, cfg.rtl.promWordBits(), cfg.rtl.promDepth());
+    file_words = readPromHexFiles(prom, cfg.rtl);
   } catch (const std::exception& e) {
     throw ArgError(fmt::format("PROM: {}", e.what()));
   }
-  for (size_t i = 0; i < file_words.size(); ++i)
-    if (file_words[i] != table.words[i])
-      throw ArgError(fmt::format("PROM {}: word {} is 0x{}, the table of configuration {} ({}) holds 0x{}", prom, i,
-                                 hexWord(file_words[i], cfg.rtl.promWordBits()), o.config, table.request.describe(),
-                                 hexWord(table.words[i], cfg.rtl.promWordBits())));
+  const std::string d = romImageDiff(file_words, RomImage::of(table), cfg.rtl);
+  if (!d.empty())
+    throw ArgError(fmt::format("PROM {}: {} (the table of configuration {}, {})", prom, d, o.config,
+                               table.request.describe()));
 }
 
 // ... then what the simulator loaded from it (once the model has evaluated).
 void checkLoadedProm(const SpecRtl& rtl, const std::string& prom, const SpecUnitParams& p, const PromTable& table) {
-  const std::vector<PromWord> loaded = rtl.romWords();
-  for (size_t i = 0; i < loaded.size(); ++i)
-    if (loaded[i] != table.words[i])
-      throw ArgError(fmt::format("the simulator loaded PROM word {} = 0x{} from {}, the table holds 0x{}", i,
-                                 hexWord(loaded[i], p.promWordBits()), prom, hexWord(table.words[i], p.promWordBits())));
+  const std::string d = romImageDiff({rtl.romWords(), rtl.segRomWords()}, RomImage::of(table), p);
+  if (!d.empty()) throw ArgError(fmt::format("the simulator loaded from {}: {} (the table's)", prom, d));
 }
 
 // The verilated configuration, which loads the PROM file prom; checked against the
@@ -222,7 +218,7 @@ void saveSpecVectors(const ScOptions& o, const SpecUnitParams& p, const PromTabl
   OutputFiles out;  // the file and the PROM kept beside it: both or neither
   if (temp_prom) {
     const std::string kept = o.save_vectors + ".hex";
-    out.add(kept, renderProm(table, PromFormat::Hex));
+    for (const auto& [suffix, text] : renderPromFiles(table, PromFormat::Hex)) out.add(kept + suffix, text);
     v.prom = fs::path(kept).filename().string();
   }
   v.source = savedVectorsSource(o);
@@ -332,7 +328,7 @@ ScReport runSpecSc(const ScOptions& o, sc_core::sc_clock& clk, sc_core::sc_signa
 
   ScWaveform wave(o.fst);  // before the model
   const std::unique_ptr<SpecRtl> rtl = makeRtl(o, cfg, prom);
-  SpecUnitModel model(modelParams(o, cfg.rtl), table.words);
+  SpecUnitModel model(modelParams(o, cfg.rtl), table.words, table.seg_words);
   std::unique_ptr<SpecSource> src;
   if (file) src = std::make_unique<FileSpecSource>(*file);
   else src = std::make_unique<RandomSpecSource>(cfg.rtl, o.seed, o.vectors, o.gap);

@@ -30,6 +30,8 @@ class SpecRtl : public sc_core::sc_module {
   // The words the simulator loaded into the PROM (a public signal); valid once the model has
   // evaluated (after sc_start(SC_ZERO_TIME)).
   virtual std::vector<PromWord> romWords() const = 0;
+  // The piecewise kind's segment ROM as loaded (empty for the other kinds).
+  virtual std::vector<PromWord> segRomWords() const = 0;
   // All signals of the model into an FST file (opened after elaboration by the caller).
   virtual void traceFst(VerilatedFstC& tfp, int levels) = 0;
   virtual void finalize() = 0;  // final blocks

@@ -13,13 +13,16 @@
 
 namespace shd {
 
+// SegRom reads the segment ROM of a piecewise model (a generated function: the signal exists in
+// those models only).
 template <class V>
 class SpecRtlImpl final : public SpecRtl {
  public:
+  using SegRom = std::vector<PromWord> (*)(const V&);
   // name by value: the sc_module_name must live until the model below is constructed, so that
   // it becomes a child of this module.
-  SpecRtlImpl(sc_core::sc_module_name name, std::string config, const SpecUnitParams& p)
-      : SpecRtl(name), config_(std::move(config)), p_(p), dut_("dut") {
+  SpecRtlImpl(sc_core::sc_module_name name, std::string config, const SpecUnitParams& p, SegRom seg_rom)
+      : SpecRtl(name), config_(std::move(config)), p_(p), seg_rom_(seg_rom), dut_("dut") {
     dut_.clk_i(clk_i);
     dut_.rst_ni(rst_ni);
     dut_.valid_i(valid_i);
@@ -40,12 +43,14 @@ class SpecRtlImpl final : public SpecRtl {
   std::vector<PromWord> romWords() const override {
     return ports::romWords(dut_.rootp->shd_spec_unit__DOT__u_rom__DOT__rom);
   }
+  std::vector<PromWord> segRomWords() const override { return seg_rom_(dut_); }
   void traceFst(VerilatedFstC& tfp, int levels) override { dut_.trace(&tfp, levels); }
   void finalize() override { dut_.final(); }
 
  private:
   std::string config_;
   SpecUnitParams p_;
+  SegRom seg_rom_;
   V dut_;
 };
 

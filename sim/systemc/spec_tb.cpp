@@ -147,7 +147,7 @@ std::vector<SpecIn> SpecGolden::capturedWindow(const sc_time& last_edge, uint64_
 }
 
 std::vector<SpecOut> specGoldenReplay(const SpecUnitModel& model, SpecFault fault, const std::vector<SpecIn>& in) {
-  SpecUnitModel m(model.params(), model.prom());
+  SpecUnitModel m(model.params(), model.prom(), model.segRom());
   m.reset();
   SpecIn delayed;  // the Latency fault's register, reset to no input as in SpecGolden
   std::vector<SpecOut> out;

@@ -20,13 +20,13 @@ namespace {
 const char* const kHeaderKeys[] = {"unit", "config", "params", "prom", "latency", "source"};
 
 const char* const kSpecParamOrder = "Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits "
-                                    "SpecFracBits LightBits PipeStages Kind TableBits";
+                                    "SpecFracBits LightBits PipeStages Kind TableBits Segments";
 const char* const kSpanParamOrder = "NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits";
 
 std::vector<int> specParamList(const SpecUnitParams& p) {
   return {p.Degree,       p.CosFracBits,    p.ShinBits,     p.CoefIntBits, p.CoefFracBits,
           p.DiffFracBits, p.HornerFracBits, p.SpecFracBits, p.LightBits,   p.PipeStages,
-          p.Kind,         p.TableBits};
+          p.Kind,         p.TableBits,      p.Segments};
 }
 
 std::vector<int> spanParamList(const SpanParams& p) {

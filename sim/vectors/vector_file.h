@@ -22,8 +22,8 @@
 // for two clock cycles with the valid inputs low (span: out_ready_i high), then high.
 //
 // spec (rtl/shd_spec_unit.v): params = Degree CosFracBits ShinBits CoefIntBits CoefFracBits
-//   DiffFracBits HornerFracBits SpecFracBits LightBits PipeStages Kind TableBits. One line per
-//   clock cycle:
+//   DiffFracBits HornerFracBits SpecFracBits LightBits PipeStages Kind TableBits Segments. One
+//   line per clock cycle:
 //     valid shin cos light_r light_g light_b  exp_valid exp_spec exp_r exp_g exp_b
 //   the inputs applied before the cycle's rising edge and every output as expected right after
 //   that edge (the outputs hold their last valid result, so all of them are compared on every

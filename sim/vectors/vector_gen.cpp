@@ -34,7 +34,8 @@ void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64
                               VectorGenSummary* summary) {
   const std::string prom_file = output + ".hex";
   OutputFiles files;
-  files.add(prom_file, renderProm(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl), PromFormat::Hex));
+  const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
+  for (const auto& [suffix, text] : renderPromFiles(table, PromFormat::Hex)) files.add(prom_file + suffix, text);
   files.add(output, renderSpecVectors(generateSpecVectors(cfg, cycles, seed, prom_file,
                                                           std::filesystem::absolute(output).parent_path().string(),
                                                           summary)));
@@ -44,13 +45,11 @@ void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64
 void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& prom_file) {
   const SpecUnitParams& p = cfg.rtl;
   const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), p);
-  const std::vector<PromWord> words = readPromHex(prom_file, p.promWordBits(), p.promDepth());
-  for (size_t i = 0; i < words.size(); ++i)
-    if (words[i] != table.words[i])
-      throw std::runtime_error(fmt::format("PROM file {} holds word {} = 0x{}, configuration {} makes 0x{}: regenerate it "
-                                           "(scripts/regen_vectors.sh)",
-                                           prom_file, i, hexWord(words[i], p.promWordBits()), cfg.name,
-                                           hexWord(table.words[i], p.promWordBits())));
+  const std::string d = romImageDiff(readPromHexFiles(prom_file, p), RomImage::of(table), p);
+  if (!d.empty())
+    throw std::runtime_error(fmt::format("PROM file {}: {} (configuration {}'s table): regenerate it "
+                                         "(scripts/regen_vectors.sh)",
+                                         prom_file, d, cfg.name));
 }
 
 SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& prom_file,
@@ -107,7 +106,14 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
       for (int64_t cos = cut - 1; cos <= cut + 1; ++cos) corner(shin, cos, {lmax, lmax / 2, 1});
     }
 
-  SpecUnitModel model(p, table.words);
+  if (p.kind() == SpecKind::Piecewise)  // each segment's first codes and their neighbours
+    for (uint32_t shin = 0; shin <= last_entry; shin = shin + 8 > last_entry && shin != last_entry ? last_entry : shin + 8) {
+      const PiecewiseCodes q = decodePiecewise(table.words[shin], &table.seg_words[size_t{shin} * static_cast<size_t>(p.Segments)], p);
+      for (const PiecewiseCodes::Seg& g : q.segs)
+        for (int64_t cos = g.B - 1; cos <= g.B + 1; ++cos) corner(shin, cos, {lmax, lmax / 2, 1});
+    }
+
+  SpecUnitModel model(p, table.words, table.seg_words);
   model.reset();
   RandomSpecStimulus stim(p, seed, cycles, 0.2);
   VectorGenSummary s;

@@ -5,9 +5,10 @@
 // Run:      testbench/icarus/run_icarus.sh FILE does all of it; by hand:
 //             iverilog -g2012 -Wall -I testbench/icarus -s tb_spec_unit -Ptb_spec_unit.<Name>=<value>... -o tb.vvp \
 //               testbench/icarus/tb_spec_unit.v rtl/shd_spec_unit.v rtl/shd_spec_poly.v rtl/shd_spec_schlick.v \
-//               rtl/shd_spec_explog.v \
+//               rtl/shd_spec_explog.v rtl/shd_spec_piecewise.v \
 //               rtl/shd_coef_rom.v rtl/shd_pipe_reg.v
 //             vvp -n tb.vvp +vec=/abs/file.vec +prom=/abs/prom.hex [+dump=/abs/wave.fst -fst]
+//           (Kind 4, piecewise: its segment ROM loads from /abs/prom.hex.seg beside the PROM)
 //           Paths must be absolute: $readmemh (and $fopen) resolve a relative path against the
 //           simulator's current directory, not the vector file's, and a PROM file $readmemh cannot
 //           find is only a warning.
@@ -31,11 +32,14 @@ module tb_spec_unit #(
   parameter integer LightBits      = 8,
   parameter integer PipeStages     = 1,
   parameter integer Kind           = 0,
-  parameter integer TableBits      = 8
+  parameter integer TableBits      = 8,
+  parameter integer Segments       = 1
 ) ();
 
-  // The PROM's depth: 2^ShinBits words, 2^(ShinBits+TableBits) for the table (Kind 1).
+  // The PROM's depth: 2^ShinBits words, 2^(ShinBits+TableBits) for the table (Kind 1); the
+  // segment ROM's (Kind 4): 2^ShinBits words per segment.
   localparam integer DEPTH     = 1 << (ShinBits + ((Kind == 1) ? TableBits : 0));
+  localparam integer SEG_DEPTH = (Kind == 4) ? (1 << ShinBits) * Segments : 0;
   localparam integer MAX_SHOWN = 10;
 
   reg                   clk_i   = 1'b0;
@@ -56,7 +60,7 @@ module tb_spec_unit #(
     .Degree(Degree), .CosFracBits(CosFracBits), .ShinBits(ShinBits), .CoefIntBits(CoefIntBits),
     .CoefFracBits(CoefFracBits), .DiffFracBits(DiffFracBits), .HornerFracBits(HornerFracBits),
     .SpecFracBits(SpecFracBits), .LightBits(LightBits), .PipeStages(PipeStages), .Kind(Kind),
-    .TableBits(TableBits)
+    .TableBits(TableBits), .Segments(Segments)
   ) dut (
     .clk_i(clk_i), .rst_ni(rst_ni), .valid_i(valid_i), .shin_i(shin_i), .cos_i(cos_i),
     .light_r_i(light_r_i), .light_g_i(light_g_i), .light_b_i(light_b_i), .valid_o(valid_o),
@@ -70,7 +74,7 @@ module tb_spec_unit #(
   reg     cycle_bad;
   reg     params_seen;
   reg     dumping;
-  integer hp [0:12];   // one more than the 12 parameters: a 13th number makes the line differ
+  integer hp [0:13];   // one more than the 13 parameters: a 14th number makes the line differ
   reg [63:0] f [0:11];   // one more than the 11 columns: a 12th field makes the line malformed
 
   task automatic clock;
@@ -82,6 +86,21 @@ module tb_spec_unit #(
 
   localparam TB_NAME = "tb_spec_unit";
 `include "tb_vectors.vh"
+
+  // The segment ROM (Kind 4), during reset: $readmemh of <prom>.seg ran at time 0.
+  generate
+    if (Kind == 4) begin : g_seg_rom_check
+      integer k;
+      initial begin
+        #2;
+        for (k = 0; k < SEG_DEPTH; k = k + 1)
+          if (^dut.g_piecewise.u_piecewise.u_seg_rom.rom[k] === 1'bx) begin
+            $display("tb_spec_unit: error: segment ROM word %0d is X after $readmemh: the +prom file's .seg is missing, short or corrupt", k);
+            $fatal(1);
+          end
+      end
+    end
+  endgenerate
 
   // A column of `width` bits: hex without X or Z digits, no bit at or above the width.
   task automatic field(input integer k, input integer width, input [8*16-1:0] name);
@@ -119,20 +138,20 @@ module tb_spec_unit #(
       if (n > 0) begin
         lineno = lineno + 1;
         if (line[8*n-1 -: 8] == "#") begin
-          for (i = 0; i < 13; i = i + 1) hp[i] = 32'bx;
-          if ($sscanf(line, "# params %d %d %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4],
-                      hp[5], hp[6], hp[7], hp[8], hp[9], hp[10], hp[11], hp[12]) >= 1) begin
+          for (i = 0; i < 14; i = i + 1) hp[i] = 32'bx;
+          if ($sscanf(line, "# params %d %d %d %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4],
+                      hp[5], hp[6], hp[7], hp[8], hp[9], hp[10], hp[11], hp[12], hp[13]) >= 1) begin
             if (hp[0] !== Degree || hp[1] !== CosFracBits || hp[2] !== ShinBits || hp[3] !== CoefIntBits ||
                 hp[4] !== CoefFracBits || hp[5] !== DiffFracBits || hp[6] !== HornerFracBits ||
                 hp[7] !== SpecFracBits || hp[8] !== LightBits || hp[9] !== PipeStages || hp[10] !== Kind ||
-                hp[11] !== TableBits || hp[12] !== 32'bx) begin
+                hp[11] !== TableBits || hp[12] !== Segments || hp[13] !== 32'bx) begin
               if (line[7:0] == "\n") line = line >> 8;
               $display("tb_spec_unit: error: %0s, line %0d: '%0s' differs from the parameters compiled in:", path, lineno, line);
-              $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (%0s)",
+              $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (%0s)",
                        Degree, CosFracBits, ShinBits, CoefIntBits, CoefFracBits, DiffFracBits, HornerFracBits,
-                       SpecFracBits, LightBits, PipeStages, Kind, TableBits,
+                       SpecFracBits, LightBits, PipeStages, Kind, TableBits, Segments,
                        {"Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits ",
-                        "SpecFracBits LightBits PipeStages Kind TableBits"});
+                        "SpecFracBits LightBits PipeStages Kind TableBits Segments"});
               $fatal(1);
             end
             params_seen = 1'b1;
