@@ -10,10 +10,11 @@ CONFIG is a configuration file (<unit>_<name>.json; --unit names the unit of a f
 otherwise) or "<unit>:<name>" of the registry vectors/config/ (scripts/shd_config.py reads it:
 `shd_config.py list` prints the registry). The unit decides the top module and the RTL files:
 spec is shd_spec_unit (rtl/shd_spec_unit.v, shd_spec_poly.v, shd_spec_schlick.v, shd_spec_explog.v,
-shd_coef_rom.v, shd_pipe_reg.v), span is shd_span_unit (rtl/shd_span_unit.v). Everything below is
-about the spec unit except where "A span configuration" says otherwise. The spec unit's parameter
-Kind chooses its datapath (0 poly, 1 table, 2 schlick, 3 explog; rtl/shd_spec_unit.v); a parameter
-the configuration leaves out takes the Verilog default (Kind 0, TableBits 8) here as in the RTL.
+shd_spec_piecewise.v, shd_coef_rom.v, shd_pipe_reg.v), span is shd_span_unit (rtl/shd_span_unit.v).
+Everything below is about the spec unit except where "A span configuration" says otherwise. The
+spec unit's parameter Kind chooses its datapath (0 poly, 1 table, 2 schlick, 3 explog, 4 piecewise;
+rtl/shd_spec_unit.v); a parameter the configuration leaves out takes the Verilog default (Kind 0,
+TableBits 8, Segments 1) here as in the RTL.
   --prom    the PROM ($readmemh hex file). Default: the repository's vectors/prom/spec_<name>.hex
             when it exists and CONFIG is the registry's configuration of that name (the same JSON);
             otherwise make one with `shadesim prom --config CONFIG --format hex -o FILE` and pass
@@ -31,7 +32,10 @@ mixed, and yosys warns about out-of-range selects in those intermediate modules)
 becomes RomFile, an absolute path (yosys reads it at elaboration: `initial $readmemh` under
 SYNTHESIS). The PROM must hold exactly its depth of words of the configuration's word width:
 2^ShinBits words (2^(ShinBits+TableBits) for Kind 1) of KW = CoefIntBits+CoefFracBits bits (Kind 0
-degree 2, Kinds 2 and 3), 2*KW+CosFracBits+1 bits (Kind 0 degree 3) or SpecFracBits+1 bits (Kind 1).
+degree 2, Kinds 2 and 3), 2*KW+CosFracBits+1 bits (Kind 0 degree 3), SpecFracBits+1 bits (Kind 1)
+or Segments*(CosFracBits+1) bits (Kind 4). Kind 4 has a second such memory, its segment ROM: the
+file PROM + ".seg" (the RTL appends the suffix to RomFile itself), 2^(ShinBits+log2 Segments)
+words of clog2(CosFracBits+1) + (Degree+1)*KW bits, checked as strictly.
 Paths travel inside yosys commands (RomFile as a Verilog string), so the PROM, the output
 directory and the RTL directory must not contain whitespace, quotes, backslashes or ';'.
 Flows:
@@ -44,6 +48,7 @@ Output (in --out; every file is written under a temporary name and renamed):
   <target>_stat.json  yosys `stat -json` of the synthesised netlist
   <target>.log        the full yosys log
   summary.json        {"config", "config_file", "prom_file", "yosys", "rtl": {...}, "prom": {...},
+                       "segment_rom": {...} (Kind 4; each {depth, word_bits, varying_bits}),
                        "targets": {"<target>": {luts, ffs, carries, dsps, brams, bram_kbits,
                        cells_total, wall_s, cells_by_type, expected, checks}}}
     luts        iCE40 SB_LUT4; xc7 LUT1..LUT6 plus INV (yosys's name for an inverting LUT1)
@@ -66,10 +71,11 @@ Output (in --out; every file is written under a temporary name and renamed):
             into LUTs (rom_style = "logic", an asynchronous read) or is duplicated. Kind 3 has
             two more ROMs, its fixed log and exp tables of 2^TableBits words (rtl/shd_spec_explog.v
             computes them at elaboration); their geometry comes from the same integer algorithm
-            here (explog_tables), and each of the three memories is counted on its own.
+            here (explog_tables), and each of the three memories is counted on its own. Kind 4
+            has one more, its segment ROM (geometry from the .seg file), counted on its own too.
   dsps      The DSP count equals what the multipliers need. Operand widths come from the RTL
             header's derivation (uQ1.Wc: CW = Wc+1; KW = Ci+Cf; DTW = Df-1; GTW = Ci+1+Hf;
-            FW = Wf+1; L = LightBits):
+            AW = KW+3; FW = Wf+1; L = LightBits):
               MUL1     c*c           CW x CW unsigned                      (Kind 0)
               MUL2     deg 2: a*dt   (KW+1) x DTW signed (a is unsigned: one zero sign bit)
                        deg 3: gt*dt  GTW x DTW signed                      (Kind 0)
@@ -80,6 +86,10 @@ Output (in --out; every file is written under a temporary name and renamed):
               N*L      y = n L       KW x (clog2(Wc+1)+LF) unsigned         DGW = GF-T+1,
               de*r2    exp interp.   DEW x (EX-T) unsigned, when EX > T     DEW = EF-T+1 as in
                                                                             rtl/shd_spec_explog.v)
+              step 1   Kd*u + K      KW x (CW+1) signed (u: one zero sign  (Kind 4: the Horner
+                                     bit; acc = Kd sign-extended, which    multiply-adds
+                                     wreduce takes back to KW bits)        m = acc*u + K*2^Wc)
+              step k   acc*u + K     AW x (CW+1) signed, k = 2..Degree     (Kind 4)
               MUL3..5  f*L           FW x L unsigned (three of them)       (every Kind)
             (Kind 1, the table, has MUL3..5 only; the Kind 2 divider has no multiplier.)
             and each is tiled the way yosys's share/mul2dsp.v does it (iCE40: 16x16 tiles;
@@ -128,19 +138,22 @@ ROOT = os.path.dirname(HERE)  # the source tree, or <prefix>/share/shadesim
 PROG = "synth.py"
 
 # The parameters the checks below use; the configuration must define them (the spec unit's per
-# Kind; Kind and TableBits themselves may be left out: SPEC_DEFAULTS).
+# Kind; Kind, TableBits and Segments themselves may be left out: SPEC_DEFAULTS).
 REQUIRED = {
     "spec": {0: ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits",
                  "DiffFracBits", "HornerFracBits", "SpecFracBits", "LightBits"],
              1: ["ShinBits", "SpecFracBits", "LightBits"],
              2: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"],
-             3: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"]},
+             3: ["CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits", "LightBits"],
+             4: ["Degree", "CosFracBits", "ShinBits", "CoefIntBits", "CoefFracBits", "SpecFracBits",
+                 "LightBits", "PipeStages", "Segments"]},
     "span": ["NumTri", "LanesPerTri", "AlignLanes", "NumAttr", "AttrBits",
              "CoordBits", "RemBits", "PixBits", "TagBits"],
 }
 # The spec unit's Verilog defaults of the parameters a configuration may leave out.
-SPEC_DEFAULTS = {"Kind": 0, "TableBits": 8}
-SPEC_KINDS = {0: "poly", 1: "table", 2: "schlick", 3: "explog"}
+SPEC_DEFAULTS = {"Kind": 0, "TableBits": 8, "Segments": 1}
+SPEC_KINDS = {0: "poly", 1: "table", 2: "schlick", 3: "explog", 4: "piecewise"}
+SEGMENT_BITS = {1: 0, 2: 1, 4: 2}  # Kind 4: log2 Segments, the segment ROM's extra address bits
 
 FLOWS = {
     "ice40": "synth_ice40 -dsp",
@@ -207,7 +220,8 @@ def spec_params(rtl):
 
 def missing_params(unit, rtl):
     """The parameters the checks need that `rtl` lacks or holds as a non-integer (for spec, those
-    of its Kind); a ValueError for a Kind that is not one of SPEC_KINDS."""
+    of its Kind); a ValueError for a Kind that is not one of SPEC_KINDS or, for Kind 4, a
+    Segments that is not 1, 2 or 4."""
     if unit == "span":
         need = REQUIRED[unit]
     else:
@@ -217,6 +231,8 @@ def missing_params(unit, rtl):
                              + ", ".join(f"{k} ({n})" for k, n in SPEC_KINDS.items()))
         need = REQUIRED[unit][kind] + (["TableBits"] if kind in (1, 3) else [])
         rtl = spec_params(rtl)
+        if kind == 4 and (type(rtl["Segments"]) is not int or rtl["Segments"] not in SEGMENT_BITS):
+            raise ValueError(f"rtl.Segments = {json.dumps(rtl['Segments'])} is not 1, 2 or 4")
     return [n for n in need if not isinstance(rtl.get(n), int)]
 
 
@@ -239,23 +255,45 @@ def default_prom(c, ref):
     return path
 
 
-def prom_geometry(path, p):
-    """(depth, word bits, bit columns that vary) of a $readmemh file; fails on a malformed one."""
+def rom_layouts(p):
+    """[(name, file suffix, depth, word bits, depth as the parameters give it)] of the memories
+    whose contents come from files: the PROM and, for Kind 4, its segment ROM (PROM + ".seg")."""
     p = spec_params(p)
     kind = p["Kind"]
-    addr_bits = p["ShinBits"] + (p["TableBits"] if kind == 1 else 0)
-    depth_text = "2^(ShinBits+TableBits)" if kind == 1 else "2^ShinBits"
-    depth = 1 << addr_bits
     if kind == 1:
-        word_bits = p["SpecFracBits"] + 1
-    else:
-        kw = p["CoefIntBits"] + p["CoefFracBits"]
-        word_bits = kw if kind in (2, 3) or p["Degree"] == 2 else 2 * kw + p["CosFracBits"] + 1
+        return [("PROM", "", 1 << (p["ShinBits"] + p["TableBits"]), p["SpecFracBits"] + 1,
+                 "2^(ShinBits+TableBits)")]
+    kw = p["CoefIntBits"] + p["CoefFracBits"]
+    depth, wc = 1 << p["ShinBits"], p["CosFracBits"]
+    if kind != 4:
+        word_bits = kw if kind in (2, 3) or p["Degree"] == 2 else 2 * kw + wc + 1
+        return [("PROM", "", depth, word_bits, "2^ShinBits")]
+    sb = SEGMENT_BITS[p["Segments"]]                        # log2 Segments
+    seg_bits = wc.bit_length() + (p["Degree"] + 1) * kw    # {K_d..K_0, e}, e clog2(Wc+1) bits
+    return [("PROM", "", depth, p["Segments"] * (wc + 1), "2^ShinBits"),
+            ("segment ROM", ".seg", depth << sb, seg_bits, "2^(ShinBits+log2 Segments)")]
+
+
+def prom_geometry(path, p):
+    """[(name, depth, word bits, bit columns that vary)] of the PROM's $readmemh file and, for
+    Kind 4, of its segment ROM's (path + ".seg"); fails on a missing or malformed one."""
+    geometry = []
+    for name, suffix, depth, word_bits, depth_text in rom_layouts(p):
+        if suffix and not os.path.isfile(path + suffix):
+            raise InputError(f"{path + suffix}: no {name} beside the PROM {path} ('shadesim prom "
+                             f"--format hex -o <file>' writes both)")
+        words = read_hex(path + suffix, name, depth, word_bits, depth_text)
+        geometry.append((name, depth, word_bits, varying_bits(words, word_bits)))
+    return geometry
+
+
+def read_hex(path, name, depth, word_bits, depth_text):
+    """The words of memory `name` from its $readmemh file, which must fill exactly its depth."""
     try:
         with open(path, encoding="utf-8") as f:
             text = f.read()
     except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"{path}: cannot read the PROM: {getattr(e, 'strerror', None) or e}")
+        raise InputError(f"{path}: cannot read the {name}: {getattr(e, 'strerror', None) or e}")
     text = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
     text = re.sub(r"//[^\n]*", " ", text)
     words, addr = {}, 0
@@ -275,8 +313,8 @@ def prom_geometry(path, p):
         words[addr] = v
         addr += 1
     if len(words) != depth:
-        raise InputError(f"{path}: {len(words)} words, the unit needs {depth} ({depth_text})")
-    return depth, word_bits, varying_bits(words.values(), word_bits)
+        raise InputError(f"{path}: {len(words)} words, the {name} needs {depth} ({depth_text})")
+    return words.values()
 
 
 def varying_bits(words, bits):
@@ -287,7 +325,7 @@ def varying_bits(words, bits):
 
 def prepare(ref, unit, prom_arg):
     """CONFIG, --unit and --prom as the command line gives them: (the configuration, its file's
-    real path, the PROM's real path or None for span, the PROM geometry or None). Refuses --prom
+    real path, the PROM's real path or None for span, prom_geometry's list or None). Refuses --prom
     for a span configuration and a PROM that is missing, malformed or not a plain path."""
     c = load_config(ref, unit)
     config_file = os.path.realpath(c.path) if os.path.isfile(c.path) else c.path
@@ -434,6 +472,14 @@ def multipliers(unit, p):
         m.append(("N*L", kw, llw, False, False, kw + llw))
         if ex > t:
             m.append(("de*r2", dew, ex - t, False, False, dew + ex - t))
+    elif p["Kind"] == 4:
+        wc = p["CosFracBits"]
+        kw = p["CoefIntBits"] + p["CoefFracBits"]
+        # m = acc*u + K*2^Wc, u with a zero sign bit; step 1's acc is K_d sign-extended, which
+        # wreduce takes back to KW bits; later steps' acc has AW = KW+3, bits [AW+Wc-1:Wc] used.
+        m.append(("step 1 Kd*u", kw, wc + 2, True, True, kw + wc + 2))
+        for k in range(2, p["Degree"] + 1):
+            m.append((f"step {k} acc*u", kw + 3, wc + 2, True, True, kw + 3 + wc))
     for k, ch in enumerate("RGB"):
         m.append((f"MUL{3 + k} f*L{ch}", fw, lb, False, False, fw - 1 + lb))
     return m
@@ -545,8 +591,7 @@ def evaluate(c, tgt, wall, out, geometry, failed):
             failed.append(f"{name}/{tgt} no_mem: {leftover_mem} $mem, {r['brams']} block RAM, "
                           f"{r['distributed_ram']} distributed RAM/ROM cells (expected none)")
     else:
-        depth, word_bits, varying = geometry
-        mems = [("PROM", depth, word_bits, varying)]
+        mems = list(geometry)
         if spec_params(p)["Kind"] == 3:
             mems += explog_tables(p)
         if tgt == "ice40":
@@ -664,11 +709,12 @@ def main(argv):
         summary = dict(config=c.name, config_file=config_file, top=c.top, yosys=yosys_version,
                        rtl=c.rtl, targets={})
     else:
-        depth, word_bits, varying = geometry
         summary = dict(config=c.name, config_file=config_file, prom_file=prom,
-                       yosys=yosys_version, rtl=c.rtl,
-                       prom=dict(depth=depth, word_bits=word_bits, varying_bits=varying),
-                       targets={})
+                       yosys=yosys_version, rtl=c.rtl)
+        for name, depth, word_bits, varying in geometry:   # "prom", "segment_rom" (Kind 4)
+            summary[name.lower().replace(" ", "_")] = dict(depth=depth, word_bits=word_bits,
+                                                           varying_bits=varying)
+        summary["targets"] = {}
     failed = []
     for tgt, wall in walls.items():
         summary["targets"][tgt] = evaluate(c, tgt, wall, out, geometry, failed)

@@ -193,13 +193,17 @@ def check_pnr_table(report, body):
 
 
 def prom_bits(rtl):
-    """Depth x word width of a specular configuration's PROM, from its parameters
-    (rtl/shd_spec_unit.v)."""
+    """Depth x word width of a specular configuration's PROM, plus the piecewise kind's segment
+    ROM, from its parameters (rtl/shd_spec_unit.v, SpecUnitParams::promBits)."""
     kind, kw = rtl.get("Kind", 0), rtl["CoefIntBits"] + rtl["CoefFracBits"]
     if kind == 1:
         return (1 << (rtl["ShinBits"] + rtl["TableBits"])) * (rtl["SpecFracBits"] + 1)
     if kind in (2, 3):  # schlick m, explog n (its fixed log and exp tables are not the PROM)
         return (1 << rtl["ShinBits"]) * kw
+    if kind == 4:  # {B_S-1..B_0}; segment ROM {K_d..K_0, e} at {shin, s}, e clog2(Wc+1) bits
+        s, wc = rtl.get("Segments", 1), rtl["CosFracBits"]
+        seg_word = wc.bit_length() + (rtl["Degree"] + 1) * kw
+        return (1 << rtl["ShinBits"]) * s * (wc + 1 + seg_word)
     return (1 << rtl["ShinBits"]) * (kw if rtl["Degree"] == 2 else 2 * kw + rtl["CosFracBits"] + 1)
 
 
