@@ -27,7 +27,15 @@ module shd_coef_rom #(
   reg [WordBits-1:0] rom [0:DEPTH-1] /*verilator public_flat_rd*/;
 
 `ifdef SYNTHESIS
-  initial $readmemh({RomFile, Suffix}, rom);
+  // Without a suffix the file name is RomFile itself: {RomFile, ""} would append a NUL byte to
+  // it (an empty string is one byte of 0 in an expression).
+  generate
+    if (Suffix == "") begin : g_file
+      initial $readmemh(RomFile, rom);
+    end else begin : g_suffixed
+      initial $readmemh({RomFile, Suffix}, rom);
+    end
+  endgenerate
 `else
   reg [8*1024-1:0] rom_path;
   reg [8*1024-1:0] rom_full;

@@ -37,8 +37,14 @@ void checkSpecDatapath(const shd::SpecUnitParams& p) {
   const uint32_t cos_codes[] = {0, 1, one / 2, one - 1, one, 2 * one - 1};
   const uint32_t light = static_cast<uint32_t>(p.lightMax());
   const uint32_t last_shin = static_cast<uint32_t>(p.shinCodes() - 1);
+  // The piecewise kind's segment ROM: zero, or every coefficient bit set with the scale 0 (a
+  // larger one could carry u past 1.0, which the model refuses).
+  const int seg_bits = p.kind() == shd::SpecKind::Piecewise ? p.segWordBits() : 1;
+  const shd::PromWord seg_ones =
+      (seg_bits >= 128 ? ~shd::PromWord{0} : (shd::PromWord{1} << seg_bits) - 1) >> p.segScaleBits() << p.segScaleBits();
   for (shd::PromWord word : {shd::PromWord{0}, ones}) {
-    const shd::SpecUnitModel unit(p, std::vector<shd::PromWord>(static_cast<size_t>(p.promDepth()), word));
+    const shd::SpecUnitModel unit(p, std::vector<shd::PromWord>(static_cast<size_t>(p.promDepth()), word),
+                                  std::vector<shd::PromWord>(static_cast<size_t>(p.segDepth()), word == 0 ? 0 : seg_ones));
     for (uint32_t shin : {0u, last_shin})
       for (uint32_t cos : cos_codes) {
         const shd::SpecOut out = unit.evaluate(shin, cos, {light, light, 0});

@@ -31,7 +31,8 @@ Case format (configparser INI, one section per case; see the head of cases.ini):
         {work} the case's work directory (also the current directory), {root} the repository
   exit = the expected status;  error = regex of the error line (exit 2);  warning = regex of a
   "warning:" line (exit 0);  expect = regex that stdout + stderr must match;  outputs = files the
-  run must create (exit 0/1 cases);  timeout = seconds
+  run must create (exit 0/1 cases);  timeout = seconds;  systemc_config = UNIT:NAME: the case is
+  skipped when shadesim_systemc has no model of that configuration (a sanitizer build has few)
   Inputs, made in this order in the fresh work directory:
     mkdir = d, ...                      directories
     copy = SRC [-> DST], ...            files (SRC relative to this directory, or {root}/...)
@@ -64,6 +65,7 @@ import shlex
 import shutil
 import signal
 import stat
+import subprocess
 import struct
 import sys
 import time
@@ -77,7 +79,7 @@ ERROR_FORMAT = re.compile(r"^(shadesim [a-z-]+|shadesim|shadesim_systemc): error
 # it contained, inside its one error line, is not reported here).
 SANITIZER = re.compile(r"^(==\d+==)?(ERROR: \w+Sanitizer|\w+Sanitizer:DEADLYSIGNAL)|^SUMMARY: \w+Sanitizer|"
                        r"^[^\s:]+:\d+:\d+: runtime error: ", re.M)
-KNOWN_KEYS = {"what", "run", "exit", "error", "warning", "expect", "outputs", "timeout",
+KNOWN_KEYS = {"what", "run", "exit", "error", "warning", "expect", "outputs", "timeout", "systemc_config",
               "mkdir", "copy", "fifo", "chardev", "symlink"}
 FILE_KEYS = ("file.", "bytes.", "edit.", "truncate.")
 
@@ -88,6 +90,20 @@ class CorpusError(Exception):
 
 class Skip(Exception):
     """The case cannot be set up on this machine (e.g. no right to make a device node)."""
+
+
+_SC_BUILT = {}
+
+
+def systemc_has(binary, unit, name):
+    """Whether shadesim_systemc was built with a model of <unit>:<name>: its error for an unknown
+    configuration lists the ones it has ("(built: a, b)")."""
+    if (binary, unit) not in _SC_BUILT:
+        r = subprocess.run([binary, "--unit", unit, "--config", "none-such", "--quiet"],
+                           capture_output=True, text=True, timeout=60)
+        m = re.search(r"\(built: ([^)]*)\)", r.stderr)
+        _SC_BUILT[(binary, unit)] = set(split_list(m.group(1))) if m else set()
+    return name in _SC_BUILT[(binary, unit)]
 
 
 def split_list(value):
@@ -275,6 +291,11 @@ class Run:
         self.seconds = 0.0
 
     def start(self):
+        need = self.case.get("systemc_config")
+        if need:
+            unit, _, name = need.partition(":")
+            if not systemc_has(self.args.systemc, unit, name):
+                raise Skip(f"shadesim_systemc has no model of {need} in this build")
         case_dir = self.log
         if os.path.lexists(case_dir):
             shutil.rmtree(case_dir)
