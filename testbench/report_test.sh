@@ -18,7 +18,9 @@ here=$(cd "$(dirname "$0")" && pwd)
 source "$here/fresh_work.sh"
 fresh_work "$work"
 cd "$work"
-"$shadesim" report --scene "$scene" --modes serial,evenodd --bench 1 --no-hardware -o r --quiet > report.out
+# SHD_REPORT_ARGS: more options for the first report (the sanitizer build: fewer units).
+# shellcheck disable=SC2086
+"$shadesim" report --scene "$scene" --modes serial,evenodd --bench 1 --no-hardware ${SHD_REPORT_ARGS:-} -o r --quiet > report.out
 cat report.out
 if [ "${4:-}" = tools-absent ]; then
   mkdir -p nobin cache
