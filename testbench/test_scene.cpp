@@ -15,24 +15,18 @@
 #include <fmt/format.h>
 
 #include "scene/scene.h"
+#include "test_util.h"
 
 namespace shd {
 namespace {
+
+using testutil::centroid;
+using testutil::outwardFaceNormal;
 
 namespace fs = std::filesystem;
 
 const std::string kModels = "/usr/share/assimp/models";
 const std::string kScenes = std::string(SHD_SOURCE_DIR) + "/vectors/scenes";
-
-// The outward face normal for idx3d's vertex order (sphere.h: (c - a) x (b - a)).
-Vec3 outwardFaceNormal(const Mesh& m, const std::array<uint32_t, 3>& t) {
-  const Vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
-  return cross(c - a, b - a);
-}
-
-Vec3 centroid(const Mesh& m, const std::array<uint32_t, 3>& t) {
-  return (1.0 / 3.0) * (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]);
-}
 
 // Every triangle with area is wound so that its outward face normal agrees with the vertex
 // normals (their sum): the winding rule of sphere.h.

@@ -6,25 +6,19 @@
 #include <stdexcept>
 
 #include "scene/sphere.h"
+#include "test_util.h"
 
 namespace shd {
 namespace {
+
+using testutil::centroid;
+using testutil::outwardFaceNormal;
 
 constexpr double kPiT = 3.14159265358979323846;
 
 double triangleArea(const Mesh& m, const std::array<uint32_t, 3>& t) {
   const Vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
   return 0.5 * length(cross(b - a, c - a));
-}
-
-// The outward face normal for idx3d's vertex order (sphere.h: (c - a) x (b - a)).
-Vec3 outwardFaceNormal(const Mesh& m, const std::array<uint32_t, 3>& t) {
-  const Vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
-  return cross(c - a, b - a);
-}
-
-Vec3 centroid(const Mesh& m, const std::array<uint32_t, 3>& t) {
-  return (1.0 / 3.0) * (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]);
 }
 
 TEST(Idx3dSphere, CountsOfTheDefaultSphere) {

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <exception>
 #include <filesystem>
 #include <string>
@@ -11,8 +13,19 @@
 
 #include "config/registry.h"
 #include "render/render.h"
+#include "scene/sphere.h"
 
 namespace shd::testutil {
+
+// The outward face normal of a triangle in idx3d's vertex order (sphere.h: (c - a) x (b - a)).
+inline Vec3 outwardFaceNormal(const Mesh& m, const std::array<uint32_t, 3>& t) {
+  const Vec3 a = m.positions[t[0]], b = m.positions[t[1]], c = m.positions[t[2]];
+  return cross(c - a, b - a);
+}
+
+inline Vec3 centroid(const Mesh& m, const std::array<uint32_t, 3>& t) {
+  return (1.0 / 3.0) * (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]);
+}
 
 // The registry's span configurations (the lane modes), and one's parameters.
 inline std::vector<std::string> spanModes() { return builtinConfigNames("span"); }
