@@ -187,11 +187,15 @@ std::string pnrToolVersion(const std::string& script) {
 
 nlohmann::json unitPointPnr(const std::string& unit, const nlohmann::json& rtl, const PromFiles& prom,
                             const nlohmann::json& prom_desc, const PnrTool& tool) {
+  // The devices and flows, as the key of the caches made before the devices could be chosen
+  // ("up5k hx8k-nodsp" for both).
+  std::string what;
+  for (const PnrDevice& d : tool.devices) what += fmt::format("{}{}{}", what.empty() ? "" : " ", d.name, d.dsps ? "" : "-nodsp");
   return cachedUnitRun(
-      unit + "-pnr", "pnr", unit, rtl, prom, prom_desc, tool.script, tool.cache_dir, tool.version, "up5k hx8k-nodsp",
+      unit + "-pnr", "pnr", unit, rtl, prom, prom_desc, tool.script, tool.cache_dir, tool.version, what,
       [&](const std::vector<std::string>& argv, const fs::path& tmp) {
         nlohmann::json devices = nlohmann::json::object();
-        for (const PnrDevice& d : pnrDevices()) {
+        for (const PnrDevice& d : tool.devices) {
           std::vector<std::string> a = argv;
           a.insert(a.end(), {"--device", d.name, "--out", (tmp / d.name).string()});
           if (!d.dsps) a.push_back("--no-dsp");

@@ -52,17 +52,6 @@ std::vector<std::string> dspClasses(const std::string& unit, const std::vector<n
 // The area of the specular-unit point whose PROM `table` is (its parameters are table.unit).
 nlohmann::json specPointArea(const PromTable& table, const SynthTool& tool);
 
-// Place and route on iCE40 by scripts/pnr.py (nextpnr-ice40), cached beside the areas.
-struct PnrTool {
-  std::string script;     // scripts/pnr.py
-  std::string cache_dir;  // an existing directory: <unit>-pnr-<key>.json per configuration
-  std::string version;    // pnrToolVersion()
-};
-
-// synthToolVersion() of the synth.py beside `script`, nextpnr-ice40's version and a hash of
-// `script`: part of every cache key. std::runtime_error if yosys or nextpnr-ice40 does not run.
-std::string pnrToolVersion(const std::string& script);
-
 // The devices a configuration is placed on, each with its flow: the UP5K with its DSPs
 // (synth_ice40 -dsp; fmax an upper bound, scripts/pnr.py "DSP timing"), the HX8K without (it has
 // none: every multiplier in logic cells, fmax exact).
@@ -73,8 +62,20 @@ struct PnrDevice {
 };
 const std::vector<PnrDevice>& pnrDevices();
 
+// Place and route on iCE40 by scripts/pnr.py (nextpnr-ice40), cached beside the areas.
+struct PnrTool {
+  std::string script;     // scripts/pnr.py
+  std::string cache_dir;  // an existing directory: <unit>-pnr-<key>.json per configuration
+  std::string version;    // pnrToolVersion()
+  std::vector<PnrDevice> devices = pnrDevices();  // those placed on, in pnrDevices() order
+};
+
+// synthToolVersion() of the synth.py beside `script`, nextpnr-ice40's version and a hash of
+// `script`: part of every cache key. std::runtime_error if yosys or nextpnr-ice40 does not run.
+std::string pnrToolVersion(const std::string& script);
+
 // {"<device>": {"flow", "fits", "fmax_mhz", "fmax_kind", "luts", "luts_total", "dsps",
-// "dsps_total", "brams", "brams_total", "util_percent", "seed", "why_not"}} per pnrDevices()
+// "dsps_total", "brams", "brams_total", "util_percent", "seed", "why_not"}} per tool.devices
 // entry (pnr.py's summary, docs/place-and-route.md; fmax_mhz and fmax_kind null and why_not set
 // when it does not fit). Arguments and cache as unitPointArea; std::runtime_error when pnr.py
 // fails (not fitting is a result, not a failure).

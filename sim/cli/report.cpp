@@ -60,8 +60,9 @@ class ReportCmd final : public Command {
 
  private:
   std::string scene_ = "builtin:sphere", dir_, hardware_cache_;
-  std::vector<std::string> modes_, spec_units_;
+  std::vector<std::string> modes_, spec_units_, pnr_devices_;
   std::vector<SpecUnitConfig> alt_units_;  // --spec-units, loaded
+  std::vector<PnrDevice> devices_;         // --pnr-devices, checked
   std::vector<double> scene_n_;            // the shininess values the scene's objects use
   size_t bench_ = 5;
   bool rtl_ = false, quiet_ = false, no_hardware_ = false;
@@ -82,6 +83,7 @@ class ReportCmd final : public Command {
   void checkHardwareCache() const;
   std::vector<SpanUnitConfig> modeConfigs() const;
   std::vector<SpecUnitConfig> altUnitConfigs() const;
+  std::vector<PnrDevice> pnrDeviceList() const;
   void requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const;
   Hardware hardwareTools() const;
   json unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
@@ -121,8 +123,17 @@ void ReportCmd::add(CLI::App& app) {
                  "the directory (made if missing; its parent must exist) where each unit configuration's yosys area "
                  "and nextpnr place and route are kept, computed once (shared with sweep --synth-cache); default "
                  "$XDG_CACHE_HOME/shadesim or ~/.cache/shadesim");
+  std::vector<std::string> device_names;
+  for (const PnrDevice& d : pnrDevices()) device_names.push_back(d.name);
+  app.add_option("--pnr-devices", pnr_devices_,
+                 fmt::format("the iCE40 devices each unit is placed and routed on, comma-separated (default: {}): the "
+                             "UP5K with its DSPs, the HX8K without (every multiplier in logic cells: the longer run)",
+                             fmt::join(device_names, ",")))
+      ->delimiter(',')
+      ->check(CLI::IsMember(device_names));
   app.add_flag("--no-hardware", no_hardware_, "no area and no place and route: the report without yosys and nextpnr")
-      ->excludes("--hardware-cache");
+      ->excludes("--hardware-cache")
+      ->excludes("--pnr-devices");
   app.add_option("--heat-scale", heat_scale_, "error (LSB) shown white in the heat maps")
       ->check(realIn(0, 255, Ends::OpenLow))
       ->default_val(heat_scale_);
@@ -197,6 +208,16 @@ std::vector<SpecUnitConfig> ReportCmd::altUnitConfigs() const {
   return units;
 }
 
+std::vector<PnrDevice> ReportCmd::pnrDeviceList() const {
+  std::vector<PnrDevice> devices;
+  for (const PnrDevice& d : pnrDevices())
+    if (pnr_devices_.empty() || std::count(pnr_devices_.begin(), pnr_devices_.end(), d.name) > 0) devices.push_back(d);
+  for (const std::string& n : pnr_devices_)
+    if (std::count(pnr_devices_.begin(), pnr_devices_.end(), n) > 1)
+      throw ArgError(fmt::format("--pnr-devices: {} is named twice", n));
+  return devices;
+}
+
 void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const {
   for (const SpanUnitConfig& m : modes) {
     try {
@@ -258,7 +279,7 @@ Hardware ReportCmd::hardwareTools() const {
   }
   try {
     if (pnr.empty()) throw std::runtime_error("scripts/pnr.py is neither in this installation nor in the source tree");
-    hw.pnr = PnrTool{pnr, hw.cache, pnrToolVersion(pnr)};
+    hw.pnr = PnrTool{pnr, hw.cache, pnrToolVersion(pnr), devices_};
   } catch (const std::exception& e) {
     hw.absentBecause("fmax, time", fmt::format("place and route: {}", e.what()), true);
   }
@@ -386,14 +407,14 @@ json rowArea(const json& row, const json& units) {
   return sum;
 }
 
-// A row's time per frame in microseconds on each device of pnrDevices(): the span unit's cycles
+// A row's time per frame in microseconds on each device placed on: the span unit's cycles
 // at its fmax plus the specular unit's cycles at the least fmax of the configurations it uses
 // (each unit placed alone at its own clock; not overlapped, as total_cycles). null where the row
 // has no cycles, a unit was not placed, or one does not fit the device.
-json rowTime(const json& row, const json& units) {
+json rowTime(const json& row, const json& units, const std::vector<PnrDevice>& devices) {
   if (row["span_cycles"].is_null()) return json();
   json t = json::object();
-  for (const PnrDevice& d : pnrDevices()) {
+  for (const PnrDevice& d : devices) {
     auto fmax = [&](const json& u) -> double {
       const json& f = u.contains("pnr") ? u["pnr"][d.name]["fmax_mhz"] : json();
       return f.is_number() ? f.get<double>() : 0.0;
@@ -426,10 +447,10 @@ json ReportCmd::reportJson(const Scene& sc, const std::vector<SpanUnitConfig>& m
   if (with_area)
     for (json& r : rows) r["area"] = rowArea(r, units);
   if (with_pnr)
-    for (json& r : rows) r["time_us"] = rowTime(r, units);
+    for (json& r : rows) r["time_us"] = rowTime(r, units, hw.pnr->devices);
   json devices = json::array();
   if (with_pnr)
-    for (const PnrDevice& d : pnrDevices()) devices.push_back({{"name", d.name}, {"title", d.title}, {"dsps", d.dsps}});
+    for (const PnrDevice& d : hw.pnr->devices) devices.push_back({{"name", d.name}, {"title", d.title}, {"dsps", d.dsps}});
   bool rtl_equal = true;
   for (const json& r : rows) rtl_equal = rtl_equal && (!r.contains("rtl") || (r["rtl"]["pixel_mismatches"] == 0 && r["rtl"]["cycles_equal"] == true));
   bool modes_equal = true;
@@ -512,6 +533,7 @@ int ReportCmd::run(const CLI::App&) {
   const std::vector<SpanUnitConfig> modes = modeConfigs();
   const LobeConfigs lobes;
   alt_units_ = altUnitConfigs();
+  devices_ = pnrDeviceList();
   for (const SceneObject& o : sc.objects) scene_n_.push_back(sc.materials.at(static_cast<size_t>(o.material)).shininess);
   if (rtl_) requireRtl(modes, lobes);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-report-{}", getpid());

@@ -361,12 +361,20 @@ std::string reportMarkdown(const json& report) {
           "(peak: where cos^n >= 0.5), in output LSBs at full light. phong-fixed: the image that asks the unit at "
           "every pixel, against the reference (hl: in the highlight).\n\n" +
           specUnitsTable(report) + "\n";
-  if (!devicesOf(report).empty())
-    md += "## Place and route\n\nEach unit alone on iCE40 by nextpnr (scripts/pnr.py): the UP5K with its DSPs (fmax an "
-          "upper bound: the DSPs' own delays are not in it), the HX8K without (every multiplier in logic cells; fmax "
-          "exact). A row's time per frame (µs) is its span cycles at the span unit's fmax plus its specular cycles "
-          "at the specular unit's.\n\n" +
+  if (!devicesOf(report).empty()) {
+    std::vector<std::string> devices;  // as --pnr-devices chose them
+    for (const json& d : report["options"]["pnr_devices"])
+      devices.push_back(d["dsps"].get<bool>()
+                            ? fmt::format("the {} with its DSPs (fmax an upper bound: the DSPs' own delays are not in it)",
+                                          d["title"].get<std::string>())
+                            : fmt::format("the {} without DSPs (every multiplier in logic cells; fmax exact)",
+                                          d["title"].get<std::string>()));
+    md += fmt::format("## Place and route\n\nEach unit alone by nextpnr (scripts/pnr.py) on {}. A row's time per frame "
+                      "(µs) is its span cycles at the span unit's fmax plus its specular cycles at the specular "
+                      "unit's.\n\n",
+                      fmt::join(devices, ", and ")) +
           pnrTable(report) + "\n";
+  }
   md += "## Columns that do not apply\n\n";
   for (const json& n : report["not_applicable"])
     md += fmt::format("- {} ({}): {}.\n", fmt::join(n["columns"].get<std::vector<std::string>>(), ", "),
