@@ -25,6 +25,7 @@ std::unique_ptr<Command> makeConfigsCmd();
 std::unique_ptr<Command> makeSweepCmd();
 std::unique_ptr<Command> makeSweepMergeCmd();
 std::unique_ptr<Command> makeReportCmd();
+std::unique_ptr<Command> makePruneCmd();
 
 namespace {
 
@@ -59,6 +60,7 @@ const std::vector<CommandInfo>& commands() {
       {"sweep-merge", "join the shard directories of one sweep", makeSweepMergeCmd},
       {"report", "what each shading method and lobe costs and buys on a scene: error, time, cycles, area",
        makeReportCmd},
+      {"prune", "the smallest units one scene needs: its shininess values, lane mode, what it leaves unused", makePruneCmd},
   };
   return all;
 }

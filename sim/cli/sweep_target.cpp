@@ -62,27 +62,6 @@ std::string areaText(const nlohmann::json& area) {
   return s;
 }
 
-// Writes the configuration's vector file (and its PROM) beside it and replays it under Icarus.
-// Returns the verdict line; std::runtime_error when Icarus reports a mismatch or cannot run.
-std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles) {
-  const std::string script = findShareFile("testbench/icarus/run_icarus.sh");
-  if (script.empty())
-    throw std::runtime_error("testbench/icarus/run_icarus.sh is neither in this installation nor in the source tree");
-  const SpecUnitConfig cfg = specConfig(config_file);
-  const std::string vec = fs::path(config_file).replace_extension(".vec").string();
-  VectorGenSummary s;
-  writeSpecVectorsWithProm(cfg, cycles, kVerifySeed, vec, &s);
-  std::string out, err, error;
-  const int rc = runProcess({script, vec}, out, err, error);
-  if (rc != 0) {
-    std::string said = out + err;
-    if (said.size() > 1200) said = "..." + said.substr(said.size() - 1200);
-    throw std::runtime_error(fmt::format("{} {}: {}\n{}", script, vec, rc < 0 ? error : fmt::format("exit {}", rc), said));
-  }
-  return fmt::format("Icarus replayed {} ({} cycles, {} valid inputs, seed {}): every output matches the model",
-                     vec, s.cycles, s.valid_inputs, kVerifySeed);
-}
-
 // Each internal width of the chosen point one bit narrower: its error and, where it breaks E,
 // the input; where it still meets E, its area (minimality is by area).
 nlohmann::json narrowerPoints(const SweepUnit& unit, const nlohmann::json& chosen, const SynthTool* synth,
@@ -136,6 +115,25 @@ void printNarrower(const nlohmann::json& narrower) {
 }
 
 }  // namespace
+
+std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles) {
+  const std::string script = findShareFile("testbench/icarus/run_icarus.sh");
+  if (script.empty())
+    throw std::runtime_error("testbench/icarus/run_icarus.sh is neither in this installation nor in the source tree");
+  const SpecUnitConfig cfg = specConfig(config_file);
+  const std::string vec = fs::path(config_file).replace_extension(".vec").string();
+  VectorGenSummary s;
+  writeSpecVectorsWithProm(cfg, cycles, kVerifySeed, vec, &s);
+  std::string out, err, error;
+  const int rc = runProcess({script, vec}, out, err, error);
+  if (rc != 0) {
+    std::string said = out + err;
+    if (said.size() > 1200) said = "..." + said.substr(said.size() - 1200);
+    throw std::runtime_error(fmt::format("{} {}: {}\n{}", script, vec, rc < 0 ? error : fmt::format("exit {}", rc), said));
+  }
+  return fmt::format("Icarus replayed {} ({} cycles, {} valid inputs, seed {}): every output matches the model",
+                     vec, s.cycles, s.valid_inputs, kVerifySeed);
+}
 
 int runTarget(const std::string& dir, const SweepPlan& plan, const SweepUnit& unit, const nlohmann::json& results,
               const SynthTool* synth, const TargetRequest& req) {

@@ -27,4 +27,10 @@ struct TargetRequest {
 int runTarget(const std::string& dir, const SweepPlan& plan, const SweepUnit& unit, const nlohmann::json& results,
               const SynthTool* synth, const TargetRequest& req);
 
+// Writes the specular configuration's vector file (<config>.vec, its PROM <config>.vec.hex) from
+// the model (`cycles` cycles, a fixed seed) and replays it under Icarus (testbench/icarus/
+// run_icarus.sh, the configuration's parameters: nothing to build). Returns the verdict line;
+// std::runtime_error when Icarus reports a mismatch or cannot run.
+std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles);
+
 }  // namespace shd::cli

@@ -1,0 +1,304 @@
+// shadesim prune: what one scene needs of the units, as it is rendered (docs/prune.md).
+// Renders the scene with the full configurations through recording specular engines; writes the
+// analysis, a PROM per device lobe holding only the shininess values the scene uses (every
+// format, the address map and the material-to-address table), the lane mode with the fewest
+// cycles on this scene (each measured), what the scene leaves unused and why, and the proof: the
+// scene rendered with the pruned PROMs in the chosen mode against the full configuration
+// (at most E LSB apart) and each pruned specular configuration replayed under Icarus.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "cli/command.h"
+#include "cli/options.h"
+#include "cli/render_common.h"
+#include "cli/sweep_target.h"
+#include "device/prom.h"
+#include "device/prom_io.h"
+#include "io/files.h"
+#include "render/lobe_units.h"
+#include "render/methods.h"
+#include "report/scene_use.h"
+#include "scene/scene.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace shd::cli {
+
+namespace {
+
+constexpr uint64_t kPruneVerifyCycles = 20000;  // the Icarus replay of each pruned configuration
+
+// One device lobe of the scene: its full configuration, what the scene asked of it, its pruned
+// PROM.
+struct LobePrune {
+  Lobe lobe;
+  SpecUnitConfig full, pruned;
+  std::unique_ptr<ModelSpecEngine> full_engine, pruned_engine;
+  std::unique_ptr<RecordingSpecEngine> recorder;
+  std::vector<double> n_used;  // the shininess values requested, ascending
+};
+
+class PruneCmd final : public Command {
+ public:
+  void add(CLI::App& app) override;
+  int run(const CLI::App& app) override;
+
+ private:
+  std::string scene_ = "builtin:sphere", dir_, method_ = "phong-fixed", brdf_;
+  LobeConfigs lobes_;
+  double target_lsb_ = 0;
+  bool quiet_ = false;
+
+  void say(const std::string& m) const {
+    if (!quiet_) std::fprintf(stderr, "prune: %s\n", m.c_str());
+  }
+  void checkScene(const Scene& sc) const;
+  json laneModes(const Scene& sc, const RenderOptions& ro, const SpecEngines& full, const RenderResult& ref,
+                 std::string& best) const;
+  void prunePromOf(LobePrune& lp, OutputFiles& out, json& lobe_json) const;
+  json unusedParts(const RenderOptions& ro, const std::vector<LobePrune>& lobes) const;
+};
+
+void PruneCmd::add(CLI::App& app) {
+  app.add_option("--scene", scene_, "builtin:sphere | builtin:plane | builtin:torus | builtin:materials, a scene JSON "
+                                    "file or a mesh file")
+      ->default_val(scene_);
+  std::vector<std::string> methods;
+  for (const Method m : allMethods()) methods.emplace_back(toString(m));
+  app.add_option("--method", method_, "the shading method the scene is rendered with: " + fmt::format("{}", fmt::join(methods, " | ")))
+      ->check(CLI::IsMember(methods))
+      ->default_val(method_);
+  app.add_option("--brdf", brdf_, "override every material's brdf (as for render)")
+      ->check(CLI::IsMember({"phong", "blinn", "normalized-blinn", "schlick", "quadratic", "cubic", "cook-torrance",
+                             "pow"}));
+  app.add_option("--quadratic-config", lobes_.quadratic,
+                 "the full specular unit of the quadratic lobe: " + configChoices("spec"))
+      ->default_val(lobes_.quadratic);
+  app.add_option("--cubic-config", lobes_.cubic, "the full specular unit of the cubic lobe: " + configChoices("spec"))
+      ->default_val(lobes_.cubic);
+  app.add_option("--target-lsb", target_lsb_,
+                 "E: the pruned configuration's image may differ from the full one's by at most E LSB at any pixel")
+      ->required()
+      ->check(realIn(0, 255));
+  app.add_option("-o,--output", dir_, "the directory written (made if missing; its parent must exist)")->required();
+  app.add_flag("--quiet", quiet_, "no progress on stderr");
+}
+
+void PruneCmd::checkScene(const Scene& sc) const {
+  if (sc.objects.empty()) throw ArgError(fmt::format("--scene {}: no objects: nothing to render, nothing to prune", sc.name));
+  if (sc.lights.empty())
+    throw ArgError(fmt::format("--scene {}: no lights: every pixel is the ambient term; prune a scene that is lit", sc.name));
+  std::error_code ec;
+  const fs::path d(dir_);
+  if (fs::exists(d, ec) && !fs::is_directory(d, ec)) throw ArgError(fmt::format("-o {}: not a directory", dir_));
+  const fs::path parent = d.has_parent_path() ? d.parent_path() : fs::path(".");
+  if (!fs::exists(d, ec) && !fs::is_directory(parent, ec))
+    throw ArgError(fmt::format("-o {}: no such directory, and its parent {} is none either", dir_, parent.string()));
+}
+
+// Every lane mode of the registry on the scene, with the full specular units: cycles per frame,
+// each image checked equal to the serial one. `best`: the mode with the fewest cycles.
+json PruneCmd::laneModes(const Scene& sc, const RenderOptions& ro, const SpecEngines& full, const RenderResult& ref,
+                         std::string& best) const {
+  json modes = json::array();
+  uint64_t least = UINT64_MAX;
+  for (const std::string& name : builtinConfigNames("span")) {
+    ModelSpanEngine span(spanConfig(name).rtl);
+    const RenderResult r = render(sc, ro, span, full);
+    if (r.fb.rgb != ref.fb.rgb)
+      throw std::runtime_error(fmt::format("lane mode {} renders another image than serial", name));
+    modes.push_back({{"mode", name},
+                     {"lanes", spanConfig(name).rtl.lanes()},
+                     {"span_cycles", r.stats.span_cycles},
+                     {"fragments", r.stats.fragments},
+                     {"fragments_per_cycle", r.stats.span_cycles ? static_cast<double>(r.stats.fragments) / r.stats.span_cycles : 0.0}});
+    if (r.stats.span_cycles < least) least = r.stats.span_cycles, best = name;
+    say(fmt::format("lane mode {}: {} cycles", name, r.stats.span_cycles));
+  }
+  return modes;
+}
+
+// The lobe's PROM with only the shininess values the scene requested: the pruned configuration,
+// its PROM in every format, the address map. Into `out` and `lobe_json`.
+void PruneCmd::prunePromOf(LobePrune& lp, OutputFiles& out, json& lobe_json) const {
+  std::vector<std::string> n_text;
+  for (double n : lp.n_used) n_text.push_back(fmt::format("{}", n));
+  lp.pruned = lp.full;
+  lp.pruned.name = lp.full.name + "pruned";  // a configuration name is letters and digits
+  lp.pruned.description = fmt::format("{} with only the shininess values {} uses (shadesim prune)", lp.full.name, scene_);
+  lp.pruned.prom.n = fmt::format("{}", fmt::join(n_text, ","));
+  lp.pruned.prom.is_list = true;
+  lp.pruned.rtl.ShinBits = addressBitsFor(lp.n_used.size());
+  lp.pruned.rtl.validate();
+  PromTable t = buildPromTable(PromRequest::fromContent(lp.pruned.prom), lp.pruned.rtl);
+  const std::string stem = "spec_" + lp.pruned.name;
+  const json cfg = {{"name", lp.pruned.name},
+                    {"description", lp.pruned.description},
+                    {"rtl", lp.pruned.rtl.toJson()},
+                    {"prom", {{"fit", lp.pruned.prom.fit}, {"level", lp.pruned.prom.level}, {"n_list", lp.pruned.prom.n}}}};
+  lp.pruned.path = (fs::path(dir_) / (stem + ".json")).string();
+  out.add(lp.pruned.path, cfg.dump(2) + "\n");
+  for (PromFormat f : {PromFormat::Hex, PromFormat::Mem, PromFormat::Coe, PromFormat::Mif, PromFormat::Csv})
+    for (const auto& [suffix, text] : renderPromFiles(t, f))
+      out.add((fs::path(dir_) / "prom" / (stem + "." + toString(f) + suffix)).string(), text);
+  json map = json::array();
+  for (const PromEntry& e : t.entries) map.push_back({{"address", e.address}, {"n", e.n}});
+  lobe_json["pruned"] = {{"config", stem + ".json"},
+                         {"ShinBits", lp.pruned.rtl.ShinBits},
+                         {"prom_bits", lp.pruned.rtl.promBits()},
+                         {"address_map", map}};
+  lobe_json["full"] = {{"config", lp.full.ref()},
+                       {"ShinBits", lp.full.rtl.ShinBits},
+                       {"prom_bits", lp.full.rtl.promBits()},
+                       {"n", lp.full.prom.n}};
+  lp.pruned_engine = std::make_unique<ModelSpecEngine>(std::move(t));
+}
+
+// What the scene leaves unused, with the reason for each.
+json PruneCmd::unusedParts(const RenderOptions& ro, const std::vector<LobePrune>& lobes) const {
+  json unused = json::array();
+  const MethodTraits& tr = traits(ro.method);
+  if (tr.exact)
+    unused.push_back({{"part", "span unit"}, {"why", fmt::format("{} shades every pixel directly, without the span unit", method_)}});
+  if (lobes.empty())
+    unused.push_back({{"part", "specular unit"},
+                      {"why", tr.exact ? fmt::format("{} evaluates the lobes exactly, without the unit", method_)
+                                       : "no object's lobe is a device lobe (quadratic or cubic)"}});
+  for (const LobePrune& lp : lobes) {
+    bool lit = false;
+    for (const auto& item : lp.recorder->use()) lit = lit || item.second.light_max > 0;
+    if (!lit)
+      unused.push_back({{"part", fmt::format("specular unit of the {} lobe", toString(lp.lobe))},
+                        {"why", "every request carries light code 0 (k_s = 0 or no light reaches it): its output is never seen"}});
+  }
+  // The span unit's attributes 0..2 carry the colour or the normal, 3 the depth (render.h).
+  const int attrs = spanConfig("serial").rtl.NumAttr;
+  if (attrs > 4)
+    unused.push_back({{"part", fmt::format("span attribute lanes 4..{}", attrs - 1)},
+                      {"why", "the renderer interpolates 4 attributes: 3 of colour or normal and the depth"}});
+  return unused;
+}
+
+int PruneCmd::run(const CLI::App&) {
+  const Scene sc = loadScene(scene_);
+  checkScene(sc);
+  RenderOptions ro;
+  ro.method = parseMethod(method_);
+  ro.brdf = brdf_;
+  // 1. The full configurations, as rendered: every specular request recorded.
+  std::vector<LobePrune> lobes;
+  SpecEngines full_view, rec_view;
+  for (Lobe l : deviceLobesUsed(sc, ro)) {
+    LobePrune lp{l, lobeConfigArg(lobes_, l), {}, nullptr, nullptr, nullptr, {}};
+    lp.full_engine = std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(lp.full.prom), lp.full.rtl));
+    lp.recorder = std::make_unique<RecordingSpecEngine>(*lp.full_engine);
+    (l == Lobe::Cubic ? full_view.cubic : full_view.quadratic) = lp.full_engine.get();
+    (l == Lobe::Cubic ? rec_view.cubic : rec_view.quadratic) = lp.recorder.get();
+    lobes.push_back(std::move(lp));
+  }
+  say(fmt::format("{} with {}: {} device lobe(s)", sc.name, method_, lobes.size()));
+  ModelSpanEngine serial(spanConfig("serial").rtl);
+  const RenderResult full = render(sc, ro, serial, rec_view);
+  // 2. The lane mode with the fewest cycles (none for the exact method: no span unit).
+  std::string best = "serial";
+  const bool uses_span = !traits(ro.method).exact;
+  const json modes = uses_span ? laneModes(sc, ro, full_view, full, best) : json::array();
+  // 3. Per lobe the PROM of the shininess values used.
+  OutputFiles out;
+  json lobes_json = json::array();
+  SpecEngines pruned_view;
+  for (LobePrune& lp : lobes) {
+    for (const auto& [address, u] : lp.recorder->use()) {
+      (void)u;
+      for (const PromEntry& e : lp.full_engine->table().entries)
+        if (e.address == address) lp.n_used.push_back(e.n);
+    }
+    std::sort(lp.n_used.begin(), lp.n_used.end());
+    json lj = {{"lobe", toString(lp.lobe)}, {"requests", shinUseJson(*lp.recorder)}};
+    if (lp.n_used.empty()) continue;
+    prunePromOf(lp, out, lj);
+    (lp.lobe == Lobe::Cubic ? pruned_view.cubic : pruned_view.quadratic) = lp.pruned_engine.get();
+    lobes_json.push_back(lj);
+  }
+  // The material-to-address table the renderer uses (render.cpp: the PROM entry of the rounded
+  // shininess).
+  json materials = json::array();
+  for (const Material& m : sc.materials) {
+    const Lobe l = parseLobe(brdf_.empty() ? m.brdf : brdf_);
+    const LobePrune* lp = nullptr;
+    for (const LobePrune& x : lobes)
+      if (x.lobe == l && x.pruned_engine) lp = &x;
+    materials.push_back({{"material", m.name},
+                         {"shininess", m.shininess},
+                         {"lobe", toString(l)},
+                         {"address", lp ? json(lp->pruned_engine->table().addressOf(std::round(m.shininess))) : json()}});
+  }
+  // 4. The proof: the pruned PROMs in the chosen mode against the full configuration.
+  ModelSpanEngine chosen(spanConfig(best).rtl);
+  const RenderResult pruned = render(sc, ro, chosen, pruned_view);
+  int max_diff = 0;
+  uint64_t differ = 0;
+  for (size_t i = 0; i < full.fb.rgb.size(); ++i) {
+    const int d = std::abs(int(full.fb.rgb[i]) - int(pruned.fb.rgb[i]));
+    max_diff = std::max(max_diff, d);
+    differ += d > 0;
+  }
+  const bool image_ok = max_diff <= target_lsb_;
+  say(fmt::format("pruned against full: max {} LSB ({} channel values differ)", max_diff, differ));
+  json analysis = {{"scene", sc.name},
+                   {"method", method_},
+                   {"brdf", brdf_.empty() ? json() : json(brdf_)},
+                   {"objects", sc.objects.size()},
+                   {"lights", sc.lights.size()},
+                   {"attributes", traits(ro.method).attributes == Attributes::Colour ? "colour" : "normal"},
+                   {"counts", frameCounts(full.stats)},
+                   {"triangles", triangleHistogram(full.triangles)},
+                   {"lobes", lobes_json},
+                   {"materials", materials}};
+  json summary = {{"target_lsb", target_lsb_},
+                  {"lane_modes", modes},
+                  {"chosen_mode", uses_span ? json(best) : json()},
+                  {"unused", unusedParts(ro, lobes)},
+                  {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}}}};
+  out.add((fs::path(dir_) / "analysis.json").string(), analysis.dump(1) + "\n");
+  std::error_code ec;
+  fs::create_directories(fs::path(dir_) / "prom", ec);
+  if (ec) throw std::runtime_error(fmt::format("cannot make {}: {}", (fs::path(dir_) / "prom").string(), ec.message()));
+  out.add((fs::path(dir_) / "prune.json").string(), summary.dump(1) + "\n");
+  out.commit();
+  // 5. The RTL of each pruned configuration, replayed under Icarus (nothing to build).
+  bool rtl_ok = true;
+  for (const LobePrune& lp : lobes) {
+    if (!lp.pruned_engine) continue;
+    try {
+      say(verifyUnderIcarus(lp.pruned.path, kPruneVerifyCycles));
+    } catch (const std::runtime_error& e) {
+      std::fprintf(stderr, "prune: RTL check of %s failed: %s\n", lp.pruned.name.c_str(), e.what());
+      rtl_ok = false;
+    }
+  }
+  std::printf("prune %s (%s): lane mode %s; ", sc.name.c_str(), method_.c_str(), uses_span ? best.c_str() : "none");
+  for (const json& lj : lobes_json)
+    std::printf("%s lobe PROM %lld -> %lld bits; ", lj["lobe"].get<std::string>().c_str(),
+                static_cast<long long>(lj["full"]["prom_bits"].get<int64_t>()),
+                static_cast<long long>(lj["pruned"]["prom_bits"].get<int64_t>()));
+  std::printf("pruned image max %d LSB from the full (target %g)%s\n", max_diff, target_lsb_,
+              image_ok ? "" : ": OVER THE TARGET");
+  return image_ok && rtl_ok ? kExitOk : kExitFailed;
+}
+
+}  // namespace
+
+std::unique_ptr<Command> makePruneCmd() { return std::make_unique<PruneCmd>(); }
+
+}  // namespace shd::cli

@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# prune_test.sh SHADESIM WORK: `shadesim prune` on builtin:materials (phong-fixed, a quadratic and
+# a cubic device lobe), checked from outside: the pruned PROMs hold exactly the shininess values
+# of the materials with those lobes; the chosen lane mode's and serial's cycles are what
+# `shadesim render --json` measures, and no mode has fewer; the scene rendered with the pruned
+# configurations is the same PNG as with the full ones; the material-to-address table is the
+# address map's; and a shininess the pruned PROM does not hold is refused by name.
+set -euo pipefail
+shadesim=$(realpath "$1")
+work=$2
+here=$(cd "$(dirname "$0")" && pwd)
+source "$here/fresh_work.sh"
+fresh_work "$work"
+cd "$work"
+"$shadesim" prune --scene builtin:materials --target-lsb 1 -o p --quiet > prune.out
+cat prune.out
+for f in analysis.json prune.json spec_defaultpruned.json spec_cubicpruned.json spec_defaultpruned.vec \
+         prom/spec_defaultpruned.hex prom/spec_defaultpruned.mem prom/spec_defaultpruned.coe \
+         prom/spec_defaultpruned.mif prom/spec_defaultpruned.csv prom/spec_cubicpruned.hex; do
+  [ -s "p/$f" ] || { echo "prune_test: p/$f missing or empty" >&2; exit 1; }
+done
+mode=$(python3 -c "import json; print(json.load(open('p/prune.json'))['chosen_mode'])")
+for m in "$mode" serial; do
+  "$shadesim" render --scene builtin:materials --method phong-fixed --mode "$m" -o "r_$m.png" --json "r_$m.json" --quiet > /dev/null
+done
+"$shadesim" render --scene builtin:materials --method phong-fixed --mode "$mode" \
+  --quadratic-config p/spec_defaultpruned.json --cubic-config p/spec_cubicpruned.json -o pruned.png --quiet > /dev/null
+cmp "r_$mode.png" pruned.png
+python3 - "$mode" <<'PY'
+import json, sys
+from glob import glob
+mode = sys.argv[1]
+a, p = json.load(open("p/analysis.json")), json.load(open("p/prune.json"))
+def fail(msg):
+    sys.exit("prune_test: " + msg)
+cycles = {m["mode"]: m["span_cycles"] for m in p["lane_modes"]}
+for m in (mode, "serial"):
+    got = json.load(open(f"r_{m}.json"))["cycles"]
+    if cycles[m] != got:
+        fail(f"mode {m}: prune says {cycles[m]} cycles, render --json {got}")
+if min(cycles.values()) != cycles[mode]:
+    fail(f"chosen mode {mode} ({cycles[mode]} cycles) is not the fewest: {cycles}")
+if not p["proof"]["within_target"] or p["proof"]["max_abs_lsb"] != 0:
+    fail(f"proof: {p['proof']}")
+# The scene's materials (scene.cpp builtin:materials): cubic n = 8, quadratic n = 1000.
+want = {"cubic": [8.0], "quadratic": [1000.0]}
+for lobe in a["lobes"]:
+    got = [e["n"] for e in lobe["pruned"]["address_map"]]
+    if got != want[lobe["lobe"]]:
+        fail(f"{lobe['lobe']} lobe: the pruned PROM holds {got}, the scene uses {want[lobe['lobe']]}")
+    if lobe["pruned"]["prom_bits"] >= lobe["full"]["prom_bits"]:
+        fail(f"{lobe['lobe']} lobe: {lobe['pruned']['prom_bits']} bits pruned, {lobe['full']['prom_bits']} full")
+    cfg = json.load(open(f"p/{lobe['pruned']['config']}"))
+    if cfg["prom"]["n_list"] != ",".join(f"{n:g}" for n in want[lobe["lobe"]]):
+        fail(f"{lobe['pruned']['config']}: n_list {cfg['prom']['n_list']}")
+    for m in a["materials"]:
+        if m["lobe"] == lobe["lobe"]:
+            hit = [e for e in lobe["pruned"]["address_map"] if e["address"] == m["address"]]
+            if not hit or hit[0]["n"] != round(m["shininess"]):
+                fail(f"material {m['material']}: address {m['address']} does not hold n = {m['shininess']}")
+print(f"prune_test: lane mode {mode} {cycles[mode]} cycles (serial {cycles['serial']}), PROMs "
+      + ", ".join(f"{l['lobe']} {l['full']['prom_bits']} -> {l['pruned']['prom_bits']} bits" for l in a["lobes"]))
+PY
+# A shininess the pruned PROM does not hold: refused, naming it.
+python3 - <<'PY'
+import json
+s = {"camera": {"eye": [0, 0, -3], "target": [0, 0, 0], "px_per_unit": 128, "width": 128, "height": 128, "z_near": 0.1},
+     "ambient": [0, 0, 0], "lights": [{"type": "directional", "direction": [-1, 1, -1], "colour": [1, 1, 1]}],
+     "materials": [{"name": "m", "colour": "#3070C0", "kd": 1, "ks": 1, "shininess": 77, "brdf": "quadratic"}],
+     "objects": [{"name": "s", "mesh": "builtin:sphere(1,16)", "material": "m"}]}
+json.dump(s, open("n77.json", "w"))
+PY
+status=0
+"$shadesim" render --scene n77.json --method phong-fixed --quadratic-config p/spec_defaultpruned.json -o n77.png --quiet \
+  > /dev/null 2> n77.err || status=$?
+[ "$status" -eq 2 ] && grep -q "shininess 77 is not in the specular unit's PROM" n77.err \
+  || { cat n77.err; echo "prune_test: a shininess outside the pruned PROM: exit $status, not refused by name" >&2; exit 1; }
+echo "prune_test: passed"
