@@ -28,6 +28,7 @@
 #include "render/methods.h"
 #include "report/scene_use.h"
 #include "scene/scene.h"
+#include "sweep/spec_sweep.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -46,7 +47,26 @@ struct LobePrune {
   std::unique_ptr<ModelSpecEngine> full_engine, pruned_engine;
   std::unique_ptr<RecordingSpecEngine> recorder;
   std::vector<double> n_used;  // the shininess values requested, ascending
+  json narrowed = json::array();  // {"width", "from", "to"} per width narrowed
+  json one_less = json::object();  // per width: what one bit fewer breaks
 };
+
+// The largest difference of two frames' channel values (LSB), and how many differ.
+std::pair<int, uint64_t> frameDifference(const RenderResult& a, const RenderResult& b) {
+  int max_diff = 0;
+  uint64_t differ = 0;
+  for (size_t i = 0; i < a.fb.rgb.size(); ++i) {
+    const int d = std::abs(int(a.fb.rgb[i]) - int(b.fb.rgb[i]));
+    max_diff = std::max(max_diff, d);
+    differ += d > 0;
+  }
+  return {max_diff, differ};
+}
+
+// The engine of a lobe's configuration (std::invalid_argument when its coefficients do not fit).
+std::unique_ptr<ModelSpecEngine> engineOf(const SpecUnitConfig& c) {
+  return std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(c.prom), c.rtl));
+}
 
 class PruneCmd final : public Command {
  public:
@@ -65,7 +85,10 @@ class PruneCmd final : public Command {
   void checkScene(const Scene& sc) const;
   json laneModes(const Scene& sc, const RenderOptions& ro, const SpecEngines& full, const RenderResult& ref,
                  std::string& best) const;
-  void prunePromOf(LobePrune& lp, OutputFiles& out, json& lobe_json) const;
+  void prunePromOf(LobePrune& lp) const;
+  void narrowWidths(const Scene& sc, const RenderOptions& ro, const SpanParams& mode, const RenderResult& full,
+                    std::vector<LobePrune>& lobes) const;
+  void writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_json) const;
   json unusedParts(const RenderOptions& ro, const std::vector<LobePrune>& lobes) const;
 };
 
@@ -128,9 +151,9 @@ json PruneCmd::laneModes(const Scene& sc, const RenderOptions& ro, const SpecEng
   return modes;
 }
 
-// The lobe's PROM with only the shininess values the scene requested: the pruned configuration,
-// its PROM in every format, the address map. Into `out` and `lobe_json`.
-void PruneCmd::prunePromOf(LobePrune& lp, OutputFiles& out, json& lobe_json) const {
+// The lobe's configuration with only the shininess values the scene requested in its PROM, in
+// ascending order, at the least ShinBits that addresses them.
+void PruneCmd::prunePromOf(LobePrune& lp) const {
   std::vector<std::string> n_text;
   for (double n : lp.n_used) n_text.push_back(fmt::format("{}", n));
   lp.pruned = lp.full;
@@ -140,13 +163,67 @@ void PruneCmd::prunePromOf(LobePrune& lp, OutputFiles& out, json& lobe_json) con
   lp.pruned.prom.is_list = true;
   lp.pruned.rtl.ShinBits = addressBitsFor(lp.n_used.size());
   lp.pruned.rtl.validate();
-  PromTable t = buildPromTable(PromRequest::fromContent(lp.pruned.prom), lp.pruned.rtl);
+  lp.pruned_engine = engineOf(lp.pruned);
+}
+
+// Each internal width of each lobe's unit (the sweep's list for its kind) one bit narrower at a
+// time while the scene's image, rendered in the chosen mode, stays within E of the full
+// configuration's; until no width can lose a bit. Records what one bit fewer breaks per width.
+void PruneCmd::narrowWidths(const Scene& sc, const RenderOptions& ro, const SpanParams& mode, const RenderResult& full,
+                            std::vector<LobePrune>& lobes) const {
+  ModelSpanEngine span(mode);
+  auto view = [&] {
+    SpecEngines v;
+    for (LobePrune& lp : lobes) (lp.lobe == Lobe::Cubic ? v.cubic : v.quadratic) = lp.pruned_engine.get();
+    return v;
+  };
+  for (LobePrune& lp : lobes) {
+    const std::vector<std::string> widths = specSweepUnit(specSweepBase(lp.pruned.name, lp.pruned.rtl, lp.pruned.prom)).widths;
+    for (bool stepped = true; stepped;) {
+      stepped = false;
+      for (const std::string& w : widths) {
+        SpecUnitConfig c = lp.pruned;
+        json rtl = c.rtl.toJson();
+        rtl[w] = rtl[w].get<int>() - 1;
+        std::unique_ptr<ModelSpecEngine> e;
+        try {
+          c.rtl = SpecUnitParams::fromJson(rtl, c.name);
+          c.rtl.validate();
+          e = engineOf(c);
+        } catch (const std::invalid_argument& ex) {
+          lp.one_less[w] = {{"breaks", ex.what()}};
+          continue;
+        }
+        std::swap(lp.pruned_engine, e);
+        const auto [max_diff, differ] = frameDifference(full, render(sc, ro, span, view()));
+        if (max_diff > target_lsb_) {
+          std::swap(lp.pruned_engine, e);  // back
+          lp.one_less[w] = {{"breaks", fmt::format("the image is {} LSB from the full one's ({} values differ)", max_diff, differ)}};
+          continue;
+        }
+        lp.pruned = c;
+        stepped = true;
+      }
+    }
+    for (const std::string& w : widths) {
+      const int from = lp.full.rtl.toJson()[w].get<int>(), to = lp.pruned.rtl.toJson()[w].get<int>();
+      if (from != to) lp.narrowed.push_back({{"width", w}, {"from", from}, {"to", to}});
+    }
+    std::vector<std::string> steps;
+    for (const json& n : lp.narrowed)
+      steps.push_back(fmt::format("{} {} -> {}", n["width"].get<std::string>(), n["from"].get<int>(), n["to"].get<int>()));
+    say(fmt::format("{}: {}", lp.pruned.name, steps.empty() ? "no width can lose a bit" : fmt::format("{}", fmt::join(steps, ", "))));
+  }
+}
+
+// The pruned configuration and its PROM in every format into `out`, its figures into `lobe_json`.
+void PruneCmd::writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_json) const {
+  const PromTable& t = lp.pruned_engine->table();
   const std::string stem = "spec_" + lp.pruned.name;
   const json cfg = {{"name", lp.pruned.name},
                     {"description", lp.pruned.description},
                     {"rtl", lp.pruned.rtl.toJson()},
                     {"prom", {{"fit", lp.pruned.prom.fit}, {"level", lp.pruned.prom.level}, {"n_list", lp.pruned.prom.n}}}};
-  lp.pruned.path = (fs::path(dir_) / (stem + ".json")).string();
   out.add(lp.pruned.path, cfg.dump(2) + "\n");
   for (PromFormat f : {PromFormat::Hex, PromFormat::Mem, PromFormat::Coe, PromFormat::Mif, PromFormat::Csv})
     for (const auto& [suffix, text] : renderPromFiles(t, f))
@@ -154,14 +231,17 @@ void PruneCmd::prunePromOf(LobePrune& lp, OutputFiles& out, json& lobe_json) con
   json map = json::array();
   for (const PromEntry& e : t.entries) map.push_back({{"address", e.address}, {"n", e.n}});
   lobe_json["pruned"] = {{"config", stem + ".json"},
+                         {"rtl", lp.pruned.rtl.toJson()},
                          {"ShinBits", lp.pruned.rtl.ShinBits},
                          {"prom_bits", lp.pruned.rtl.promBits()},
+                         {"narrowed", lp.narrowed},
+                         {"one_bit_narrower", lp.one_less},
                          {"address_map", map}};
   lobe_json["full"] = {{"config", lp.full.ref()},
+                       {"rtl", lp.full.rtl.toJson()},
                        {"ShinBits", lp.full.rtl.ShinBits},
                        {"prom_bits", lp.full.rtl.promBits()},
                        {"n", lp.full.prom.n}};
-  lp.pruned_engine = std::make_unique<ModelSpecEngine>(std::move(t));
 }
 
 // What the scene leaves unused, with the reason for each.
@@ -213,20 +293,24 @@ int PruneCmd::run(const CLI::App&) {
   std::string best = "serial";
   const bool uses_span = !traits(ro.method).exact;
   const json modes = uses_span ? laneModes(sc, ro, full_view, full, best) : json::array();
-  // 3. Per lobe the PROM of the shininess values used.
+  // 3. Per lobe the PROM of the shininess values used, then its widths narrowed within E.
+  for (LobePrune& lp : lobes) {
+    for (const auto& item : lp.recorder->use())
+      for (const PromEntry& e : lp.full_engine->table().entries)
+        if (e.address == item.first) lp.n_used.push_back(e.n);
+    std::sort(lp.n_used.begin(), lp.n_used.end());
+    if (!lp.n_used.empty()) prunePromOf(lp);
+  }
+  lobes.erase(std::remove_if(lobes.begin(), lobes.end(), [](const LobePrune& lp) { return lp.n_used.empty(); }), lobes.end());
+  const SpanParams mode = spanConfig(best).rtl;
+  narrowWidths(sc, ro, mode, full, lobes);
   OutputFiles out;
   json lobes_json = json::array();
   SpecEngines pruned_view;
   for (LobePrune& lp : lobes) {
-    for (const auto& [address, u] : lp.recorder->use()) {
-      (void)u;
-      for (const PromEntry& e : lp.full_engine->table().entries)
-        if (e.address == address) lp.n_used.push_back(e.n);
-    }
-    std::sort(lp.n_used.begin(), lp.n_used.end());
     json lj = {{"lobe", toString(lp.lobe)}, {"requests", shinUseJson(*lp.recorder)}};
-    if (lp.n_used.empty()) continue;
-    prunePromOf(lp, out, lj);
+    lp.pruned.path = (fs::path(dir_) / ("spec_" + lp.pruned.name + ".json")).string();
+    writePruned(lp, out, lj);
     (lp.lobe == Lobe::Cubic ? pruned_view.cubic : pruned_view.quadratic) = lp.pruned_engine.get();
     lobes_json.push_back(lj);
   }
@@ -235,24 +319,15 @@ int PruneCmd::run(const CLI::App&) {
   json materials = json::array();
   for (const Material& m : sc.materials) {
     const Lobe l = parseLobe(brdf_.empty() ? m.brdf : brdf_);
-    const LobePrune* lp = nullptr;
-    for (const LobePrune& x : lobes)
-      if (x.lobe == l && x.pruned_engine) lp = &x;
+    const auto lp = std::find_if(lobes.begin(), lobes.end(), [&](const LobePrune& x) { return x.lobe == l; });
     materials.push_back({{"material", m.name},
                          {"shininess", m.shininess},
                          {"lobe", toString(l)},
-                         {"address", lp ? json(lp->pruned_engine->table().addressOf(std::round(m.shininess))) : json()}});
+                         {"address", lp != lobes.end() ? json(lp->pruned_engine->table().addressOf(std::round(m.shininess))) : json()}});
   }
-  // 4. The proof: the pruned PROMs in the chosen mode against the full configuration.
-  ModelSpanEngine chosen(spanConfig(best).rtl);
-  const RenderResult pruned = render(sc, ro, chosen, pruned_view);
-  int max_diff = 0;
-  uint64_t differ = 0;
-  for (size_t i = 0; i < full.fb.rgb.size(); ++i) {
-    const int d = std::abs(int(full.fb.rgb[i]) - int(pruned.fb.rgb[i]));
-    max_diff = std::max(max_diff, d);
-    differ += d > 0;
-  }
+  // 4. The proof: the pruned configurations in the chosen mode against the full ones.
+  ModelSpanEngine chosen(mode);
+  const auto [max_diff, differ] = frameDifference(full, render(sc, ro, chosen, pruned_view));
   const bool image_ok = max_diff <= target_lsb_;
   say(fmt::format("pruned against full: max {} LSB ({} channel values differ)", max_diff, differ));
   json analysis = {{"scene", sc.name},
