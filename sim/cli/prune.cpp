@@ -89,7 +89,7 @@ class PruneCmd final : public Command {
   void narrowWidths(const Scene& sc, const RenderOptions& ro, const SpanParams& mode, const RenderResult& full,
                     std::vector<LobePrune>& lobes) const;
   void writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_json) const;
-  json unusedParts(const RenderOptions& ro, const std::vector<LobePrune>& lobes) const;
+  json unusedParts(const RenderOptions& ro, const SpanParams& mode, const std::vector<LobePrune>& lobes) const;
 };
 
 void PruneCmd::add(CLI::App& app) {
@@ -245,7 +245,7 @@ void PruneCmd::writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_jso
 }
 
 // What the scene leaves unused, with the reason for each.
-json PruneCmd::unusedParts(const RenderOptions& ro, const std::vector<LobePrune>& lobes) const {
+json PruneCmd::unusedParts(const RenderOptions& ro, const SpanParams& mode, const std::vector<LobePrune>& lobes) const {
   json unused = json::array();
   const MethodTraits& tr = traits(ro.method);
   if (tr.exact)
@@ -253,7 +253,7 @@ json PruneCmd::unusedParts(const RenderOptions& ro, const std::vector<LobePrune>
   if (lobes.empty())
     unused.push_back({{"part", "specular unit"},
                       {"why", tr.exact ? fmt::format("{} evaluates the lobes exactly, without the unit", method_)
-                                       : "no object's lobe is a device lobe (quadratic or cubic)"}});
+                                       : "no visible object has a device lobe (quadratic or cubic): the unit gets no request"}});
   for (const LobePrune& lp : lobes) {
     bool lit = false;
     for (const auto& item : lp.recorder->use()) lit = lit || item.second.light_max > 0;
@@ -262,7 +262,7 @@ json PruneCmd::unusedParts(const RenderOptions& ro, const std::vector<LobePrune>
                         {"why", "every request carries light code 0 (k_s = 0 or no light reaches it): its output is never seen"}});
   }
   // The span unit's attributes 0..2 carry the colour or the normal, 3 the depth (render.h).
-  const int attrs = spanConfig("serial").rtl.NumAttr;
+  const int attrs = mode.NumAttr;
   if (attrs > 4)
     unused.push_back({{"part", fmt::format("span attribute lanes 4..{}", attrs - 1)},
                       {"why", "the renderer interpolates 4 attributes: 3 of colour or normal and the depth"}});
@@ -343,7 +343,7 @@ int PruneCmd::run(const CLI::App&) {
   json summary = {{"target_lsb", target_lsb_},
                   {"lane_modes", modes},
                   {"chosen_mode", uses_span ? json(best) : json()},
-                  {"unused", unusedParts(ro, lobes)},
+                  {"unused", unusedParts(ro, mode, lobes)},
                   {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}}}};
   out.add((fs::path(dir_) / "analysis.json").string(), analysis.dump(1) + "\n");
   std::error_code ec;
