@@ -16,6 +16,7 @@ cd "$work"
 "$shadesim" prune --scene builtin:materials --target-lsb 1 -o p --quiet > prune.out
 cat prune.out
 for f in analysis.json prune.json spec_defaultpruned.json spec_cubicpruned.json spec_defaultpruned.vec \
+         spec_defaultpruned.frame.vec spec_cubicpruned.frame.vec \
          prom/spec_defaultpruned.hex prom/spec_defaultpruned.mem prom/spec_defaultpruned.coe \
          prom/spec_defaultpruned.mif prom/spec_defaultpruned.csv prom/spec_cubicpruned.hex; do
   [ -s "p/$f" ] || { echo "prune_test: p/$f missing or empty" >&2; exit 1; }
@@ -51,6 +52,14 @@ pruned = matplotlib.image.imread("pruned.png")
 diff = int(round(abs(full.astype(float) - pruned.astype(float)).max() * 255))
 if diff > 1 or diff != p["proof"]["max_abs_lsb"] or not p["proof"]["within_target"]:
     fail(f"the pruned image is {diff} LSB from the full one; prune's proof says {p['proof']}")
+# The RTL: the chosen mode's verilated span unit in the loop, each pruned unit under Icarus on
+# every distinct request of the frame.
+rtl = p["proof"]["rtl"]
+if rtl["span"] != {"config": mode, "image_equal": True, "span_cycles": cycles[mode], "cycles_equal": True}:
+    fail(f"the span unit in the loop: {rtl['span']}")
+if sorted(e["config"] for e in rtl["spec"]) != ["cubicpruned", "defaultpruned"] or \
+        any(e["icarus"] != "equal" or e["frame_requests"] < 100 for e in rtl["spec"]):
+    fail(f"the pruned specular units under Icarus: {rtl['spec']}")
 # The scene's materials (scene.cpp builtin:materials): cubic n = 8, quadratic n = 1000.
 want = {"cubic": [8.0], "quadratic": [1000.0]}
 for lobe in a["lobes"]:

@@ -8,8 +8,22 @@
 
 namespace shd {
 
+std::vector<SpecRequest> RecordingSpecEngine::distinctRequests() const {
+  std::vector<SpecRequest> out;
+  out.reserve(inputs_.size());
+  for (const auto& k : inputs_) {
+    SpecRequest r;
+    r.shin = k[0];
+    r.cos = k[1];
+    r.light = {k[2], k[3], k[4]};
+    out.push_back(r);
+  }
+  return out;
+}
+
 uint64_t RecordingSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) {
   for (const SpecRequest& r : in) {
+    if (keep_) inputs_.insert({r.shin, r.cos, r.light[0], r.light[1], r.light[2]});
     ShinUse& u = use_[r.shin];
     ++u.requests;
     u.cos_min = std::min(u.cos_min, r.cos);

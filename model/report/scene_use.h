@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -29,14 +30,19 @@ struct ShinUse {
 // renders the same image as the model's memo (test Render.PhongFixedMemoEqualsTheBatchedRequests).
 class RecordingSpecEngine final : public SpecEngine {
  public:
-  explicit RecordingSpecEngine(SpecEngine& inner) : inner_(inner) {}
+  // keep_inputs: also keep every distinct request (distinctRequests()).
+  explicit RecordingSpecEngine(SpecEngine& inner, bool keep_inputs = false) : inner_(inner), keep_(keep_inputs) {}
   const PromTable& table() const override { return inner_.table(); }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
   const std::map<uint32_t, ShinUse>& use() const { return use_; }
+  // The distinct requests seen (with keep_inputs), ordered by address, cosine, then light.
+  std::vector<SpecRequest> distinctRequests() const;
 
  private:
   SpecEngine& inner_;
-  std::map<uint32_t, ShinUse> use_;  // by PROM address
+  bool keep_;
+  std::map<uint32_t, ShinUse> use_;      // by PROM address
+  std::set<std::array<uint32_t, 5>> inputs_;  // {shin, cos, light} (keep_)
 };
 
 // {"address", "n", "requests", "unlit", "cos_code_min", "cos_code_max", "cos_code_max_lit",

@@ -21,6 +21,8 @@
 #include "cli/options.h"
 #include "cli/render_common.h"
 #include "cli/sweep_target.h"
+#include "cosim/render_rtl.h"
+#include "harness/span_dut.h"
 #include "device/prom.h"
 #include "device/prom_io.h"
 #include "io/files.h"
@@ -29,6 +31,7 @@
 #include "report/scene_use.h"
 #include "scene/scene.h"
 #include "sweep/spec_sweep.h"
+#include "vectors/vector_gen.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -42,10 +45,10 @@ constexpr uint64_t kPruneVerifyCycles = 20000;  // the Icarus replay of each pru
 // One device lobe of the scene: its full configuration, what the scene asked of it, its pruned
 // PROM.
 struct LobePrune {
-  Lobe lobe;
+  Lobe lobe = Lobe::Quadratic;
   SpecUnitConfig full, pruned;
   std::unique_ptr<ModelSpecEngine> full_engine, pruned_engine;
-  std::unique_ptr<RecordingSpecEngine> recorder;
+  std::unique_ptr<RecordingSpecEngine> recorder, pruned_recorder;  // the full frame's, the pruned frame's
   std::vector<double> n_used;  // the shininess values requested, ascending
   json narrowed = json::array();  // {"width", "from", "to"} per width narrowed
   json one_less = json::object();  // per width: what one bit fewer breaks
@@ -89,6 +92,8 @@ class PruneCmd final : public Command {
   void narrowWidths(const Scene& sc, const RenderOptions& ro, const SpanParams& mode, const RenderResult& full,
                     std::vector<LobePrune>& lobes) const;
   void writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_json) const;
+  json rtlProof(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& mode, const RenderResult& pruned,
+                const SpecEngines& pruned_engines, const std::vector<LobePrune>& lobes, bool& ok) const;
   json unusedParts(const RenderOptions& ro, const SpanParams& mode, const std::vector<LobePrune>& lobes) const;
 };
 
@@ -244,6 +249,53 @@ void PruneCmd::writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_jso
                        {"n", lp.full.prom.n}};
 }
 
+// The pruned frame on the RTL, with nothing to build. The span unit of the chosen lane mode (a
+// registry configuration, verilated into this program) renders the frame with the pruned
+// specular models: image and cycles must equal the model's. Each pruned specular unit, whose
+// parameters no verilated model has, is simulated by Icarus with the configuration's parameters:
+// a vector file of every distinct request of the frame (<config>.frame.vec: the unit's outputs
+// are all the frame takes from it), then one of seeded random vectors with gaps (<config>.vec).
+json PruneCmd::rtlProof(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& mode, const RenderResult& pruned,
+                        const SpecEngines& pruned_engines, const std::vector<LobePrune>& lobes, bool& ok) const {
+  json rtl = {{"span", json()}, {"spec", json::array()}};
+  auto fail = [&](const std::string& what, const std::string& why) {
+    std::fprintf(stderr, "prune: RTL check of %s failed: %s\n", what.c_str(), why.c_str());
+    ok = false;
+    return why;
+  };
+  if (!mode.name.empty()) {
+    try {
+      requireVerilated(mode);
+      RtlSpanEngine span(mode, dir_);
+      const RenderResult r = render(sc, ro, span, pruned_engines);
+      const bool same = r.fb.rgb == pruned.fb.rgb && r.stats.span_cycles == pruned.stats.span_cycles;
+      rtl["span"] = {{"config", mode.name}, {"image_equal", r.fb.rgb == pruned.fb.rgb},
+                     {"span_cycles", r.stats.span_cycles}, {"cycles_equal", r.stats.span_cycles == pruned.stats.span_cycles}};
+      if (!same) fail("span:" + mode.name, "the frame with the verilated span unit differs from the model's");
+      say(fmt::format("span:{} in the loop: {} cycles, image {}", mode.name, r.stats.span_cycles, same ? "equal" : "DIFFERENT"));
+    } catch (const std::exception& e) {
+      rtl["span"] = {{"config", mode.name}, {"error", fail("span:" + mode.name, e.what())}};
+    }
+  }
+  for (const LobePrune& lp : lobes) {
+    std::vector<SpecIn> inputs;
+    for (const SpecRequest& r : lp.pruned_recorder->distinctRequests()) inputs.push_back(SpecIn{true, r.shin, r.cos, r.light});
+    const std::string vec = fs::path(lp.pruned.path).replace_extension(".frame.vec").string();
+    json entry = {{"config", lp.pruned.name}, {"frame_requests", inputs.size()}};
+    try {
+      writeSpecInputVectorsWithProm(lp.pruned, inputs, fmt::format("shadesim prune: the distinct requests of {}", sc.name), vec);
+      replayUnderIcarus(vec);
+      say(fmt::format("Icarus replayed {} ({} distinct requests of the frame): every output matches the model", vec, inputs.size()));
+      say(verifyUnderIcarus(lp.pruned.path, kPruneVerifyCycles));
+      entry["icarus"] = "equal";
+    } catch (const std::runtime_error& e) {
+      entry["icarus"] = fail(lp.pruned.name, e.what());
+    }
+    rtl["spec"].push_back(entry);
+  }
+  return rtl;
+}
+
 // What the scene leaves unused, with the reason for each.
 json PruneCmd::unusedParts(const RenderOptions& ro, const SpanParams& mode, const std::vector<LobePrune>& lobes) const {
   json unused = json::array();
@@ -279,7 +331,9 @@ int PruneCmd::run(const CLI::App&) {
   std::vector<LobePrune> lobes;
   SpecEngines full_view, rec_view;
   for (Lobe l : deviceLobesUsed(sc, ro)) {
-    LobePrune lp{l, lobeConfigArg(lobes_, l), {}, nullptr, nullptr, nullptr, {}};
+    LobePrune lp;
+    lp.lobe = l;
+    lp.full = lobeConfigArg(lobes_, l);
     lp.full_engine = std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(lp.full.prom), lp.full.rtl));
     lp.recorder = std::make_unique<RecordingSpecEngine>(*lp.full_engine);
     (l == Lobe::Cubic ? full_view.cubic : full_view.quadratic) = lp.full_engine.get();
@@ -325,9 +379,16 @@ int PruneCmd::run(const CLI::App&) {
                          {"lobe", toString(l)},
                          {"address", lp != lobes.end() ? json(lp->pruned_engine->table().addressOf(std::round(m.shininess))) : json()}});
   }
-  // 4. The proof: the pruned configurations in the chosen mode against the full ones.
+  // 4. The proof: the pruned configurations in the chosen mode against the full ones, every
+  // distinct specular request of that frame kept for the RTL.
+  SpecEngines rec_pruned;
+  for (LobePrune& lp : lobes) {
+    lp.pruned_recorder = std::make_unique<RecordingSpecEngine>(*lp.pruned_engine, true);
+    (lp.lobe == Lobe::Cubic ? rec_pruned.cubic : rec_pruned.quadratic) = lp.pruned_recorder.get();
+  }
   ModelSpanEngine chosen(mode);
-  const auto [max_diff, differ] = frameDifference(full, render(sc, ro, chosen, pruned_view));
+  const RenderResult pruned = render(sc, ro, chosen, rec_pruned);
+  const auto [max_diff, differ] = frameDifference(full, pruned);
   const bool image_ok = max_diff <= target_lsb_;
   say(fmt::format("pruned against full: max {} LSB ({} channel values differ)", max_diff, differ));
   json analysis = {{"scene", sc.name},
@@ -340,28 +401,21 @@ int PruneCmd::run(const CLI::App&) {
                    {"triangles", triangleHistogram(full.triangles)},
                    {"lobes", lobes_json},
                    {"materials", materials}};
-  json summary = {{"target_lsb", target_lsb_},
-                  {"lane_modes", modes},
-                  {"chosen_mode", uses_span ? json(best) : json()},
-                  {"unused", unusedParts(ro, mode, lobes)},
-                  {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}}}};
+  // 5. The RTL (nothing to build): the chosen mode's span unit in the loop, each pruned specular
+  // unit under Icarus on the frame's requests and on seeded random vectors.
   out.add((fs::path(dir_) / "analysis.json").string(), analysis.dump(1) + "\n");
   std::error_code ec;
   fs::create_directories(fs::path(dir_) / "prom", ec);
   if (ec) throw std::runtime_error(fmt::format("cannot make {}: {}", (fs::path(dir_) / "prom").string(), ec.message()));
-  out.add((fs::path(dir_) / "prune.json").string(), summary.dump(1) + "\n");
   out.commit();
-  // 5. The RTL of each pruned configuration, replayed under Icarus (nothing to build).
   bool rtl_ok = true;
-  for (const LobePrune& lp : lobes) {
-    if (!lp.pruned_engine) continue;
-    try {
-      say(verifyUnderIcarus(lp.pruned.path, kPruneVerifyCycles));
-    } catch (const std::runtime_error& e) {
-      std::fprintf(stderr, "prune: RTL check of %s failed: %s\n", lp.pruned.name.c_str(), e.what());
-      rtl_ok = false;
-    }
-  }
+  const json rtl = rtlProof(sc, ro, uses_span ? spanConfig(best) : SpanUnitConfig{}, pruned, rec_pruned, lobes, rtl_ok);
+  json summary = {{"target_lsb", target_lsb_},
+                  {"lane_modes", modes},
+                  {"chosen_mode", uses_span ? json(best) : json()},
+                  {"unused", unusedParts(ro, mode, lobes)},
+                  {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}, {"rtl", rtl}}}};
+  writeFileAtomic((fs::path(dir_) / "prune.json").string(), summary.dump(1) + "\n");
   std::printf("prune %s (%s): lane mode %s; ", sc.name.c_str(), method_.c_str(), uses_span ? best.c_str() : "none");
   for (const json& lj : lobes_json)
     std::printf("%s lobe PROM %lld -> %lld bits; ", lj["lobe"].get<std::string>().c_str(),

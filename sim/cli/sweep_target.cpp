@@ -116,14 +116,10 @@ void printNarrower(const nlohmann::json& narrower) {
 
 }  // namespace
 
-std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles) {
+void replayUnderIcarus(const std::string& vec) {
   const std::string script = findShareFile("testbench/icarus/run_icarus.sh");
   if (script.empty())
     throw std::runtime_error("testbench/icarus/run_icarus.sh is neither in this installation nor in the source tree");
-  const SpecUnitConfig cfg = specConfig(config_file);
-  const std::string vec = fs::path(config_file).replace_extension(".vec").string();
-  VectorGenSummary s;
-  writeSpecVectorsWithProm(cfg, cycles, kVerifySeed, vec, &s);
   std::string out, err, error;
   const int rc = runProcess({script, vec}, out, err, error);
   if (rc != 0) {
@@ -131,6 +127,14 @@ std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles) {
     if (said.size() > 1200) said = "..." + said.substr(said.size() - 1200);
     throw std::runtime_error(fmt::format("{} {}: {}\n{}", script, vec, rc < 0 ? error : fmt::format("exit {}", rc), said));
   }
+}
+
+std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles) {
+  const SpecUnitConfig cfg = specConfig(config_file);
+  const std::string vec = fs::path(config_file).replace_extension(".vec").string();
+  VectorGenSummary s;
+  writeSpecVectorsWithProm(cfg, cycles, kVerifySeed, vec, &s);
+  replayUnderIcarus(vec);
   return fmt::format("Icarus replayed {} ({} cycles, {} valid inputs, seed {}): every output matches the model",
                      vec, s.cycles, s.valid_inputs, kVerifySeed);
 }

@@ -32,5 +32,8 @@ int runTarget(const std::string& dir, const SweepPlan& plan, const SweepUnit& un
 // run_icarus.sh, the configuration's parameters: nothing to build). Returns the verdict line;
 // std::runtime_error when Icarus reports a mismatch or cannot run.
 std::string verifyUnderIcarus(const std::string& config_file, uint64_t cycles);
+// Replays a vector file under Icarus (its '# config' line gives the parameters); std::runtime_error
+// when Icarus reports a mismatch or cannot run.
+void replayUnderIcarus(const std::string& vec);
 
 }  // namespace shd::cli

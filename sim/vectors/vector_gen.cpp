@@ -30,16 +30,55 @@ std::string VectorGenSummary::text() const {
 
 // ------------------------------------------------------------------ spec
 
-void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& output,
-                              VectorGenSummary* summary) {
+namespace {
+
+// `output` (the vector file `make(prom_file, out_dir)` gives) and the configuration's PROM beside
+// it as `output`.hex, written together.
+void writeWithProm(const SpecUnitConfig& cfg, const std::string& output,
+                   const std::function<SpecVectors(const std::string&, const std::string&)>& make) {
   const std::string prom_file = output + ".hex";
   OutputFiles files;
   const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
   for (const auto& [suffix, text] : renderPromFiles(table, PromFormat::Hex)) files.add(prom_file + suffix, text);
-  files.add(output, renderSpecVectors(generateSpecVectors(cfg, cycles, seed, prom_file,
-                                                          std::filesystem::absolute(output).parent_path().string(),
-                                                          summary)));
+  files.add(output, renderSpecVectors(make(prom_file, std::filesystem::absolute(output).parent_path().string())));
   files.commit();
+}
+
+// A vector file's header fields: the configuration, its parameters, the PROM relative to out_dir.
+SpecVectors specVectorsHeader(const SpecUnitConfig& cfg, const std::string& prom_file, const std::string& out_dir) {
+  SpecVectors v;
+  v.config = cfg.name;
+  v.params = cfg.rtl;
+  v.prom = fs::absolute(prom_file).lexically_normal().lexically_relative(fs::absolute(out_dir).lexically_normal())
+               .generic_string();
+  return v;
+}
+
+}  // namespace
+
+void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& output,
+                              VectorGenSummary* summary) {
+  writeWithProm(cfg, output, [&](const std::string& prom_file, const std::string& out_dir) {
+    return generateSpecVectors(cfg, cycles, seed, prom_file, out_dir, summary);
+  });
+}
+
+void writeSpecInputVectorsWithProm(const SpecUnitConfig& cfg, const std::vector<SpecIn>& inputs,
+                                   const std::string& source, const std::string& output) {
+  writeWithProm(cfg, output, [&](const std::string& prom_file, const std::string& out_dir) {
+    SpecVectors v = specVectorsHeader(cfg, prom_file, out_dir);
+    v.source = source;
+    const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
+    SpecUnitModel model(cfg.rtl, table.words, table.seg_words);
+    model.reset();
+    std::vector<SpecIn> stream = inputs;
+    stream.resize(inputs.size() + static_cast<size_t>(cfg.rtl.latency()));  // idle: the last results leave
+    for (const SpecIn& in : stream) {
+      v.in.push_back(in);
+      v.expected.push_back(model.tick(in));
+    }
+    return v;
+  });
 }
 
 void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& prom_file) {
@@ -54,15 +93,10 @@ void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& pro
 
 SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& prom_file,
                                 const std::string& out_dir, VectorGenSummary* summary) {
-  const std::string& config = cfg.name;
   const SpecUnitParams& p = cfg.rtl;
   const PromTable table = buildPromTable(PromRequest::fromContent(cfg.prom), p);
 
-  SpecVectors v;
-  v.config = config;
-  v.params = p;
-  v.prom = fs::absolute(prom_file).lexically_normal().lexically_relative(fs::absolute(out_dir).lexically_normal())
-               .generic_string();
+  SpecVectors v = specVectorsHeader(cfg, prom_file, out_dir);
   v.source = fmt::format("shadesim vectors --unit spec --config {} --cycles {} --seed {}", cfg.ref(), cycles, seed);
 
   // The corners, valid on every cycle.

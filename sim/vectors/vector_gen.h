@@ -29,6 +29,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "config/registry.h"
 #include "vectors/vector_file.h"
@@ -53,6 +54,10 @@ SpecVectors generateSpecVectors(const SpecUnitConfig& cfg, uint64_t cycles, uint
 // header refers to), written together (io/files.h OutputFiles: both or neither).
 void writeSpecVectorsWithProm(const SpecUnitConfig& cfg, uint64_t cycles, uint64_t seed, const std::string& output,
                               VectorGenSummary* summary = nullptr);
+// The same with the given inputs, one per cycle, then idle cycles until every result has left
+// (latency()); `source` is the header's "# source" (how the inputs were made).
+void writeSpecInputVectorsWithProm(const SpecUnitConfig& cfg, const std::vector<SpecIn>& inputs,
+                                   const std::string& source, const std::string& output);
 // `prom_file` must hold exactly the configuration's table: the expected outputs depend on it
 // (std::runtime_error naming the first differing address otherwise).
 void requirePromFileHoldsTable(const SpecUnitConfig& cfg, const std::string& prom_file);
