@@ -13,7 +13,7 @@ here=$(cd "$(dirname "$0")" && pwd)
 source "$here/fresh_work.sh"
 fresh_work "$work"
 cd "$work"
-"$shadesim" prune --scene builtin:materials --target-lsb 1 -o p --quiet > prune.out
+"$shadesim" prune --scene builtin:materials --target-lsb 1 --no-hardware -o p --quiet > prune.out
 cat prune.out
 for f in analysis.json prune.json spec_defaultpruned.json spec_cubicpruned.json spec_defaultpruned.vec \
          spec_defaultpruned.frame.vec spec_cubicpruned.frame.vec \

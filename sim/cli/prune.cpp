@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/command.h"
+#include "cli/hardware.h"
 #include "cli/options.h"
 #include "cli/render_common.h"
 #include "cli/sweep_target.h"
@@ -78,9 +79,11 @@ class PruneCmd final : public Command {
 
  private:
   std::string scene_ = "builtin:sphere", dir_, method_ = "phong-fixed", brdf_;
+  std::string hardware_cache_;
+  std::vector<std::string> pnr_devices_;
   LobeConfigs lobes_;
   double target_lsb_ = 0;
-  bool quiet_ = false;
+  bool quiet_ = false, no_hardware_ = false;
 
   void say(const std::string& m) const {
     if (!quiet_) std::fprintf(stderr, "prune: %s\n", m.c_str());
@@ -92,6 +95,7 @@ class PruneCmd final : public Command {
   void narrowWidths(const Scene& sc, const RenderOptions& ro, const SpanParams& mode, const RenderResult& full,
                     std::vector<LobePrune>& lobes) const;
   void writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_json) const;
+  json hardwareFigures(const std::vector<LobePrune>& lobes, Hardware& hw) const;
   json rtlProof(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& mode, const RenderResult& pruned,
                 const SpecEngines& pruned_engines, const std::vector<LobePrune>& lobes, bool& ok) const;
   json unusedParts(const RenderOptions& ro, const SpanParams& mode, const std::vector<LobePrune>& lobes) const;
@@ -119,6 +123,17 @@ void PruneCmd::add(CLI::App& app) {
       ->required()
       ->check(realIn(0, 255));
   app.add_option("-o,--output", dir_, "the directory written (made if missing; its parent must exist)")->required();
+  app.add_option("--hardware-cache", hardware_cache_,
+                 "where the yosys area and nextpnr place and route of each configuration are kept (as for report)");
+  std::vector<std::string> device_names;
+  for (const PnrDevice& d : pnrDevices()) device_names.push_back(d.name);
+  app.add_option("--pnr-devices", pnr_devices_,
+                 fmt::format("the iCE40 devices each unit is placed on, comma-separated (default: {})", fmt::join(device_names, ",")))
+      ->delimiter(',')
+      ->check(CLI::IsMember(device_names));
+  app.add_flag("--no-hardware", no_hardware_, "no area and no place and route of the full and pruned units")
+      ->excludes("--hardware-cache")
+      ->excludes("--pnr-devices");
   app.add_flag("--quiet", quiet_, "no progress on stderr");
 }
 
@@ -296,6 +311,27 @@ json PruneCmd::rtlProof(const Scene& sc, const RenderOptions& ro, const SpanUnit
   return rtl;
 }
 
+// The area (yosys, iCE40 and xc7) and the place and route (nextpnr) of each lobe's full and
+// pruned configuration, computed in parallel, kept in the cache: {"spec": {<config>: {"area",
+// "pnr"}}, "absent": [...]}.
+json PruneCmd::hardwareFigures(const std::vector<LobePrune>& lobes, Hardware& hw) const {
+  json units = {{"spec", json::object()}};
+  std::vector<HardwareJob> jobs;
+  for (const LobePrune& lp : lobes)
+    for (const auto* e : {lp.full_engine.get(), lp.pruned_engine.get()}) {
+      const PromTable* t = &e->table();
+      const std::string name = e == lp.full_engine.get() ? lp.full.name : lp.pruned.name;
+      units["spec"][name] = json::object();
+      if (hw.pnr)
+        jobs.push_back({"spec", name, "pnr", "place and route of " + name, [t, tool = *hw.pnr] { return specPointPnr(*t, tool); }});
+      if (hw.synth)
+        jobs.push_back({"spec", name, "area", "area of " + name, [t, tool = *hw.synth] { return specPointArea(*t, tool); }});
+    }
+  runHardwareJobs(jobs, units, hw, [this](const std::string& m) { say(m); });
+  units["absent"] = hw.absent;
+  return units;
+}
+
 // What the scene leaves unused, with the reason for each.
 json PruneCmd::unusedParts(const RenderOptions& ro, const SpanParams& mode, const std::vector<LobePrune>& lobes) const {
   json unused = json::array();
@@ -313,6 +349,9 @@ json PruneCmd::unusedParts(const RenderOptions& ro, const SpanParams& mode, cons
       unused.push_back({{"part", fmt::format("specular unit of the {} lobe", toString(lp.lobe))},
                         {"why", "every request carries light code 0 (k_s = 0 or no light reaches it): its output is never seen"}});
   }
+  if (ro.method == Method::Flat)
+    unused.push_back({{"part", "span attribute lanes 0..2 (the colour) as interpolators"},
+                      {"why", "flat shades once per polygon: the colour's increments are 0, a register per triangle holds it"}});
   // The span unit's attributes 0..2 carry the colour or the normal, 3 the depth (render.h).
   const int attrs = mode.NumAttr;
   if (attrs > 4)
@@ -410,20 +449,37 @@ int PruneCmd::run(const CLI::App&) {
   out.commit();
   bool rtl_ok = true;
   const json rtl = rtlProof(sc, ro, uses_span ? spanConfig(best) : SpanUnitConfig{}, pruned, rec_pruned, lobes, rtl_ok);
+  std::vector<PnrDevice> devices;
+  for (const PnrDevice& d : pnrDevices())
+    if (pnr_devices_.empty() || std::count(pnr_devices_.begin(), pnr_devices_.end(), d.name) > 0) devices.push_back(d);
+  Hardware hw = findHardwareTools(no_hardware_, hardware_cache_, devices);
+  const json hardware = hardwareFigures(lobes, hw);
   json summary = {{"target_lsb", target_lsb_},
                   {"lane_modes", modes},
                   {"chosen_mode", uses_span ? json(best) : json()},
                   {"unused", unusedParts(ro, mode, lobes)},
+                  {"hardware", hardware},
                   {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}, {"rtl", rtl}}}};
   writeFileAtomic((fs::path(dir_) / "prune.json").string(), summary.dump(1) + "\n");
   std::printf("prune %s (%s): lane mode %s; ", sc.name.c_str(), method_.c_str(), uses_span ? best.c_str() : "none");
-  for (const json& lj : lobes_json)
-    std::printf("%s lobe PROM %lld -> %lld bits; ", lj["lobe"].get<std::string>().c_str(),
+  for (size_t k = 0; k < lobes.size(); ++k) {
+    const json& lj = lobes_json[k];
+    std::printf("%s lobe PROM %lld -> %lld bits", lj["lobe"].get<std::string>().c_str(),
                 static_cast<long long>(lj["full"]["prom_bits"].get<int64_t>()),
                 static_cast<long long>(lj["pruned"]["prom_bits"].get<int64_t>()));
+    const json& full_area = hardware["spec"][lobes[k].full.name].value("area", json());
+    const json& pruned_area = hardware["spec"][lobes[k].pruned.name].value("area", json());
+    if (full_area.contains("ice40") && pruned_area.contains("ice40"))
+      std::printf(", iCE40 %lld -> %lld LUT", static_cast<long long>(full_area["ice40"]["luts"].get<int64_t>()),
+                  static_cast<long long>(pruned_area["ice40"]["luts"].get<int64_t>()));
+    std::printf("; ");
+  }
   std::printf("pruned image max %d LSB from the full (target %g)%s\n", max_diff, target_lsb_,
               image_ok ? "" : ": OVER THE TARGET");
-  return image_ok && rtl_ok ? kExitOk : kExitFailed;
+  for (const json& a : hw.absent)
+    if (hw.failed)
+      std::fprintf(stderr, "prune: %s absent: %s\n", a["figures"].get<std::string>().c_str(), a["why"].get<std::string>().c_str());
+  return image_ok && rtl_ok && !hw.failed ? kExitOk : kExitFailed;
 }
 
 }  // namespace

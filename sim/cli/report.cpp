@@ -6,11 +6,8 @@
 // report.json, report.csv, report.md, the images, a contact sheet and the plots of
 // scripts/plot_report.py into one directory (docs/report.md).
 #include <algorithm>
-#include <atomic>
 #include <cstdio>
 #include <memory>
-#include <thread>
-#include <cstdlib>
 #include <functional>
 #include <filesystem>
 #include <map>
@@ -22,6 +19,7 @@
 #include <unistd.h>
 
 #include "cli/command.h"
+#include "cli/hardware.h"
 #include "cli/report_measure.h"
 #include "report/spec_error.h"
 #include "cli/report_write.h"
@@ -39,19 +37,6 @@ namespace {
 
 // The files of a report besides the images and the plots.
 const std::vector<std::string> kReportFiles = {"report.json", "report.csv", "report.md", "contact_sheet.png"};
-
-// The tools of the hardware figures (area by yosys, fmax by nextpnr) and why a figure is absent.
-struct Hardware {
-  std::optional<SynthTool> synth;
-  std::optional<PnrTool> pnr;
-  std::string cache;
-  json absent = json::array();  // [{"figures", "why"}]: a tool missing or a run failed
-  bool failed = false;          // a figure is absent for a reason other than --no-hardware
-  void absentBecause(const std::string& figures, const std::string& why, bool failure) {
-    absent.push_back({{"figures", figures}, {"why", why}});
-    failed = failed || failure;
-  }
-};
 
 class ReportCmd final : public Command {
  public:
@@ -245,80 +230,7 @@ void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeC
 // The hardware tools, or why there are none: --no-hardware, a cache directory that cannot be
 // made, yosys or nextpnr missing. Only a bad --hardware-cache is an argument error.
 Hardware ReportCmd::hardwareTools() const {
-  Hardware hw;
-  if (no_hardware_) {
-    hw.absentBecause("area, fmax, time", "not measured: --no-hardware", false);
-    return hw;
-  }
-  std::error_code ec;
-  if (!hardware_cache_.empty()) {
-    hw.cache = hardware_cache_;
-  } else {
-    const char* xdg = std::getenv("XDG_CACHE_HOME");
-    const char* home = std::getenv("HOME");
-    if (xdg && *xdg)
-      hw.cache = (fs::path(xdg) / "shadesim").string();
-    else if (home && *home)
-      hw.cache = (fs::path(home) / ".cache" / "shadesim").string();
-  }
-  if (hw.cache.empty()) {
-    hw.absentBecause("area, fmax, time", "no cache directory: give --hardware-cache DIR (neither XDG_CACHE_HOME nor HOME is set)", true);
-    return hw;
-  }
-  if (!fs::is_directory(hw.cache, ec)) fs::create_directories(hw.cache, ec);
-  if (!fs::is_directory(hw.cache, ec)) {
-    hw.absentBecause("area, fmax, time", fmt::format("cannot make the cache directory {}: {}", hw.cache, ec.message()), true);
-    return hw;
-  }
-  const std::string synth = findShareFile("scripts/synth.py"), pnr = findShareFile("scripts/pnr.py");
-  try {
-    if (synth.empty()) throw std::runtime_error("scripts/synth.py is neither in this installation nor in the source tree");
-    hw.synth = SynthTool{synth, hw.cache, "both", synthToolVersion(synth)};
-  } catch (const std::exception& e) {
-    hw.absentBecause("area", fmt::format("yosys: {}", e.what()), true);
-  }
-  try {
-    if (pnr.empty()) throw std::runtime_error("scripts/pnr.py is neither in this installation nor in the source tree");
-    hw.pnr = PnrTool{pnr, hw.cache, pnrToolVersion(pnr), devices_};
-  } catch (const std::exception& e) {
-    hw.absentBecause("fmax, time", fmt::format("place and route: {}", e.what()), true);
-  }
-  return hw;
-}
-
-// One hardware figure of one unit configuration: `member` ("area" or "pnr") of units[unit][name].
-struct HardwareJob {
-  std::string unit, name, member, what;
-  std::function<json()> run;
-};
-
-// The jobs on as many threads as the machine has cores (each job runs yosys or nextpnr in
-// processes of its own); their figures into `units`, in job order, and a failed job's reason into
-// hw.absent, in job order too, so the report does not depend on which job ended first.
-void runHardwareJobs(const std::vector<HardwareJob>& jobs, json& units, Hardware& hw,
-                     const std::function<void(const std::string&)>& say) {
-  std::vector<json> figures(jobs.size());
-  std::vector<std::string> errors(jobs.size());
-  std::atomic<size_t> next{0};
-  auto worker = [&] {
-    for (size_t i; (i = next++) < jobs.size();) {
-      say(fmt::format("{} (or the cache)", jobs[i].what));
-      try {
-        figures[i] = jobs[i].run();
-      } catch (const std::exception& e) {
-        errors[i] = e.what();
-      }
-    }
-  };
-  std::vector<std::thread> threads(std::min<size_t>(jobs.size(), std::max(1u, std::thread::hardware_concurrency())));
-  for (std::thread& t : threads) t = std::thread(worker);
-  for (std::thread& t : threads) t.join();
-  for (size_t i = 0; i < jobs.size(); ++i) {
-    if (errors[i].empty())
-      units[jobs[i].unit][jobs[i].name][jobs[i].member] = figures[i];
-    else
-      hw.absentBecause(jobs[i].member, fmt::format("{}: {}", jobs[i].what, errors[i]), true);
-  }
+  return findHardwareTools(no_hardware_, hardware_cache_, devices_);
 }
 
 // The unit against cos^n (report/spec_error.h) for the shininess values of the scene its PROM
