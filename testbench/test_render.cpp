@@ -12,6 +12,7 @@
 #include "render/methods.h"
 #include "render/pipeline.h"
 #include "render/render.h"
+#include "report/scene_use.h"
 #include "cosim/render_rtl.h"
 #include "cosim/replay.h"
 #include "scene/scene.h"
@@ -210,6 +211,76 @@ TEST(Render, PhongFixedMemoEqualsTheBatchedRequests) {
     EXPECT_EQ(batched.stats.spec_cycles, memo.stats.spec_cycles) << scene;
     EXPECT_GT(memo.stats.spec_evaluations, 10000u) << scene;
   }
+}
+
+// The culled triangles by reason, each counted once: the sphere's are back faces (and the few
+// too small for a pixel centre), the plane's (facing the camera, wider than the view) are outside
+// the guard band or off the viewport. Every triangle is drawn or culled.
+TEST(Render, CulledTrianglesAreCountedByReason) {
+  for (const char* scene : {"builtin:sphere", "builtin:plane", "builtin:materials", "builtin:torus"}) {
+    const RenderStats st = renderModel(loadScene(scene), Method::Gouraud, "blinn", "serial").stats;
+    EXPECT_EQ(st.culled, st.culled_back + st.culled_outside + st.culled_no_pixel) << scene;
+    EXPECT_LE(st.culled + (st.drawn > 0 ? 1 : 0), st.triangles) << scene;
+  }
+  const RenderStats sphere = renderModel(loadScene("builtin:sphere"), Method::Gouraud, "blinn", "serial").stats;
+  EXPECT_GT(sphere.culled_back, sphere.triangles / 3);
+  EXPECT_EQ(sphere.culled_outside, 0u);
+  const RenderStats plane = renderModel(loadScene("builtin:plane"), Method::Gouraud, "blinn", "serial").stats;
+  EXPECT_EQ(plane.culled_back, 0u);
+  EXPECT_GT(plane.culled_outside, 0u);
+  EXPECT_GT(plane.culled_no_pixel, 0u);
+}
+
+// The recording engine (report/scene_use.h) of shadesim prune: the image is the model's, the
+// distinct requests and the per-address figures are those of every request the frame made (kept
+// here by an engine of the test's own), and the zero code is where the unit's output turns
+// positive.
+TEST(Render, RecordingSpecEngineSeesEveryRequest) {
+  struct Collect final : SpecEngine {
+    SpecEngine& e;
+    std::vector<SpecRequest> all;
+    explicit Collect(SpecEngine& inner) : e(inner) {}
+    const PromTable& table() const override { return e.table(); }
+    const SpecUnitModel* model() const override { return e.model(); }  // the recorder's zero code
+    uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
+      all.insert(all.end(), in.begin(), in.end());
+      return e.evaluate(in, out);
+    }
+  };
+  const Scene s = loadScene("builtin:sphere");
+  const RenderResult memo = renderModel(s, Method::PhongFixed, "quadratic", "serial");
+  ModelEngines e("serial");
+  Collect all(*e.quad);
+  RecordingSpecEngine rec(all, true);
+  SpecEngines view;
+  view.quadratic = &rec;
+  RenderOptions o;
+  o.method = Method::PhongFixed;
+  o.brdf = "quadratic";
+  const RenderResult r = render(s, o, e.span, view);
+  EXPECT_EQ(r.fb.rgb, memo.fb.rgb);
+  std::set<std::array<uint32_t, 5>> distinct;
+  for (const SpecRequest& q : all.all) distinct.insert({q.shin, q.cos, q.light[0], q.light[1], q.light[2]});
+  EXPECT_EQ(rec.distinctRequests().size(), distinct.size());
+  const nlohmann::json use = shinUseJson(rec);
+  ASSERT_EQ(use.size(), 1u);  // one material, n = 32
+  const uint32_t shin = use[0]["address"];
+  const int64_t zero = use[0]["zero_code"];
+  const SpecUnitModel& m = *e.quad->model();
+  EXPECT_EQ(m.evaluate(shin, static_cast<uint32_t>(zero), {255, 255, 255}).spec, 0u);
+  EXPECT_GT(m.evaluate(shin, static_cast<uint32_t>(zero + 1), {255, 255, 255}).spec, 0u);
+  uint64_t below = 0, lo = UINT32_MAX, hi = 0;
+  for (const SpecRequest& q : all.all) {
+    below += static_cast<int64_t>(q.cos) <= zero;
+    lo = std::min<uint64_t>(lo, q.cos);
+    hi = std::max<uint64_t>(hi, q.cos);
+  }
+  EXPECT_EQ(use[0]["requests"].get<uint64_t>(), all.all.size());
+  EXPECT_EQ(use[0]["at_or_below_zero"].get<uint64_t>(), below);
+  EXPECT_EQ(use[0]["cos_code_min"].get<uint64_t>(), lo);
+  EXPECT_EQ(use[0]["cos_code_max"].get<uint64_t>(), hi);
+  EXPECT_GT(below, 0u);
+  EXPECT_LT(below, all.all.size());
 }
 
 TEST(Render, BadOptionsAreNamed) {

@@ -70,12 +70,14 @@ bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly
     poly = clipPolygon(poly, [&](const PVertex& v) { return v.cam.z - proj.z_near; });
     if (poly.size() < 3) {
       ++st.culled;
+      ++st.culled_outside;
       return false;
     }
     ++st.clipped;
     for (PVertex& v : poly) proj.project(v);
     if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
       ++st.culled;
+      ++st.culled_back;
       return false;
     }
   }
@@ -93,6 +95,7 @@ bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly
     poly = clipPolygon(poly, [&](const PVertex& v) { return H + kGuard - v.y; });
     if (poly.size() < 3) {
       ++st.culled;
+      ++st.culled_outside;
       return false;
     }
     for (PVertex& v : poly) v.cam = proj.vertexCam(v);

@@ -143,8 +143,12 @@ struct RenderOptions {
 
 struct RenderStats {
   uint64_t triangles = 0;       // input triangles of every object
-  uint64_t culled = 0;          // input triangles of which nothing is drawn: back faces, behind
-                                // the camera, outside the view, no pixel centre inside
+  uint64_t culled = 0;          // input triangles of which nothing is drawn, the sum of:
+  uint64_t culled_back = 0;     //   back faces (and zero-area triangles), before any clipping
+                                //   or after the near plane
+  uint64_t culled_outside = 0;  //   nothing left after the near plane or the guard band
+  uint64_t culled_no_pixel = 0; //   on screen within the guard band but no pixel centre inside
+                                //   (off the viewport, or too small); dropped by setup
   uint64_t clipped = 0;         // triangles cut by the near plane or the guard band
   uint64_t drawn = 0;           // screen triangles sent to the span unit
   uint64_t fragments = 0;

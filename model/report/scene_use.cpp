@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "device/prom.h"
+#include "device/spec_unit.h"
 
 namespace shd {
 
@@ -26,6 +27,7 @@ uint64_t RecordingSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::
     if (keep_) inputs_.insert({r.shin, r.cos, r.light[0], r.light[1], r.light[2]});
     ShinUse& u = use_[r.shin];
     ++u.requests;
+    ++u.by_cos[r.cos];
     u.cos_min = std::min(u.cos_min, r.cos);
     u.cos_max = std::max(u.cos_max, r.cos);
     const uint32_t light = std::max({r.light[0], r.light[1], r.light[2]});
@@ -38,11 +40,33 @@ uint64_t RecordingSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::
   return inner_.evaluate(in, out);
 }
 
+namespace {
+
+// The largest cosine code up to which the unit's output is 0 at every code, or -1.
+int64_t zeroCode(const SpecUnitModel& m, uint32_t shin) {
+  const uint32_t full = static_cast<uint32_t>(m.params().lightMax());
+  const int64_t one = m.params().cosOne();
+  int64_t c = 0;
+  while (c <= one && m.evaluate(shin, static_cast<uint32_t>(c), {full, full, full}).spec == 0) ++c;
+  return c - 1;
+}
+
+}  // namespace
+
 nlohmann::json shinUseJson(const RecordingSpecEngine& rec) {
   const PromTable& t = rec.table();
   const double scale = std::ldexp(1.0, -t.unit.CosFracBits);
   nlohmann::json out = nlohmann::json::array();
   for (const auto& [address, u] : rec.use()) {
+    nlohmann::json zero, below;
+    if (const SpecUnitModel* m = rec.innerModel()) {
+      const int64_t z = zeroCode(*m, address);
+      uint64_t n = 0;
+      for (const auto& [cos, count] : u.by_cos)
+        if (static_cast<int64_t>(cos) <= z) n += count;
+      zero = z;
+      below = n;
+    }
     const auto e = std::find_if(t.entries.begin(), t.entries.end(), [&](const PromEntry& p) { return p.address == address; });
     out.push_back({{"address", address},
                    {"n", e == t.entries.end() ? nlohmann::json() : nlohmann::json(e->n)},
@@ -53,7 +77,9 @@ nlohmann::json shinUseJson(const RecordingSpecEngine& rec) {
                    {"cos_code_max_lit", u.cos_max_lit},
                    {"cos_min", u.cos_min * scale},
                    {"cos_max", u.cos_max * scale},
-                   {"light_code_max", u.light_max}});
+                   {"light_code_max", u.light_max},
+                   {"zero_code", zero},
+                   {"at_or_below_zero", below}});
   }
   return out;
 }

@@ -23,6 +23,7 @@ struct ShinUse {
   uint32_t cos_max_lit = 0;                    // the largest cosine code of a request with light
   uint32_t light_max = 0;                      // the largest light code of any channel
   uint64_t unlit = 0;                          // requests whose light codes are all 0
+  std::map<uint32_t, uint64_t> by_cos;         // requests per cosine code
 };
 
 // A specular engine that evaluates through another (the model or the RTL) and records every
@@ -35,6 +36,7 @@ class RecordingSpecEngine final : public SpecEngine {
   const PromTable& table() const override { return inner_.table(); }
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
   const std::map<uint32_t, ShinUse>& use() const { return use_; }
+  const SpecUnitModel* innerModel() const { return inner_.model(); }
   // The distinct requests seen (with keep_inputs), ordered by address, cosine, then light.
   std::vector<SpecRequest> distinctRequests() const;
 
@@ -46,8 +48,12 @@ class RecordingSpecEngine final : public SpecEngine {
 };
 
 // {"address", "n", "requests", "unlit", "cos_code_min", "cos_code_max", "cos_code_max_lit",
-// "cos_min", "cos_max", "light_code_max"} per address the recorder saw, in address order (cos_*
-// as cosines: the code / 2^CosFracBits).
+// "cos_min", "cos_max", "light_code_max", "zero_code", "at_or_below_zero"} per address the
+// recorder saw, in address order (cos_* as cosines: the code / 2^CosFracBits). zero_code: the
+// largest cosine code up to which the unit's output f is 0 at every code (the polynomial's zero
+// or its cut-off; -1 when f(0) > 0), from the inner engine's model (null without one);
+// at_or_below_zero: the requests there, whose evaluation the unit could skip (its output is 0
+// whatever the light).
 nlohmann::json shinUseJson(const RecordingSpecEngine& rec);
 
 // The screen triangles of a frame by area (pixels: [0,1), [1,10), ... [10^4, inf)) and by the

@@ -454,10 +454,25 @@ int PruneCmd::run(const CLI::App&) {
     if (pnr_devices_.empty() || std::count(pnr_devices_.begin(), pnr_devices_.end(), d.name) > 0) devices.push_back(d);
   Hardware hw = findHardwareTools(no_hardware_, hardware_cache_, devices);
   const json hardware = hardwareFigures(lobes, hw);
+  // The work a pixel or a triangle does not need, in the full frame (counted, not skipped: the
+  // images and cycles are the unit's as it is).
+  uint64_t spec_requests = 0, spec_zero = 0;
+  for (const json& lj : lobes_json)
+    for (const json& u : lj["requests"]) {
+      spec_requests += u["requests"].get<uint64_t>();
+      spec_zero += u["at_or_below_zero"].is_null() ? 0 : u["at_or_below_zero"].get<uint64_t>();
+    }
+  const json skippable = {{"spec_requests", spec_requests},
+                          {"spec_at_or_below_zero", spec_zero},
+                          {"triangles", full.stats.triangles},
+                          {"culled_back", full.stats.culled_back},
+                          {"culled_outside", full.stats.culled_outside},
+                          {"culled_no_pixel", full.stats.culled_no_pixel}};
   json summary = {{"target_lsb", target_lsb_},
                   {"lane_modes", modes},
                   {"chosen_mode", uses_span ? json(best) : json()},
                   {"unused", unusedParts(ro, mode, lobes)},
+                  {"skippable", skippable},
                   {"hardware", hardware},
                   {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}, {"rtl", rtl}}}};
   writeFileAtomic((fs::path(dir_) / "prune.json").string(), summary.dump(1) + "\n");

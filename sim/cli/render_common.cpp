@@ -88,6 +88,9 @@ RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderRes
 nlohmann::json frameCounts(const RenderStats& st) {
   return {{"triangles", st.triangles},
           {"culled", st.culled},
+          {"culled_back", st.culled_back},
+          {"culled_outside", st.culled_outside},
+          {"culled_no_pixel", st.culled_no_pixel},
           {"clipped", st.clipped},
           {"drawn", st.drawn},
           {"fragments", st.fragments},

@@ -60,7 +60,8 @@ struct RtlCheck {
 };
 RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& model, const RenderResult& rtl);
 
-// The counts of a frame: {"triangles", "culled", "clipped", "drawn", "fragments",
+// The counts of a frame: {"triangles", "culled" (and its parts "culled_back", "culled_outside",
+// "culled_no_pixel"), "clipped", "drawn", "fragments",
 // "pixels_covered", "cycles" (span unit), "spec_cycles", "spec_evaluations", "divisions",
 // "split_parts", "normalisations", "adaptive_gouraud", "adaptive_phong"}.
 nlohmann::json frameCounts(const RenderStats& st);
