@@ -108,4 +108,21 @@ status=0
   > /dev/null 2> n77.err || status=$?
 [ "$status" -eq 2 ] && grep -q "shininess 77 is not in the specular unit's PROM" n77.err \
   || { cat n77.err; echo "prune_test: a shininess outside the pruned PROM: exit $status, not refused by name" >&2; exit 1; }
+# A cosine below the least the scene reached: the sphere lit from the side reaches N.H >= 0.34;
+# its pruned configuration refuses builtin:sphere lit from the front (N.H down to 0.2), naming
+# the code, and renders its own scene.
+python3 - <<'PY'
+import json
+s = json.load(open("n77.json"))
+s["lights"][0]["direction"] = [1, 0, 0]
+s["materials"][0]["shininess"] = 32
+json.dump(s, open("side.json", "w"))
+PY
+"$shadesim" prune --scene side.json --target-lsb 1 --no-hardware -o side --quiet > /dev/null
+"$shadesim" render --scene side.json --method phong-fixed --quadratic-config side/spec_defaultpruned.json -o side.png --quiet > /dev/null
+status=0
+"$shadesim" render --scene builtin:sphere --brdf quadratic --method phong-fixed --quadratic-config side/spec_defaultpruned.json \
+  -o front.png --quiet > /dev/null 2> front.err || status=$?
+[ "$status" -eq 2 ] && grep -q "is below .*the least configuration side/spec_defaultpruned.json was sized for" front.err \
+  || { cat front.err; echo "prune_test: a cosine below the analysed range: exit $status, not refused by name" >&2; exit 1; }
 echo "prune_test: passed"

@@ -156,6 +156,24 @@ std::vector<std::string> builtinConfigNames(const std::string& unit) {
   return names;
 }
 
+namespace {
+
+// "inputs": {"cos_code_min": [codes]}: non-negative integers below 2^25 (CosFracBits <= 24).
+std::vector<uint32_t> cosCodeMin(const nlohmann::json& v, const std::string& where) {
+  if (!v.is_object() || v.size() != 1 || !v.contains("cos_code_min") || !v["cos_code_min"].is_array() ||
+      v["cos_code_min"].empty())
+    throw std::invalid_argument(fmt::format("{}: inputs: must be {{\"cos_code_min\": [a code per PROM entry]}}", where));
+  std::vector<uint32_t> out;
+  for (const nlohmann::json& c : v["cos_code_min"]) {
+    if (!c.is_number_unsigned() || c.get<uint64_t>() >= (uint64_t{1} << 25))
+      throw std::invalid_argument(fmt::format("{}: inputs.cos_code_min: {} is not a cosine code (0 .. 2^25 - 1)", where, c.dump()));
+    out.push_back(c.get<uint32_t>());
+  }
+  return out;
+}
+
+}  // namespace
+
 SpecUnitConfig SpecUnitConfig::parse(const std::string& text, const std::string& where) {
   const nlohmann::json j = parseObject(text, where);
   SpecUnitConfig c;
@@ -167,6 +185,7 @@ SpecUnitConfig SpecUnitConfig::parse(const std::string& text, const std::string&
     else if (key == "rtl") c.rtl = SpecUnitParams::fromJson(value, where), has_rtl = true;
     else if (key == "prom") c.prom = promFromJson(value, where), has_prom = true;
     else if (key == "expected") checkExpected(value, where, "spec");
+    else if (key == "inputs") c.cos_code_min = cosCodeMin(value, where);
     else throw std::invalid_argument(fmt::format("{}: unknown key \"{}\"", where, key));
   }
   // A file states the whole unit: nothing falls back to a default the user did not see.

@@ -41,6 +41,10 @@ struct SpecUnitConfig {
   bool builtin = false;  // from the registry (specConfig() by name)
   SpecUnitParams rtl;
   PromContent prom;
+  // "inputs": {"cos_code_min": [...]}, optional: per PROM entry the least cosine code the
+  // configuration was sized for (shadesim prune); the models rendering with it refuse a lower one
+  // (modelSpecEngine, render/lobe_units.h). Empty: every code.
+  std::vector<uint32_t> cos_code_min;
 
   // What --config takes to name it again: the registry name, or the file.
   const std::string& ref() const { return builtin ? name : path; }

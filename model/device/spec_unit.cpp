@@ -1,5 +1,7 @@
 #include "device/spec_unit.h"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 namespace shd {
@@ -206,6 +208,22 @@ SpecTrace SpecUnitModel::trace(uint32_t shin, uint32_t cos) const {
   return t;
 }
 
+void SpecUnitModel::limitCosines(std::vector<uint32_t> least, std::string origin) {
+  cos_least_ = std::move(least);
+  cos_origin_ = std::move(origin);
+}
+
+void SpecUnitModel::refuseCosine(uint32_t shin, uint32_t cos) const {
+  const double scale = std::ldexp(1.0, -p_.CosFracBits);
+  if (shin >= cos_least_.size())
+    throw std::invalid_argument(fmt::format("shininess code {} is beyond the {} codes {} was sized for", shin,
+                                            cos_least_.size(), cos_origin_));
+  throw std::invalid_argument(fmt::format(
+      "cosine code {} (N.H = {:.6g}) at shininess code {} is below {} (N.H = {:.6g}), the least {} was sized for: "
+      "its widths are proven for the inputs the scene reached only (shadesim prune this scene)",
+      cos, cos * scale, shin, cos_least_[shin], cos_least_[shin] * scale, cos_origin_));
+}
+
 SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
   // The hot path: the same datapath as trace() on raw integers, wire by wire as in the RTL.
   // validate() bounds every intermediate to 62 bits, so int64_t holds each exactly, and
@@ -213,6 +231,7 @@ SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<ui
   if (shin >= static_cast<uint32_t>(p_.shinCodes()) || cos >= (uint32_t{2} << p_.CosFracBits)) {
     checkInputs(shin, cos);  // throws the descriptive error
   }
+  if (!cos_least_.empty() && (shin >= cos_least_.size() || cos < cos_least_[shin])) refuseCosine(shin, cos);
   const int wc = p_.CosFracBits, wf = p_.SpecFracBits;
   const int64_t c = std::min<int64_t>(cos, p_.cosOne());            // RG2 saturation
   const int64_t one = int64_t{1} << wf;

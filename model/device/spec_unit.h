@@ -29,6 +29,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "approx/piecewise.h"
@@ -109,8 +110,14 @@ class SpecUnitModel {
   SpecOut tick(const SpecIn& in);
   uint64_t cycle() const { return cycle_; }
 
+  // The least cosine code per shininess code (PROM address) a configuration was sized for
+  // (shadesim prune: the least the scene reached): evaluate() then refuses a cosine below it with
+  // std::invalid_argument naming the code, the address and `origin`. Empty: every code.
+  void limitCosines(std::vector<uint32_t> least, std::string origin);
+
  private:
   void checkInputs(uint32_t shin, uint32_t cos) const;  // std::out_of_range naming the port
+  void refuseCosine(uint32_t shin, uint32_t cos) const;  // below cos_least_: std::invalid_argument
   int64_t tableIndex(int64_t c) const;                   // table: the cosine address
   int64_t altSpec(uint32_t shin, int64_t c) const;       // f of the kinds other than poly
   SpecOut backEnd(int64_t f, const std::array<uint32_t, 3>& light) const;  // MUL3..MUL5
@@ -123,6 +130,8 @@ class SpecUnitModel {
   std::vector<SpecCoef> coef_;  // decoded prom_
   ExpLogTables explog_;         // the explog kind's fixed tables
   std::vector<PromWord> seg_;   // the piecewise kind's segment ROM
+  std::vector<uint32_t> cos_least_;  // limitCosines()
+  std::string cos_origin_;
   std::vector<PiecewiseCodes> pieces_;  // decoded per shininess code
   std::vector<Stage> pipe_;     // ring buffer, latency() entries
   size_t head_ = 0;

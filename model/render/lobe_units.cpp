@@ -22,11 +22,22 @@ SpecUnitConfig LobeConfigs::load(Lobe l) const {
   return c;
 }
 
+std::unique_ptr<ModelSpecEngine> modelSpecEngine(const SpecUnitConfig& cfg) {
+  auto e = std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl));
+  if (!cfg.cos_code_min.empty()) {
+    if (cfg.cos_code_min.size() != e->table().entries.size())
+      throw std::invalid_argument(fmt::format("configuration {}: inputs.cos_code_min has {} codes, its PROM {} entries",
+                                              cfg.ref(), cfg.cos_code_min.size(), e->table().entries.size()));
+    e->limitCosines(cfg.cos_code_min, "configuration " + cfg.ref());
+  }
+  return e;
+}
+
 LobeEngines modelLobeEngines(const Scene& scene, const RenderOptions& opt, const LobeConfigs& configs) {
   LobeEngines e;
   for (Lobe l : deviceLobesUsed(scene, opt)) {
     const SpecUnitConfig cfg = configs.load(l);
-    e.owned.push_back(std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl)));
+    e.owned.push_back(modelSpecEngine(cfg));
     (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.owned.back().get();
   }
   return e;

@@ -23,6 +23,11 @@ struct LobeConfigs {
   SpecUnitConfig load(Lobe l) const;
 };
 
+// The model's engine of a configuration: its PROM table and, with cos_code_min, the cosines it
+// refuses (std::invalid_argument naming the configuration when the list does not have one code
+// per PROM entry).
+std::unique_ptr<ModelSpecEngine> modelSpecEngine(const SpecUnitConfig& cfg);
+
 // The model's engines (bit-exact specular units with their PROM tables) for the device lobes
 // the scene uses with these options; `view` points into `owned`.
 struct LobeEngines {

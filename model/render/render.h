@@ -117,6 +117,8 @@ class ModelSpecEngine final : public SpecEngine {
   uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override;
   const SpecUnitModel* model() const override { return &unit_; }
   SpecResultMemo* memo() override { return &memo_; }
+  // SpecUnitModel::limitCosines of its model.
+  void limitCosines(std::vector<uint32_t> least, std::string origin) { unit_.limitCosines(std::move(least), std::move(origin)); }
 
  private:
   PromTable t_;

@@ -68,9 +68,7 @@ std::pair<int, uint64_t> frameDifference(const RenderResult& a, const RenderResu
 }
 
 // The engine of a lobe's configuration (std::invalid_argument when its coefficients do not fit).
-std::unique_ptr<ModelSpecEngine> engineOf(const SpecUnitConfig& c) {
-  return std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(c.prom), c.rtl));
-}
+std::unique_ptr<ModelSpecEngine> engineOf(const SpecUnitConfig& c) { return modelSpecEngine(c); }
 
 class PruneCmd final : public Command {
  public:
@@ -183,6 +181,11 @@ void PruneCmd::prunePromOf(LobePrune& lp) const {
   lp.pruned.prom.is_list = true;
   lp.pruned.rtl.ShinBits = addressBitsFor(lp.n_used.size());
   lp.pruned.rtl.validate();
+  // Per entry (ascending n) the least cosine code the scene reached: the pruned model refuses less.
+  lp.pruned.cos_code_min.clear();
+  for (double n : lp.n_used)
+    for (const auto& [address, u] : lp.recorder->use())
+      if (lp.full_engine->table().addressOf(n) == static_cast<int>(address)) lp.pruned.cos_code_min.push_back(u.cos_min);
   lp.pruned_engine = engineOf(lp.pruned);
 }
 
@@ -243,7 +246,8 @@ void PruneCmd::writePruned(const LobePrune& lp, OutputFiles& out, json& lobe_jso
   const json cfg = {{"name", lp.pruned.name},
                     {"description", lp.pruned.description},
                     {"rtl", lp.pruned.rtl.toJson()},
-                    {"prom", {{"fit", lp.pruned.prom.fit}, {"level", lp.pruned.prom.level}, {"n_list", lp.pruned.prom.n}}}};
+                    {"prom", {{"fit", lp.pruned.prom.fit}, {"level", lp.pruned.prom.level}, {"n_list", lp.pruned.prom.n}}},
+                    {"inputs", {{"cos_code_min", lp.pruned.cos_code_min}}}};
   out.add(lp.pruned.path, cfg.dump(2) + "\n");
   for (PromFormat f : {PromFormat::Hex, PromFormat::Mem, PromFormat::Coe, PromFormat::Mif, PromFormat::Csv})
     for (const auto& [suffix, text] : renderPromFiles(t, f))
@@ -373,7 +377,7 @@ int PruneCmd::run(const CLI::App&) {
     LobePrune lp;
     lp.lobe = l;
     lp.full = lobeConfigArg(lobes_, l);
-    lp.full_engine = std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(lp.full.prom), lp.full.rtl));
+    lp.full_engine = modelSpecEngine(lp.full);
     lp.recorder = std::make_unique<RecordingSpecEngine>(*lp.full_engine);
     (l == Lobe::Cubic ? full_view.cubic : full_view.quadratic) = lp.full_engine.get();
     (l == Lobe::Cubic ? rec_view.cubic : rec_view.quadratic) = lp.recorder.get();

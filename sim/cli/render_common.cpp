@@ -27,13 +27,12 @@ Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConf
   else e.span = std::make_unique<ModelSpanEngine>(span.rtl);
   for (Lobe l : deviceLobesUsed(sc, ro)) {
     const SpecUnitConfig cfg = lobeConfigArg(lobes, l);
-    PromTable t = buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl);
     if (with_rtl) {
       fs::create_directories(tmp);
-      e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg, std::move(t), (tmp / ("spec_" + cfg.name + ".hex")).string(),
-                                                       fail_dir));
+      e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg, buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl),
+                                                       (tmp / ("spec_" + cfg.name + ".hex")).string(), fail_dir));
     } else {
-      e.spec.push_back(std::make_unique<ModelSpecEngine>(std::move(t)));
+      e.spec.push_back(modelSpecEngine(cfg));
     }
     (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.spec.back().get();
   }
