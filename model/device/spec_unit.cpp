@@ -231,7 +231,6 @@ SpecOut SpecUnitModel::evaluate(uint32_t shin, uint32_t cos, const std::array<ui
   if (shin >= static_cast<uint32_t>(p_.shinCodes()) || cos >= (uint32_t{2} << p_.CosFracBits)) {
     checkInputs(shin, cos);  // throws the descriptive error
   }
-  if (!cos_least_.empty() && (shin >= cos_least_.size() || cos < cos_least_[shin])) refuseCosine(shin, cos);
   const int wc = p_.CosFracBits, wf = p_.SpecFracBits;
   const int64_t c = std::min<int64_t>(cos, p_.cosOne());            // RG2 saturation
   const int64_t one = int64_t{1} << wf;

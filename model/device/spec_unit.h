@@ -111,9 +111,14 @@ class SpecUnitModel {
   uint64_t cycle() const { return cycle_; }
 
   // The least cosine code per shininess code (PROM address) a configuration was sized for
-  // (shadesim prune: the least the scene reached): evaluate() then refuses a cosine below it with
-  // std::invalid_argument naming the code, the address and `origin`. Empty: every code.
+  // (shadesim prune: the least the scene reached): checkCosine() then refuses a cosine below it
+  // with std::invalid_argument naming the code, the address and `origin`. Empty: every code.
+  // The renderer's paths to the model check (render.h ModelSpecEngine, the memo, phong's direct
+  // requests); evaluate() itself does not, so the co-simulation's fast path stays as it is.
   void limitCosines(std::vector<uint32_t> least, std::string origin);
+  void checkCosine(uint32_t shin, uint32_t cos) const {
+    if (!cos_least_.empty() && (shin >= cos_least_.size() || cos < cos_least_[shin])) refuseCosine(shin, cos);
+  }
 
  private:
   void checkInputs(uint32_t shin, uint32_t cos) const;  // std::out_of_range naming the port

@@ -90,6 +90,7 @@ uint64_t* SpecResultMemo::row(uint32_t shin, const std::array<uint32_t, 3>& ligh
 }
 
 uint64_t SpecResultMemo::evaluate(uint32_t shin, uint32_t cos, const std::array<uint32_t, 3>& light) const {
+  model_.checkCosine(shin, cos);
   const SpecOut o = model_.evaluate(shin, cos, light);
   uint64_t e = kValid;
   for (size_t k = 0; k < 3; ++k) {

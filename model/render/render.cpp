@@ -181,7 +181,10 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
 
 uint64_t ModelSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) {
   out.resize(in.size());
-  for (size_t i = 0; i < in.size(); ++i) out[i] = unit_.evaluate(in[i].shin, in[i].cos, in[i].light).rgb;
+  for (size_t i = 0; i < in.size(); ++i) {
+    unit_.checkCosine(in[i].shin, in[i].cos);
+    out[i] = unit_.evaluate(in[i].shin, in[i].cos, in[i].light).rgb;
+  }
   return batchCycles(in.size(), unit_.params().latency());
 }
 

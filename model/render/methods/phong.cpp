@@ -51,6 +51,7 @@ struct PixelLighting {
       f.device_out.resize(count);
       for (size_t i = 0; i < count; ++i) {
         const SpecRequest& r = requests[first + i];
+        f.obj.direct->checkCosine(r.shin, r.cos);
         f.device_out[i] = f.obj.direct->evaluate(r.shin, r.cos, r.light).rgb;
       }
       f.st.pixels_covered += write(p, wcode, combine(lsb, f.device_out.data(), count));
