@@ -21,6 +21,17 @@ auto configArg(const std::string& option, const std::string& arg, Load load) {
 
 }  // namespace
 
+bool existingOrNewDir(const char* option, const std::string& arg, const std::filesystem::path& dir, const char* why) {
+  std::error_code ec;
+  if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
+    throw ArgError(fmt::format("{} {}: not a directory{}", option, arg, why));
+  if (std::filesystem::exists(dir, ec)) return true;
+  const std::filesystem::path parent = dir.has_parent_path() ? dir.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::is_directory(parent, ec))
+    throw ArgError(fmt::format("{} {}: no such directory, and its parent {} is none either", option, arg, parent.string()));
+  return false;
+}
+
 SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg) {
   return configArg(option, arg, specConfig);
 }

@@ -4,6 +4,7 @@
 // cli::run prints "shadesim <command>: error: ..." for an exception and returns kExitBadInput).
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -40,6 +41,10 @@ const std::string& commandLine();
 // names the option, an error in a file "configuration file <path>: <member>: ...".
 SpecUnitConfig specConfigArg(const std::string& option, const std::string& arg);
 SpanUnitConfig spanConfigArg(const std::string& option, const std::string& arg);
+// The directory `dir` that `option` `arg` names: true if it exists, false if it is new and its
+// parent exists (it is made later). ArgError otherwise; `why` follows "not a directory".
+bool existingOrNewDir(const char* option, const std::string& arg, const std::filesystem::path& dir, const char* why);
+
 // "name | name | ... or a JSON file": the registry's names of a unit, for help texts.
 std::string configChoices(const std::string& unit);
 

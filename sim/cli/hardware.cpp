@@ -8,11 +8,43 @@
 #include <thread>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "cli/command.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace shd::cli {
+
+void HardwareOptions::add(CLI::App& app, const std::string& no_hardware_help) {
+  app.add_option("--hardware-cache", cache,
+                 "the directory (made if missing; its parent must exist) where each unit configuration's yosys area "
+                 "and nextpnr place and route are kept, computed once (shared with sweep --synth-cache); default "
+                 "$XDG_CACHE_HOME/shadesim or ~/.cache/shadesim");
+  std::vector<std::string> names;
+  for (const PnrDevice& d : pnrDevices()) names.push_back(d.name);
+  app.add_option("--pnr-devices", devices,
+                 fmt::format("the iCE40 devices each unit is placed and routed on, comma-separated (default: {}): the "
+                             "UP5K with its DSPs, the HX8K without (every multiplier in logic cells: the longer run)",
+                             fmt::join(names, ",")))
+      ->delimiter(',')
+      ->check(CLI::IsMember(names));
+  app.add_flag("--no-hardware", none, no_hardware_help)->excludes("--hardware-cache")->excludes("--pnr-devices");
+}
+
+void HardwareOptions::check() const {
+  if (!cache.empty()) existingOrNewDir("--hardware-cache", cache, cache, "");
+  for (const std::string& n : devices)
+    if (std::count(devices.begin(), devices.end(), n) > 1) throw ArgError(fmt::format("--pnr-devices: {} is named twice", n));
+}
+
+std::vector<PnrDevice> HardwareOptions::chosenDevices() const {
+  std::vector<PnrDevice> out;
+  for (const PnrDevice& d : pnrDevices())
+    if (devices.empty() || std::count(devices.begin(), devices.end(), d.name) > 0) out.push_back(d);
+  return out;
+}
 
 Hardware findHardwareTools(bool no_hardware, const std::string& cache_option, const std::vector<PnrDevice>& devices) {
   Hardware hw;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include "sweep/area.h"
@@ -31,6 +32,19 @@ struct Hardware {
 // ("" : $XDG_CACHE_HOME/shadesim, else ~/.cache/shadesim; made if missing). A tool that is
 // missing or does not run leaves its figures absent, a failure.
 Hardware findHardwareTools(bool no_hardware, const std::string& cache_option, const std::vector<PnrDevice>& devices);
+
+// The options of the hardware figures: --hardware-cache, --pnr-devices, --no-hardware.
+struct HardwareOptions {
+  std::string cache;                 // --hardware-cache ("": the default)
+  std::vector<std::string> devices;  // --pnr-devices ({}: every one of pnrDevices())
+  bool none = false;                 // --no-hardware
+  void add(CLI::App& app, const std::string& no_hardware_help);
+  // Before any work: the cache an existing directory or a new one whose parent exists, no device
+  // named twice (ArgError).
+  void check() const;
+  std::vector<PnrDevice> chosenDevices() const;  // in pnrDevices() order
+  Hardware tools() const { return findHardwareTools(none, cache, chosenDevices()); }
+};
 
 // One hardware figure of one unit configuration: `member` ("area" or "pnr") of units[unit][name].
 struct HardwareJob {

@@ -77,11 +77,10 @@ class PruneCmd final : public Command {
 
  private:
   std::string scene_ = "builtin:sphere", dir_, method_ = "phong-fixed", brdf_;
-  std::string hardware_cache_;
-  std::vector<std::string> pnr_devices_;
+  HardwareOptions hardware_;
   LobeConfigs lobes_;
   double target_lsb_ = 0;
-  bool quiet_ = false, no_hardware_ = false;
+  bool quiet_ = false;
 
   void say(const std::string& m) const {
     if (!quiet_) std::fprintf(stderr, "prune: %s\n", m.c_str());
@@ -121,17 +120,7 @@ void PruneCmd::add(CLI::App& app) {
       ->required()
       ->check(realIn(0, 255));
   app.add_option("-o,--output", dir_, "the directory written (made if missing; its parent must exist)")->required();
-  app.add_option("--hardware-cache", hardware_cache_,
-                 "where the yosys area and nextpnr place and route of each configuration are kept (as for report)");
-  std::vector<std::string> device_names;
-  for (const PnrDevice& d : pnrDevices()) device_names.push_back(d.name);
-  app.add_option("--pnr-devices", pnr_devices_,
-                 fmt::format("the iCE40 devices each unit is placed on, comma-separated (default: {})", fmt::join(device_names, ",")))
-      ->delimiter(',')
-      ->check(CLI::IsMember(device_names));
-  app.add_flag("--no-hardware", no_hardware_, "no area and no place and route of the full and pruned units")
-      ->excludes("--hardware-cache")
-      ->excludes("--pnr-devices");
+  hardware_.add(app, "no area and no place and route of the full and pruned units");
   app.add_flag("--quiet", quiet_, "no progress on stderr");
 }
 
@@ -139,12 +128,8 @@ void PruneCmd::checkScene(const Scene& sc) const {
   if (sc.objects.empty()) throw ArgError(fmt::format("--scene {}: no objects: nothing to render, nothing to prune", sc.name));
   if (sc.lights.empty())
     throw ArgError(fmt::format("--scene {}: no lights: every pixel is the ambient term; prune a scene that is lit", sc.name));
-  std::error_code ec;
-  const fs::path d(dir_);
-  if (fs::exists(d, ec) && !fs::is_directory(d, ec)) throw ArgError(fmt::format("-o {}: not a directory", dir_));
-  const fs::path parent = d.has_parent_path() ? d.parent_path() : fs::path(".");
-  if (!fs::exists(d, ec) && !fs::is_directory(parent, ec))
-    throw ArgError(fmt::format("-o {}: no such directory, and its parent {} is none either", dir_, parent.string()));
+  existingOrNewDir("-o", dir_, dir_, "");
+  hardware_.check();
 }
 
 // Every lane mode of the registry on the scene, with the full specular units: cycles per frame,
@@ -453,10 +438,7 @@ int PruneCmd::run(const CLI::App&) {
   out.commit();
   bool rtl_ok = true;
   const json rtl = rtlProof(sc, ro, uses_span ? spanConfig(best) : SpanUnitConfig{}, pruned, rec_pruned, lobes, rtl_ok);
-  std::vector<PnrDevice> devices;
-  for (const PnrDevice& d : pnrDevices())
-    if (pnr_devices_.empty() || std::count(pnr_devices_.begin(), pnr_devices_.end(), d.name) > 0) devices.push_back(d);
-  Hardware hw = findHardwareTools(no_hardware_, hardware_cache_, devices);
+  Hardware hw = hardware_.tools();
   const json hardware = hardwareFigures(lobes, hw);
   // The work a pixel or a triangle does not need, in the full frame (counted, not skipped: the
   // images and cycles are the unit's as it is).

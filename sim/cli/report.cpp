@@ -44,13 +44,13 @@ class ReportCmd final : public Command {
   int run(const CLI::App& app) override;
 
  private:
-  std::string scene_ = "builtin:sphere", dir_, hardware_cache_;
-  std::vector<std::string> modes_, spec_units_, pnr_devices_;
+  std::string scene_ = "builtin:sphere", dir_;
+  std::vector<std::string> modes_, spec_units_;
+  HardwareOptions hardware_;
   std::vector<SpecUnitConfig> alt_units_;  // --spec-units, loaded
-  std::vector<PnrDevice> devices_;         // --pnr-devices, checked
   std::vector<double> scene_n_;            // the shininess values the scene's objects use
   size_t bench_ = 5;
-  bool rtl_ = false, quiet_ = false, no_hardware_ = false;
+  bool rtl_ = false, quiet_ = false;
   double heat_scale_ = 8, highlight_lsb_ = 32;
 
   void say(const std::string& m) const {
@@ -64,11 +64,8 @@ class ReportCmd final : public Command {
   // -o: an existing directory whose report files may be replaced, or a new one in an existing
   // directory (made only when the report is written). ArgError otherwise.
   void checkOutputDir() const;
-  // --hardware-cache: an existing directory or a new one whose parent exists. ArgError otherwise.
-  void checkHardwareCache() const;
   std::vector<SpanUnitConfig> modeConfigs() const;
   std::vector<SpecUnitConfig> altUnitConfigs() const;
-  std::vector<PnrDevice> pnrDeviceList() const;
   void requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const;
   Hardware hardwareTools() const;
   json unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
@@ -104,21 +101,7 @@ void ReportCmd::add(CLI::App& app) {
       ->default_val(bench_);
   app.add_flag("--rtl", rtl_, "also render every row with the verilated span and specular units: images and cycles "
                               "must be equal");
-  app.add_option("--hardware-cache", hardware_cache_,
-                 "the directory (made if missing; its parent must exist) where each unit configuration's yosys area "
-                 "and nextpnr place and route are kept, computed once (shared with sweep --synth-cache); default "
-                 "$XDG_CACHE_HOME/shadesim or ~/.cache/shadesim");
-  std::vector<std::string> device_names;
-  for (const PnrDevice& d : pnrDevices()) device_names.push_back(d.name);
-  app.add_option("--pnr-devices", pnr_devices_,
-                 fmt::format("the iCE40 devices each unit is placed and routed on, comma-separated (default: {}): the "
-                             "UP5K with its DSPs, the HX8K without (every multiplier in logic cells: the longer run)",
-                             fmt::join(device_names, ",")))
-      ->delimiter(',')
-      ->check(CLI::IsMember(device_names));
-  app.add_flag("--no-hardware", no_hardware_, "no area and no place and route: the report without yosys and nextpnr")
-      ->excludes("--hardware-cache")
-      ->excludes("--pnr-devices");
+  hardware_.add(app, "no area and no place and route: the report without yosys and nextpnr");
   app.add_option("--heat-scale", heat_scale_, "error (LSB) shown white in the heat maps")
       ->check(realIn(0, 255, Ends::OpenLow))
       ->default_val(heat_scale_);
@@ -128,22 +111,6 @@ void ReportCmd::add(CLI::App& app) {
   app.add_flag("--quiet", quiet_, "no progress on stderr");
 }
 
-// The directory `dir` that `option` `arg` names: true if it exists, false if it is new and its
-// parent exists (it is made later). ArgError otherwise; `why` follows "not a directory".
-bool existingOrNewDir(const char* option, const std::string& arg, const fs::path& dir, const char* why) {
-  std::error_code ec;
-  if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
-    throw ArgError(fmt::format("{} {}: not a directory{}", option, arg, why));
-  if (fs::exists(dir, ec)) return true;
-  const fs::path parent = dir.has_parent_path() ? dir.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent, ec))
-    throw ArgError(fmt::format("{} {}: no such directory, and its parent {} is none either", option, arg, parent.string()));
-  return false;
-}
-
-void ReportCmd::checkHardwareCache() const {
-  if (!hardware_cache_.empty()) existingOrNewDir("--hardware-cache", hardware_cache_, hardware_cache_, "");
-}
 
 void ReportCmd::checkOutputDir() const {
   std::error_code ec;
@@ -193,16 +160,6 @@ std::vector<SpecUnitConfig> ReportCmd::altUnitConfigs() const {
   return units;
 }
 
-std::vector<PnrDevice> ReportCmd::pnrDeviceList() const {
-  std::vector<PnrDevice> devices;
-  for (const PnrDevice& d : pnrDevices())
-    if (pnr_devices_.empty() || std::count(pnr_devices_.begin(), pnr_devices_.end(), d.name) > 0) devices.push_back(d);
-  for (const std::string& n : pnr_devices_)
-    if (std::count(pnr_devices_.begin(), pnr_devices_.end(), n) > 1)
-      throw ArgError(fmt::format("--pnr-devices: {} is named twice", n));
-  return devices;
-}
-
 void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const {
   for (const SpanUnitConfig& m : modes) {
     try {
@@ -230,7 +187,7 @@ void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeC
 // The hardware tools, or why there are none: --no-hardware, a cache directory that cannot be
 // made, yosys or nextpnr missing. Only a bad --hardware-cache is an argument error.
 Hardware ReportCmd::hardwareTools() const {
-  return findHardwareTools(no_hardware_, hardware_cache_, devices_);
+  return hardware_.tools();
 }
 
 // The unit against cos^n (report/spec_error.h) for the shininess values of the scene its PROM
@@ -440,12 +397,11 @@ void ReportCmd::write(const Measured& m, json report, const fs::path& tmp) const
 
 int ReportCmd::run(const CLI::App&) {
   checkOutputDir();
-  checkHardwareCache();
+  hardware_.check();
   const Scene sc = loadScene(scene_);
   const std::vector<SpanUnitConfig> modes = modeConfigs();
   const LobeConfigs lobes;
   alt_units_ = altUnitConfigs();
-  devices_ = pnrDeviceList();
   for (const SceneObject& o : sc.objects) scene_n_.push_back(sc.materials.at(static_cast<size_t>(o.material)).shininess);
   if (rtl_) requireRtl(modes, lobes);
   const fs::path tmp = fs::temp_directory_path() / fmt::format("shadesim-report-{}", getpid());
