@@ -44,6 +44,16 @@ RenderResult renderModel(const Scene& s, Method m, const std::string& brdf, cons
   return render(s, o, e.span, e.view);
 }
 
+// phong-fixed with the quadratic lobe on the unit `quad` (an engine standing in for the model's).
+RenderResult renderPhongFixedQuadratic(const Scene& s, SpanEngine& span, SpecEngine& quad) {
+  SpecEngines view;
+  view.quadratic = &quad;
+  RenderOptions o;
+  o.method = Method::PhongFixed;
+  o.brdf = "quadratic";
+  return render(s, o, span, view);
+}
+
 double maxError(const Framebuffer& a, const Framebuffer& ref) {
   double worst = 0;
   for (size_t i = 0; i < a.rgb.size(); ++i)
@@ -200,12 +210,7 @@ TEST(Render, PhongFixedMemoEqualsTheBatchedRequests) {
     const RenderResult memo = renderModel(s, Method::PhongFixed, "quadratic", "serial");
     ModelEngines e("serial");
     testutil::BatchOnly batch(*e.quad);
-    SpecEngines view;
-    view.quadratic = &batch;
-    RenderOptions o;
-    o.method = Method::PhongFixed;
-    o.brdf = "quadratic";
-    const RenderResult batched = render(s, o, e.span, view);
+    const RenderResult batched = renderPhongFixedQuadratic(s, e.span, batch);
     EXPECT_EQ(batched.fb.rgb, memo.fb.rgb) << scene;
     EXPECT_EQ(batched.stats.spec_evaluations, memo.stats.spec_evaluations) << scene;
     EXPECT_EQ(batched.stats.spec_cycles, memo.stats.spec_cycles) << scene;
@@ -252,12 +257,7 @@ TEST(Render, RecordingSpecEngineSeesEveryRequest) {
   ModelEngines e("serial");
   Collect all(*e.quad);
   RecordingSpecEngine rec(all, true);
-  SpecEngines view;
-  view.quadratic = &rec;
-  RenderOptions o;
-  o.method = Method::PhongFixed;
-  o.brdf = "quadratic";
-  const RenderResult r = render(s, o, e.span, view);
+  const RenderResult r = renderPhongFixedQuadratic(s, e.span, rec);
   EXPECT_EQ(r.fb.rgb, memo.fb.rgb);
   std::set<std::array<uint32_t, 5>> distinct;
   for (const SpecRequest& q : all.all) distinct.insert({q.shin, q.cos, q.light[0], q.light[1], q.light[2]});
