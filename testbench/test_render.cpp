@@ -224,8 +224,8 @@ TEST(Render, PhongFixedMemoEqualsTheBatchedRequests) {
 TEST(Render, CulledTrianglesAreCountedByReason) {
   for (const char* scene : {"builtin:sphere", "builtin:plane", "builtin:materials", "builtin:torus"}) {
     const RenderStats st = renderModel(loadScene(scene), Method::Gouraud, "blinn", "serial").stats;
-    EXPECT_EQ(st.culled, st.culled_back + st.culled_outside + st.culled_no_pixel) << scene;
-    EXPECT_LE(st.culled + (st.drawn > 0 ? 1 : 0), st.triangles) << scene;
+    EXPECT_EQ(st.culled(), st.culled_back + st.culled_outside + st.culled_no_pixel) << scene;
+    EXPECT_LE(st.culled() + (st.drawn > 0 ? 1 : 0), st.triangles) << scene;
   }
   const RenderStats sphere = renderModel(loadScene("builtin:sphere"), Method::Gouraud, "blinn", "serial").stats;
   EXPECT_GT(sphere.culled_back, sphere.triangles / 3);
@@ -335,7 +335,7 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
     verts.assign(t.begin(), t.end());
     const TriangleView tv = viewTriangle(verts, {0, 1, 2}, cam.z_near);
     if (culledEarly(tv)) {
-      ++st.culled;
+      ++st.culled_back;
       return false;
     }
     return clipToFan(tv, proj, cam.width, cam.height, poly, fan, st);
@@ -344,10 +344,10 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
   RenderStats st;
   const PVertex a = vertex({0, 0, 1}), b = vertex({0.1, 0, 1}), c = vertex({0, 0.1, 1});
   EXPECT_TRUE(clip({a, b, c}, st));
-  EXPECT_EQ(st.clipped + st.culled, 0u);
+  EXPECT_EQ(st.clipped + st.culled(), 0u);
   // Its back: culled before anything is copied.
   EXPECT_FALSE(clip({a, c, b}, st));
-  EXPECT_EQ(st.culled, 1u);
+  EXPECT_EQ(st.culled(), 1u);
   // One vertex behind the eye: a quadrilateral in front of the near plane, projected.
   st = RenderStats{};
   const PVertex behind = vertex({0, 0.1, -1});
@@ -360,7 +360,7 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
   }
   // The same facing away once clipped: culled.
   EXPECT_FALSE(clip({b, a, behind}, st));
-  EXPECT_EQ(st.culled, 1u);
+  EXPECT_EQ(st.culled(), 1u);
   // Far beyond the viewport (to the right and up, left and up, right and down): cut to the
   // guard band on all four sides, the vertices' camera points from (x, y, w).
   double x0 = 0, x1 = 0, y0 = 0, y1 = 0;

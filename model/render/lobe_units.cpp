@@ -38,7 +38,7 @@ LobeEngines modelLobeEngines(const Scene& scene, const RenderOptions& opt, const
   for (Lobe l : deviceLobesUsed(scene, opt)) {
     const SpecUnitConfig cfg = configs.load(l);
     e.owned.push_back(modelSpecEngine(cfg));
-    (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.owned.back().get();
+    e.view.set(l, e.owned.back().get());
   }
   return e;
 }

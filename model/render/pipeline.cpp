@@ -69,14 +69,12 @@ bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly
   if (!t.all_in) {  // near plane, camera space
     poly = clipPolygon(poly, [&](const PVertex& v) { return v.cam.z - proj.z_near; });
     if (poly.size() < 3) {
-      ++st.culled;
       ++st.culled_outside;
       return false;
     }
     ++st.clipped;
     for (PVertex& v : poly) proj.project(v);
     if (!(area2(poly[0], poly[1], poly[2]) < 0)) {
-      ++st.culled;
       ++st.culled_back;
       return false;
     }
@@ -94,7 +92,6 @@ bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly
     poly = clipPolygon(poly, [&](const PVertex& v) { return v.y + kGuard; });
     poly = clipPolygon(poly, [&](const PVertex& v) { return H + kGuard - v.y; });
     if (poly.size() < 3) {
-      ++st.culled;
       ++st.culled_outside;
       return false;
     }

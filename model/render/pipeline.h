@@ -98,8 +98,8 @@ inline bool culledEarly(const TriangleView& t) { return t.all_in && !(area2(*t.v
 // The visible part of a triangle that is not culledEarly as a fan: its own three vertices (the
 // common case, nothing copied), or the polygon clipped by the near plane (camera space) and the
 // guard band (screen space: attributes interpolate linearly there, as in the span unit), held
-// in poly. False when nothing is left or the clipped triangle faces away (st.culled); st.clipped
-// counts each clip.
+// in poly. False when nothing is left (st.culled_outside) or the clipped triangle faces away
+// (st.culled_back); st.clipped counts each clip.
 bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly& poly, Fan& fan, RenderStats& st);
 
 }  // namespace shd

@@ -130,7 +130,6 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   ++st.triangles;
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
   if (culledEarly(tv)) {
-    ++st.culled;
     ++st.culled_back;
     return;
   }
@@ -142,10 +141,7 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   unit_.parts(fan_, parts_);
   const uint64_t drawn_before = st.drawn;
   for (const Part& part : parts_) drawPart(part, ti);
-  if (st.drawn == drawn_before) {  // every part dropped by setup: nothing on screen
-    ++st.culled;
-    ++st.culled_no_pixel;
-  }
+  if (st.drawn == drawn_before) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
 }
 
 // A part through the span unit's setup (dropped: culled), recorded, and drawn by its unit.

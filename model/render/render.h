@@ -145,12 +145,13 @@ struct RenderOptions {
 
 struct RenderStats {
   uint64_t triangles = 0;       // input triangles of every object
-  uint64_t culled = 0;          // input triangles of which nothing is drawn, the sum of:
+  // Input triangles of which nothing is drawn, by reason (culled() is their sum):
   uint64_t culled_back = 0;     //   back faces (and zero-area triangles), before any clipping
                                 //   or after the near plane
   uint64_t culled_outside = 0;  //   nothing left after the near plane or the guard band
   uint64_t culled_no_pixel = 0; //   on screen within the guard band but no pixel centre inside
                                 //   (off the viewport, or too small); dropped by setup
+  uint64_t culled() const { return culled_back + culled_outside + culled_no_pixel; }
   uint64_t clipped = 0;         // triangles cut by the near plane or the guard band
   uint64_t drawn = 0;           // screen triangles sent to the span unit
   uint64_t fragments = 0;
@@ -204,6 +205,7 @@ struct SpecEngines {
   SpecEngine* quadratic = nullptr;  // a degree-2 unit
   SpecEngine* cubic = nullptr;      // a degree-3 unit
   SpecEngine* forLobe(Lobe l) const { return l == Lobe::Cubic ? cubic : (l == Lobe::Quadratic ? quadratic : nullptr); }
+  void set(Lobe l, SpecEngine* e) { (l == Lobe::Cubic ? cubic : quadratic) = e; }  // a device lobe's
 };
 
 // The device lobes the scene uses with these options (to build only the engines needed).

@@ -28,8 +28,6 @@ uint64_t RecordingSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::
     ShinUse& u = use_[r.shin];
     ++u.requests;
     ++u.by_cos[r.cos];
-    u.cos_min = std::min(u.cos_min, r.cos);
-    u.cos_max = std::max(u.cos_max, r.cos);
     const uint32_t light = std::max({r.light[0], r.light[1], r.light[2]});
     u.light_max = std::max(u.light_max, light);
     if (light == 0)
@@ -72,11 +70,11 @@ nlohmann::json shinUseJson(const RecordingSpecEngine& rec) {
                    {"n", e == t.entries.end() ? nlohmann::json() : nlohmann::json(e->n)},
                    {"requests", u.requests},
                    {"unlit", u.unlit},
-                   {"cos_code_min", u.cos_min},
-                   {"cos_code_max", u.cos_max},
+                   {"cos_code_min", u.cosMin()},
+                   {"cos_code_max", u.cosMax()},
                    {"cos_code_max_lit", u.cos_max_lit},
-                   {"cos_min", u.cos_min * scale},
-                   {"cos_max", u.cos_max * scale},
+                   {"cos_min", u.cosMin() * scale},
+                   {"cos_max", u.cosMax() * scale},
                    {"light_code_max", u.light_max},
                    {"zero_code", zero},
                    {"at_or_below_zero", below}});

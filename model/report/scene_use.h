@@ -19,11 +19,12 @@ namespace shd {
 // The requests one PROM address received over a frame.
 struct ShinUse {
   uint64_t requests = 0;
-  uint32_t cos_min = UINT32_MAX, cos_max = 0;  // the cosine codes (N.H in uQ1.CosFracBits)
-  uint32_t cos_max_lit = 0;                    // the largest cosine code of a request with light
-  uint32_t light_max = 0;                      // the largest light code of any channel
-  uint64_t unlit = 0;                          // requests whose light codes are all 0
-  std::map<uint32_t, uint64_t> by_cos;         // requests per cosine code
+  uint32_t cos_max_lit = 0;             // the largest cosine code of a request with light
+  uint32_t light_max = 0;               // the largest light code of any channel
+  uint64_t unlit = 0;                   // requests whose light codes are all 0
+  std::map<uint32_t, uint64_t> by_cos;  // requests per cosine code (N.H in uQ1.CosFracBits)
+  uint32_t cosMin() const { return by_cos.begin()->first; }  // at least one request
+  uint32_t cosMax() const { return by_cos.rbegin()->first; }
 };
 
 // A specular engine that evaluates through another (the model or the RTL) and records every

@@ -46,15 +46,15 @@ std::vector<PnrDevice> HardwareOptions::chosenDevices() const {
   return out;
 }
 
-Hardware findHardwareTools(bool no_hardware, const std::string& cache_option, const std::vector<PnrDevice>& devices) {
+Hardware HardwareOptions::tools() const {
   Hardware hw;
-  if (no_hardware) {
+  if (none) {
     hw.absentBecause("area, fmax, time", "not measured: --no-hardware", false);
     return hw;
   }
   std::error_code ec;
-  if (!cache_option.empty()) {
-    hw.cache = cache_option;
+  if (!cache.empty()) {
+    hw.cache = cache;
   } else {
     const char* xdg = std::getenv("XDG_CACHE_HOME");
     const char* home = std::getenv("HOME");
@@ -81,7 +81,7 @@ Hardware findHardwareTools(bool no_hardware, const std::string& cache_option, co
   }
   try {
     if (pnr.empty()) throw std::runtime_error("scripts/pnr.py is neither in this installation nor in the source tree");
-    hw.pnr = PnrTool{pnr, hw.cache, pnrToolVersion(pnr), devices};
+    hw.pnr = PnrTool{pnr, hw.cache, pnrToolVersion(pnr), chosenDevices()};
   } catch (const std::exception& e) {
     hw.absentBecause("fmax, time", fmt::format("place and route: {}", e.what()), true);
   }

@@ -28,11 +28,6 @@ struct Hardware {
   }
 };
 
-// The tools, or none with --no-hardware (absent, not a failure). cache_option: --hardware-cache
-// ("" : $XDG_CACHE_HOME/shadesim, else ~/.cache/shadesim; made if missing). A tool that is
-// missing or does not run leaves its figures absent, a failure.
-Hardware findHardwareTools(bool no_hardware, const std::string& cache_option, const std::vector<PnrDevice>& devices);
-
 // The options of the hardware figures: --hardware-cache, --pnr-devices, --no-hardware.
 struct HardwareOptions {
   std::string cache;                 // --hardware-cache ("": the default)
@@ -43,7 +38,10 @@ struct HardwareOptions {
   // named twice (ArgError).
   void check() const;
   std::vector<PnrDevice> chosenDevices() const;  // in pnrDevices() order
-  Hardware tools() const { return findHardwareTools(none, cache, chosenDevices()); }
+  // The tools, or none with --no-hardware (absent, not a failure); the cache ("": $XDG_CACHE_HOME/
+  // shadesim, else ~/.cache/shadesim) made if missing. A tool that is missing or does not run
+  // leaves its figures absent, a failure.
+  Hardware tools() const;
 };
 
 // One hardware figure of one unit configuration: `member` ("area" or "pnr") of units[unit][name].

@@ -51,6 +51,7 @@ struct LobePrune {
   std::unique_ptr<ModelSpecEngine> full_engine, pruned_engine;
   std::unique_ptr<RecordingSpecEngine> recorder, pruned_recorder;  // the full frame's, the pruned frame's
   std::vector<double> n_used;  // the shininess values requested, ascending
+  std::vector<uint32_t> cos_min;  // per n_used entry the least cosine code requested
   json narrowed = json::array();  // {"width", "from", "to"} per width narrowed
   json one_less = json::object();  // per width: what one bit fewer breaks
 };
@@ -66,9 +67,6 @@ std::pair<int, uint64_t> frameDifference(const RenderResult& a, const RenderResu
   }
   return {max_diff, differ};
 }
-
-// The engine of a lobe's configuration (std::invalid_argument when its coefficients do not fit).
-std::unique_ptr<ModelSpecEngine> engineOf(const SpecUnitConfig& c) { return modelSpecEngine(c); }
 
 class PruneCmd final : public Command {
  public:
@@ -166,12 +164,8 @@ void PruneCmd::prunePromOf(LobePrune& lp) const {
   lp.pruned.prom.is_list = true;
   lp.pruned.rtl.ShinBits = addressBitsFor(lp.n_used.size());
   lp.pruned.rtl.validate();
-  // Per entry (ascending n) the least cosine code the scene reached: the pruned model refuses less.
-  lp.pruned.cos_code_min.clear();
-  for (double n : lp.n_used)
-    for (const auto& [address, u] : lp.recorder->use())
-      if (lp.full_engine->table().addressOf(n) == static_cast<int>(address)) lp.pruned.cos_code_min.push_back(u.cos_min);
-  lp.pruned_engine = engineOf(lp.pruned);
+  lp.pruned.cos_code_min = lp.cos_min;  // the pruned model refuses less than the scene reached
+  lp.pruned_engine = modelSpecEngine(lp.pruned);
 }
 
 // Each internal width of each lobe's unit (the sweep's list for its kind) one bit narrower at a
@@ -182,7 +176,7 @@ void PruneCmd::narrowWidths(const Scene& sc, const RenderOptions& ro, const Span
   ModelSpanEngine span(mode);
   auto view = [&] {
     SpecEngines v;
-    for (LobePrune& lp : lobes) (lp.lobe == Lobe::Cubic ? v.cubic : v.quadratic) = lp.pruned_engine.get();
+    for (LobePrune& lp : lobes) v.set(lp.lobe, lp.pruned_engine.get());
     return v;
   };
   for (LobePrune& lp : lobes) {
@@ -197,7 +191,7 @@ void PruneCmd::narrowWidths(const Scene& sc, const RenderOptions& ro, const Span
         try {
           c.rtl = SpecUnitParams::fromJson(rtl, c.name);
           c.rtl.validate();
-          e = engineOf(c);
+          e = modelSpecEngine(c);
         } catch (const std::invalid_argument& ex) {
           lp.one_less[w] = {{"breaks", ex.what()}};
           continue;
@@ -307,9 +301,8 @@ json PruneCmd::hardwareFigures(const std::vector<LobePrune>& lobes, Hardware& hw
   json units = {{"spec", json::object()}};
   std::vector<HardwareJob> jobs;
   for (const LobePrune& lp : lobes)
-    for (const auto* e : {lp.full_engine.get(), lp.pruned_engine.get()}) {
-      const PromTable* t = &e->table();
-      const std::string name = e == lp.full_engine.get() ? lp.full.name : lp.pruned.name;
+    for (const auto& [name, engine] : {std::pair{lp.full.name, lp.full_engine.get()}, std::pair{lp.pruned.name, lp.pruned_engine.get()}}) {
+      const PromTable* t = &engine->table();
       units["spec"][name] = json::object();
       if (hw.pnr)
         jobs.push_back({"spec", name, "pnr", "place and route of " + name, [t, tool = *hw.pnr] { return specPointPnr(*t, tool); }});
@@ -364,8 +357,8 @@ int PruneCmd::run(const CLI::App&) {
     lp.full = lobeConfigArg(lobes_, l);
     lp.full_engine = modelSpecEngine(lp.full);
     lp.recorder = std::make_unique<RecordingSpecEngine>(*lp.full_engine);
-    (l == Lobe::Cubic ? full_view.cubic : full_view.quadratic) = lp.full_engine.get();
-    (l == Lobe::Cubic ? rec_view.cubic : rec_view.quadratic) = lp.recorder.get();
+    full_view.set(l, lp.full_engine.get());
+    rec_view.set(l, lp.recorder.get());
     lobes.push_back(std::move(lp));
   }
   say(fmt::format("{} with {}: {} device lobe(s)", sc.name, method_, lobes.size()));
@@ -375,12 +368,16 @@ int PruneCmd::run(const CLI::App&) {
   std::string best = "serial";
   const bool uses_span = !traits(ro.method).exact;
   const json modes = uses_span ? laneModes(sc, ro, full_view, full, best) : json::array();
-  // 3. Per lobe the PROM of the shininess values used, then its widths narrowed within E.
+  // 3. Per lobe the PROM of the shininess values used (ascending, each with the least cosine
+  // requested), then its widths narrowed within E.
   for (LobePrune& lp : lobes) {
-    for (const auto& item : lp.recorder->use())
-      for (const PromEntry& e : lp.full_engine->table().entries)
-        if (e.address == item.first) lp.n_used.push_back(e.n);
-    std::sort(lp.n_used.begin(), lp.n_used.end());
+    std::vector<std::pair<double, uint32_t>> used;
+    for (const PromEntry& e : lp.full_engine->table().entries) {
+      const auto u = lp.recorder->use().find(e.address);
+      if (u != lp.recorder->use().end()) used.emplace_back(e.n, u->second.cosMin());
+    }
+    std::sort(used.begin(), used.end());
+    for (const auto& [n, c] : used) lp.n_used.push_back(n), lp.cos_min.push_back(c);
     if (!lp.n_used.empty()) prunePromOf(lp);
   }
   lobes.erase(std::remove_if(lobes.begin(), lobes.end(), [](const LobePrune& lp) { return lp.n_used.empty(); }), lobes.end());
@@ -388,12 +385,10 @@ int PruneCmd::run(const CLI::App&) {
   narrowWidths(sc, ro, mode, full, lobes);
   OutputFiles out;
   json lobes_json = json::array();
-  SpecEngines pruned_view;
   for (LobePrune& lp : lobes) {
     json lj = {{"lobe", toString(lp.lobe)}, {"requests", shinUseJson(*lp.recorder)}};
     lp.pruned.path = (fs::path(dir_) / ("spec_" + lp.pruned.name + ".json")).string();
     writePruned(lp, out, lj);
-    (lp.lobe == Lobe::Cubic ? pruned_view.cubic : pruned_view.quadratic) = lp.pruned_engine.get();
     lobes_json.push_back(lj);
   }
   // The material-to-address table the renderer uses (render.cpp: the PROM entry of the rounded
@@ -412,7 +407,7 @@ int PruneCmd::run(const CLI::App&) {
   SpecEngines rec_pruned;
   for (LobePrune& lp : lobes) {
     lp.pruned_recorder = std::make_unique<RecordingSpecEngine>(*lp.pruned_engine, true);
-    (lp.lobe == Lobe::Cubic ? rec_pruned.cubic : rec_pruned.quadratic) = lp.pruned_recorder.get();
+    rec_pruned.set(lp.lobe, lp.pruned_recorder.get());
   }
   ModelSpanEngine chosen(mode);
   const RenderResult pruned = render(sc, ro, chosen, rec_pruned);

@@ -196,7 +196,7 @@ int RenderCmd::run(const CLI::App& app) {
   std::printf("%s %s %s: %llu triangles (%llu culled), %llu fragments, %llu pixels, %llu span cycles, %.2f ms; "
               "vs reference: max %.2f LSB, PSNR %s dB, %.2f%% of pixels over 1 LSB; highlight (%llu px): max %.2f LSB\n",
               sc.name.c_str(), method_.c_str(), mode_.c_str(), static_cast<unsigned long long>(st.triangles),
-              static_cast<unsigned long long>(st.culled), static_cast<unsigned long long>(st.fragments),
+              static_cast<unsigned long long>(st.culled()), static_cast<unsigned long long>(st.fragments),
               static_cast<unsigned long long>(st.pixels_covered), static_cast<unsigned long long>(st.span_cycles), ms,
               c.all.max_abs_lsb, toJson(c.all)["psnr_db"].dump().c_str(), 100 * c.all.share_over_1lsb,
               static_cast<unsigned long long>(c.highlight.pixels), c.highlight.max_abs_lsb);

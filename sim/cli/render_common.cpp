@@ -34,7 +34,7 @@ Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConf
     } else {
       e.spec.push_back(modelSpecEngine(cfg));
     }
-    (l == Lobe::Cubic ? e.view.cubic : e.view.quadratic) = e.spec.back().get();
+    e.view.set(l, e.spec.back().get());
   }
   return e;
 }
@@ -86,7 +86,7 @@ RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderRes
 
 nlohmann::json frameCounts(const RenderStats& st) {
   return {{"triangles", st.triangles},
-          {"culled", st.culled},
+          {"culled", st.culled()},
           {"culled_back", st.culled_back},
           {"culled_outside", st.culled_outside},
           {"culled_no_pixel", st.culled_no_pixel},

@@ -67,7 +67,6 @@ class ReportCmd final : public Command {
   std::vector<SpanUnitConfig> modeConfigs() const;
   std::vector<SpecUnitConfig> altUnitConfigs() const;
   void requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeConfigs& lobes) const;
-  Hardware hardwareTools() const;
   json unitsJson(const std::vector<SpanUnitConfig>& modes, const Measured& m, const LobeConfigs& lobes,
                  Hardware& hw) const;
   json reportJson(const Scene& sc, const std::vector<SpanUnitConfig>& modes, const Measured& m, json units,
@@ -186,10 +185,6 @@ void ReportCmd::requireRtl(const std::vector<SpanUnitConfig>& modes, const LobeC
 
 // The hardware tools, or why there are none: --no-hardware, a cache directory that cannot be
 // made, yosys or nextpnr missing. Only a bad --hardware-cache is an argument error.
-Hardware ReportCmd::hardwareTools() const {
-  return hardware_.tools();
-}
-
 // The unit against cos^n (report/spec_error.h) for the shininess values of the scene its PROM
 // holds, at every cos code: what the unit alone adds to the scene's error.
 json sceneSpecError(const PromTable& t, const std::vector<double>& scene_n) {
@@ -431,7 +426,7 @@ int ReportCmd::run(const CLI::App&) {
                   reportLobeGroups(setup.alt_units).size(), modes.size(), bench_, rtl_ ? ", and with the verilated units" : ""));
   const Measured m = measureReport(setup);
   for (const std::string& w : m.warnings) std::fprintf(stderr, "report: warning: %s\n", w.c_str());
-  Hardware hw = hardwareTools();
+  Hardware hw = hardware_.tools();
   json units = unitsJson(modes, m, lobes, hw);
   const json report = reportJson(sc, modes, m, std::move(units), hw);
   write(m, report, tmp);

@@ -39,7 +39,7 @@ SceneDescriptors recordSceneDescriptors(const std::string& scene, const SpanPara
   SceneDescriptors out;
   out.descs = std::move(rec.descs());
   out.scene_triangles = r.stats.triangles;
-  out.culled = r.stats.culled;
+  out.culled = r.stats.culled();
   out.frame_fragments = r.stats.fragments;
   out.frame_cycles = r.stats.span_cycles;
   return out;
