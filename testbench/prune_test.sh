@@ -52,15 +52,19 @@ pruned = matplotlib.image.imread("pruned.png")
 diff = int(round(abs(full.astype(float) - pruned.astype(float)).max() * 255))
 if diff > 1 or diff != p["proof"]["max_abs_lsb"] or not p["proof"]["within_target"]:
     fail(f"the pruned image is {diff} LSB from the full one; prune's proof says {p['proof']}")
-# The work the frame does not need, against render --json's counts of the same frame.
-k, r = p["skippable"], json.load(open("r_serial.json"))
-for key in ("triangles", "culled_back", "culled_outside", "culled_no_pixel"):
+# The work the frame skipped, against render --json's counts of the same frame; the requests at
+# the zero also against the analysis's per-address counts (the recorder's histogram).
+k, r = p["skipped"], json.load(open("r_serial.json"))
+for key in ("triangles", "culled_back", "culled_outside", "culled_no_pixel", "fragments", "depth_rejected",
+            "spec_at_zero"):
     if k[key] != r[key]:
-        fail(f"skippable {key}: {k[key]}, render --json {r[key]}")
+        fail(f"skipped {key}: {k[key]}, render --json {r[key]}")
 if k["culled_back"] + k["culled_outside"] + k["culled_no_pixel"] != r["culled"]:
     fail(f"the culled triangles by reason do not add up to {r['culled']}: {k}")
-if k["spec_requests"] != r["spec_evaluations"] or not 0 < k["spec_at_or_below_zero"] < k["spec_requests"]:
-    fail(f"specular requests: {k}, render --json {r['spec_evaluations']} evaluations")
+per_address = sum(u["at_or_below_zero"] for lobe in a["lobes"] for u in lobe["requests"])
+if k["spec_requests"] != r["spec_evaluations"] or not 0 < k["spec_at_zero"] < k["spec_requests"] \
+        or per_address != k["spec_at_zero"]:
+    fail(f"specular requests: {k}, render --json {r['spec_evaluations']} evaluations, {per_address} at the zero by address")
 # The RTL: the chosen mode's verilated span unit in the loop, each pruned unit under Icarus on
 # every distinct request of the frame.
 rtl = p["proof"]["rtl"]

@@ -425,9 +425,10 @@ TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
     std::vector<int32_t> depth = depthAround(rng, r.px), tri(depth.size(), -1);
     std::vector<int32_t> want_depth = depth, want_tri = tri;
     std::vector<uint8_t> want_rgb = rgb;
-    uint64_t want_fresh = 0;
+    uint64_t want_fresh = 0, want_passed = 0;
     for (size_t k = 0; k < r.px.count; ++k) {
       if (!zTestWrite(r.px, k, 9, want_depth, want_tri, want_fresh)) continue;
+      ++want_passed;
       const size_t p = r.px.p + k;
       for (size_t ch = 0; ch < 3; ++ch) {
         const int64_t code = int64_t{r.c[ch]} + static_cast<int64_t>(k) * step[ch];
@@ -437,12 +438,14 @@ TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
       ++passed;
     }
     const fixed_simd::Target target{depth.data(), tri.data(), 9, kRunWidth};
-    const uint64_t fresh = fixed_simd::colourRun(r, target, rgb.data());
+    uint64_t got_passed = 0;
+    const uint64_t fresh = fixed_simd::colourRun(r, target, rgb.data(), got_passed);
     ASSERT_EQ(depth, want_depth) << "run " << t;
     ASSERT_EQ(tri, want_tri) << "run " << t;
     for (size_t i = 0; i < rgb.size(); ++i)
       ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << "run " << t << " frac " << r.frac << " byte " << i;
     ASSERT_EQ(fresh, want_fresh) << "run " << t;
+    ASSERT_EQ(got_passed, want_passed) << "run " << t;
     fragments += r.px.count;
   }
   EXPECT_GT(passed, fragments / 4);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <set>
 
@@ -283,6 +284,126 @@ TEST(Render, RecordingSpecEngineSeesEveryRequest) {
   EXPECT_LT(below, all.all.size());
 }
 
+// A request whose N.H code lies at or below the unit's zero for its shininess is answered 0
+// without an evaluation and counted (RenderStats::spec_at_zero). Against an engine of the test's
+// own that evaluates every request on a model of the PROM and counts them from its own scan of
+// the codes, on every path to the unit (the memo of phong-fixed, phong's per-pixel requests,
+// the vertices of gouraud, biquadratic's samples): the same image, the same requests and
+// cycles, the same count; and the memo was never filled below the zero.
+TEST(Render, SpecRequestsAtTheZeroAreSkippedWithTheSameImage) {
+  struct EveryRequest final : SpecEngine {
+    const PromTable& t;
+    SpecUnitModel m;
+    std::map<uint32_t, std::vector<bool>> zero_prefix;  // per shin: f is 0 at every code <= c
+    uint64_t at_zero = 0;
+    explicit EveryRequest(const PromTable& table) : t(table), m(table.unit, table.words, table.seg_words) {}
+    const PromTable& table() const override { return t; }
+    uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
+      out.clear();
+      for (const SpecRequest& r : in) {
+        std::vector<bool>& z = zero_prefix[r.shin];
+        if (z.empty()) {
+          bool all = true;
+          for (int64_t c = 0; c <= m.params().cosOne(); ++c)
+            z.push_back(all = all && m.evaluate(r.shin, static_cast<uint32_t>(c), {255, 255, 255}).spec == 0);
+        }
+        at_zero += z[r.cos];
+        out.push_back(m.evaluate(r.shin, r.cos, r.light).rgb);
+      }
+      return batchCycles(in.size(), m.params().latency());
+    }
+  };
+  for (const char* scene : {"builtin:sphere", "builtin:materials"})
+    for (const Method method : {Method::PhongFixed, Method::Phong, Method::Gouraud, Method::Biquadratic}) {
+      const Scene s = loadScene(scene);
+      const std::string what = std::string(scene) + " " + toString(method);
+      ModelEngines e("serial");
+      RenderOptions o;
+      o.method = method;
+      o.brdf = "quadratic";
+      const RenderResult model = render(s, o, e.span, e.view);
+      EveryRequest every(e.quad->table());
+      SpecEngines view;
+      view.quadratic = &every;
+      const RenderResult all = render(s, o, e.span, view);
+      EXPECT_EQ(model.fb.rgb, all.fb.rgb) << what;
+      EXPECT_EQ(model.stats.spec_evaluations, all.stats.spec_evaluations) << what;
+      EXPECT_EQ(model.stats.spec_cycles, all.stats.spec_cycles) << what;
+      EXPECT_EQ(model.stats.spec_at_zero, every.at_zero) << what;
+      EXPECT_EQ(all.stats.spec_at_zero, every.at_zero) << what;
+      EXPECT_GT(every.at_zero, model.stats.spec_evaluations / 2) << what;
+      EXPECT_LT(every.at_zero, model.stats.spec_evaluations) << what;
+      if (method != Method::PhongFixed) continue;
+      // The memo's rows (by shininess and light) hold no result at or below the zero: never
+      // evaluated; and results above it.
+      uint64_t above = 0;
+      for (const auto& [shin, prefix] : every.zero_prefix) {
+        const int64_t zero = e.quad->zeroCode(shin);
+        ASSERT_GE(zero, 0) << what;
+        EXPECT_TRUE(prefix[static_cast<size_t>(zero)] && !prefix[static_cast<size_t>(zero) + 1]) << what;
+        for (const Material& mat : s.materials) {
+          const uint64_t* row = e.quad->memo()->row(shin, lightFactors(makeShadeContext(s), mat).lights[0].device);
+          for (int64_t c = 0; c <= zero; ++c) EXPECT_EQ(row[c], 0u) << what << " code " << c;
+          for (int64_t c = zero + 1; c <= e.quad->model()->params().cosOne(); ++c) above += row[c] != 0;
+        }
+      }
+      EXPECT_GT(above, 100u) << what;
+    }
+}
+
+// The z-test comes before shading (docs/rendering.md): a fragment that fails it is counted
+// (RenderStats::depth_rejected) and never shaded. Against a replay of the test's own: every
+// fragment the span unit emitted, triangle by triangle in the order they were sent, z-tested
+// against a depth buffer of its own. The counts and the depth buffers agree for every method
+// that draws with the span unit, on the model's walk (its run loops) and on the collected
+// fragments (the RTL's path), on scenes whose triangles hide others.
+TEST(Render, EarlyDepthTestRejectionsAreCounted) {
+  struct Logged final : SpanEngine {
+    ModelSpanEngine inner;
+    std::vector<SpanFragment> log;  // every fragment, in the order emitted
+    explicit Logged(const SpanParams& p) : inner(p) {}
+    const SpanParams& params() const override { return inner.params(); }
+    SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override {
+      const SpanWalk w = inner.run(d, out);
+      log.insert(log.end(), out.end() - static_cast<ptrdiff_t>(w.fragments), out.end());
+      return w;
+    }
+  };
+  const std::string teapots = "/usr/share/assimp/models/Collada/teapots.DAE";
+  ASSERT_TRUE(fs::exists(teapots)) << teapots << " missing: scripts/install_deps.sh installs assimp-testmodels";
+  uint64_t rejected = 0;
+  for (const std::string& scene : {teapots, std::string("builtin:torus")}) {
+    const Scene s = loadScene(scene);
+    for (const Method method : allMethods()) {
+      if (traits(method).exact) continue;  // no span unit
+      for (const char* mode : {"serial", "sierpinski"}) {  // runs of rows, and lanes without runs
+        const std::string what = scene + " " + toString(method) + " " + mode;
+        ModelEngines e(mode);
+        RenderOptions o;
+        o.method = method;
+        o.brdf = "quadratic";
+        const RenderResult walked = render(s, o, e.span, e.view);
+        Logged logged(spanParams(mode));
+        const RenderResult collected = render(s, o, logged, e.view);
+        std::vector<int32_t> depth(walked.fb.depth.size(), 0);
+        uint64_t want = 0;
+        for (const SpanFragment& fr : logged.log) {
+          int32_t& d = depth[static_cast<size_t>(fr.y) * static_cast<size_t>(s.camera.width) + static_cast<size_t>(fr.x)];
+          if (fr.attr[3] <= d) ++want;
+          else d = static_cast<int32_t>(fr.attr[3]);
+        }
+        ASSERT_EQ(logged.log.size(), collected.stats.fragments) << what;
+        EXPECT_EQ(collected.stats.depth_rejected, want) << what;
+        EXPECT_EQ(walked.stats.depth_rejected, want) << what;
+        EXPECT_EQ(walked.fb.depth, depth) << what;
+        EXPECT_EQ(collected.fb.rgb, walked.fb.rgb) << what;
+        rejected += want;
+      }
+    }
+  }
+  EXPECT_GT(rejected, 10000u);
+}
+
 TEST(Render, BadOptionsAreNamed) {
   const Scene s = loadScene("builtin:sphere");
   ModelSpanEngine span(spanParams("serial"));
@@ -559,6 +680,7 @@ TEST(Render, VectorPathsEqualTheScalarPaths) {
         const RenderStats &a = vec.stats, &b = scalar.stats;
         EXPECT_EQ(a.fragments, b.fragments) << what;
         EXPECT_EQ(a.pixels_covered, b.pixels_covered) << what;
+        EXPECT_EQ(a.depth_rejected, b.depth_rejected) << what;
         EXPECT_EQ(a.span_cycles, b.span_cycles) << what;
         EXPECT_EQ(a.drawn, b.drawn) << what;
         pixels += a.pixels_covered;

@@ -208,6 +208,13 @@ SpecTrace SpecUnitModel::trace(uint32_t shin, uint32_t cos) const {
   return t;
 }
 
+int64_t SpecUnitModel::zeroCode(uint32_t shin) const {
+  const uint32_t full = static_cast<uint32_t>(p_.lightMax());
+  int64_t c = 0;
+  while (c <= p_.cosOne() && evaluate(shin, static_cast<uint32_t>(c), {full, full, full}).spec == 0) ++c;
+  return c - 1;
+}
+
 void SpecUnitModel::limitCosines(std::vector<uint32_t> least, std::string origin) {
   cos_least_ = std::move(least);
   cos_origin_ = std::move(origin);

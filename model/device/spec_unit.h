@@ -103,6 +103,10 @@ class SpecUnitModel {
   // The same datapath written with Fixed values in their formats, with every intermediate:
   // the readable formulation, for diagnostics and reports; trace().f equals evaluate().spec.
   SpecTrace trace(uint32_t shin, uint32_t cos) const;
+  // The largest cosine code up to which f is 0 at every code for shininess code shin (the
+  // polynomial's zero, the cubic's cut-off, a table's or a segment's zeros), or -1 when f(0) > 0:
+  // there the output is 0 whatever the light. Found by evaluating codes 0, 1, ... in turn.
+  int64_t zeroCode(uint32_t shin) const;
 
   // Cycle-accurate: state after reset, and the outputs after one rising clock edge with `in`
   // on the input ports.

@@ -26,7 +26,9 @@ inline uint64_t u(int64_t v) { return static_cast<uint64_t>(v); }
 
 // The ROW cycle, combinational part, for one lane-triangle at walker row w with its edges'
 // current quotients: the span [lo, hi]; returns ne (the lane-triangle has pixels on the row).
-inline bool laneRowBounds(const SpanLaneTri& t, int64_t w, const SpanDdaState* e, int64_t& lo, int64_t& hi) {
+// Always inlined: once per row of every triangle, and GCC's size heuristics otherwise leave it
+// out of a walk whose sink has grown (a call per row cost 4 % of a Gouraud frame).
+[[gnu::always_inline]] inline bool laneRowBounds(const SpanLaneTri& t, int64_t w, const SpanDdaState* e, int64_t& lo, int64_t& hi) {
   lo = t.clip_x0;
   hi = t.clip_x1;
   for (int s = 0; s < 3; ++s) {

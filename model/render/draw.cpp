@@ -33,6 +33,7 @@ std::array<double, 3> Frame::shadeNow(Vec3 n, Vec3 p) {
   if (!point_requests_.empty()) {
     st.spec_cycles += obj.spec->evaluate(point_requests_, device_out);
     st.spec_evaluations += point_requests_.size();
+    for (const SpecRequest& r : point_requests_) st.spec_at_zero += obj.coding.atZero(r.cos);
     for (const auto& d : device_out)
       for (size_t k = 0; k < 3; ++k) s.lsb[k] += d[k];
   }
@@ -56,6 +57,7 @@ void PixelRequests::finish(Frame& f, const PixelWriter& write) {
     st.spec_cycles += f.obj.direct != nullptr ? batchCycles(n, f.obj.direct->params().latency())
                                               : f.obj.spec->evaluate(requests, f.device_out);
     st.spec_evaluations += n;
+    st.spec_at_zero += zero_requests;
   }
   for (const Pending& pd : pending)
     st.pixels_covered +=

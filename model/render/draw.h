@@ -224,7 +224,10 @@ class Frame {
     const PixelWriter write = writer(t.tag);
     auto fragment = [&](int32_t x, int32_t y, const int64_t* attr) {
       const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
-      if (attr[3] <= fb.depth[p]) return;
+      if (attr[3] <= fb.depth[p]) {
+        ++st.depth_rejected;
+        return;
+      }
       st.pixels_covered += write(p, attr[3], combine(colourAt(x, y), nullptr, 0));
     };
     walk(t, fragment);
@@ -255,6 +258,7 @@ class PixelRequests {
     pending.clear();
     requests.clear();
     memo_requests = 0;
+    zero_requests = 0;
   }
   // The batch's cycles and evaluations counted, and the pending fragments written.
   void finish(Frame& f, const PixelWriter& write);
@@ -262,6 +266,7 @@ class PixelRequests {
   std::vector<SpecRequest> requests;
   std::vector<Pending> pending;
   size_t memo_requests = 0;  // phong-fixed on the unit's model: requests its memo answered
+  size_t zero_requests = 0;  // of all, those at or below the unit's zero (RenderStats::spec_at_zero)
 };
 
 }  // namespace shd

@@ -58,6 +58,7 @@ struct FixedShade {
   std::array<int64_t, 3> code{};
   std::array<uint32_t, 3> device{};
   uint32_t device_requests = 0;
+  uint32_t device_zero = 0;  // of those, at or below the unit's zero (DeviceCoding::atZero)
 };
 
 // The output pixel: round(clamp(code 2^-12, 0, 255)) plus the device results, clamped to 255
@@ -123,17 +124,22 @@ class SpecResultMemo {
 };
 
 // One request of a shader to the specular unit: queued in `requests` when there is no memo (the
-// batch path), else the memo's result (its row `row`) added to s.device at once.
-inline void deviceRequest(FixedShade& s, SpecResultMemo* memo, uint64_t* row, uint32_t shin, uint32_t cos,
+// batch path: the unit evaluates every request), else the memo's result (its row `row`) added to
+// s.device at once, or nothing for a cosine at or below the unit's zero (its result is 0).
+inline void deviceRequest(FixedShade& s, SpecResultMemo* memo, uint64_t* row, const DeviceCoding& coding, uint32_t cos,
                           const std::array<uint32_t, 3>& light, std::vector<SpecRequest>* requests) {
+  ++s.device_requests;
+  const bool zero = coding.atZero(cos);
+  s.device_zero += zero;
   if (memo == nullptr) {
     if (requests == nullptr) throw std::logic_error("a shader's device requests need a list");
-    requests->push_back(SpecRequest{shin, cos, light});
+    requests->push_back(SpecRequest{coding.shin, cos, light});
+  } else if (zero) {
+    memo->model().checkCosine(coding.shin, cos);  // a pruned unit's limit holds for skipped requests too
   } else {
-    const uint64_t r = memo->result(row, shin, cos, light);
+    const uint64_t r = memo->result(row, coding.shin, cos, light);
     for (size_t c = 0; c < 3; ++c) s.device[c] += static_cast<uint32_t>(r >> (20 * c)) & 0xFFFFFu;
   }
-  ++s.device_requests;
 }
 
 // The per-pixel arithmetic (inline: it runs once per fragment).
@@ -409,7 +415,7 @@ inline FixedShade FixedPointShader::shadeDots(const Consts& k, uint64_t sqnorm, 
     const int64_t nh = scaleCosine(nh_of(li, pl), sc);
     if constexpr (C == Cosine::Device) {
       const uint32_t cos = cosCode(nh, coding_->cos_frac_bits);
-      deviceRequest(s, memo_, pl.memo, coding_->shin, cos, pl.device_light, requests);
+      deviceRequest(s, memo_, pl.memo, *coding_, cos, pl.device_light, requests);
     } else {
       uint32_t f = 0;
       if constexpr (C == Cosine::NH) {

@@ -223,7 +223,7 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   return std::min(k, r.px.count);
 }
 
-SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb) {
+SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
   const __m128i frac = _mm_cvtsi32_si128(r.frac);
   const __m256i top = _mm256_set1_epi32(255 << r.frac), half = _mm256_set1_epi32(1 << (r.frac - 1));
   // Within each 128-bit half: pixels' bytes r g b (of 32-bit lanes r | g << 8 | b << 16) packed
@@ -233,6 +233,7 @@ SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb)
   uint64_t covered = 0;
   for (size_t k = 0; k < r.px.count; k += 8) {
     const __mmask8 pass = zTest8(t, r.px, k, covered);
+    passed += static_cast<uint64_t>(__builtin_popcount(pass));
     if (pass == 0) continue;
     __m256i px = _mm256_setzero_si256();
     for (int ch = 0; ch < 3; ++ch) {
@@ -266,7 +267,7 @@ uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64
 size_t bufferRun(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRun: built without the vector kernel");
 }
-uint64_t colourRun(const ColourRun&, const Target&, uint8_t*) {
+uint64_t colourRun(const ColourRun&, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourRun: built without the vector kernel");
 }
 

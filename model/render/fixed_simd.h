@@ -92,8 +92,9 @@ struct ColourRun {
 
 // The run's z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
 // and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch]. Returns the
-// passing pixels whose depth was 0 (not covered before). With the vector kernel only.
-uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb);
+// passing pixels whose depth was 0 (not covered before); adds the passing pixels to passed.
+// With the vector kernel only.
+uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed);
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
 // the z-test (the fragment's code above the buffer's), and where it passes the code and the

@@ -151,7 +151,7 @@ void FixedWidthsShader::addSpecular(FixedShade& s, PerLight& pl, int64_t nl, int
     const int cf = coding_->cos_frac_bits;
     const uint32_t cos = static_cast<uint32_t>(
         std::clamp<i128>(rescale(nh, w_.CosFracBits, cf), 0, i128{1} << cf));
-    deviceRequest(s, memo_, pl.memo, coding_->shin, cos, pl.device_light, requests);
+    deviceRequest(s, memo_, pl.memo, *coding_, cos, pl.device_light, requests);
     return;
   }
   uint32_t f = 0;

@@ -31,6 +31,7 @@ DeviceCoding codingFor(SpecEngine* e, const Material& m) {
     throw std::invalid_argument(
         fmt::format("shininess {} is not in the specular unit's PROM (n = {})", m.shininess, t.request.n.text));
   c.shin = static_cast<uint32_t>(a);
+  c.zero = e->zeroCode(c.shin);
   return c;
 }
 
@@ -175,11 +176,26 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
 }  // namespace
 
 
+int64_t SpecEngine::zeroCode(uint32_t shin) {
+  constexpr int64_t kUnknown = -2;
+  const SpecUnitModel* m = model();
+  if (m == nullptr) {
+    if (!table_model_) {
+      const PromTable& t = table();
+      table_model_ = std::make_unique<SpecUnitModel>(t.unit, t.words, t.seg_words);
+    }
+    m = table_model_.get();
+  }
+  if (shin >= zero_.size()) zero_.resize(std::max<size_t>(shin + 1, m->prom().size()), kUnknown);
+  if (zero_[shin] == kUnknown) zero_[shin] = m->zeroCode(shin);
+  return zero_[shin];
+}
+
 uint64_t ModelSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) {
   out.resize(in.size());
   for (size_t i = 0; i < in.size(); ++i) {
     unit_.checkCosine(in[i].shin, in[i].cos);
-    out[i] = unit_.evaluate(in[i].shin, in[i].cos, in[i].light).rgb;
+    out[i] = in[i].cos <= zeroCode(in[i].shin) ? std::array<uint32_t, 3>{} : unit_.evaluate(in[i].shin, in[i].cos, in[i].light).rgb;
   }
   return batchCycles(in.size(), unit_.params().latency());
 }

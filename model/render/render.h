@@ -102,6 +102,14 @@ class SpecEngine {
   virtual const SpecUnitModel* model() const { return nullptr; }
   // Non-null with model(): its results by request, kept from frame to frame (phong-fixed).
   virtual SpecResultMemo* memo() { return nullptr; }
+  // SpecUnitModel::zeroCode of shininess code shin, found once per code on model() or, for an
+  // engine without one (the RTL), on a model of table(): the renderer answers a request at or
+  // below it 0 without evaluating it, and counts it (RenderStats::spec_at_zero).
+  int64_t zeroCode(uint32_t shin);
+
+ private:
+  std::unique_ptr<SpecUnitModel> table_model_;  // zeroCode() of an engine without model()
+  std::vector<int64_t> zero_;                   // by shin; kUnknown until found
 };
 
 // The cycles of a batch of n requests through a pipelined unit of the given latency: the last
@@ -159,6 +167,12 @@ struct RenderStats {
   uint64_t span_cycles = 0;     // span unit cycles over the frame
   uint64_t spec_cycles = 0;     // specular unit cycles (0 when no device lobe is used)
   uint64_t spec_evaluations = 0;
+  uint64_t spec_at_zero = 0;    // of those, requests whose N.H code lies at or below the unit's
+                                //   zero for their shininess (SpecEngine::zeroCode): result 0,
+                                //   which the model gives without evaluating (the unit as built
+                                //   evaluates every request: spec_cycles count them all)
+  uint64_t depth_rejected = 0;  // fragments that failed the z-test, tested before shading (early):
+                                //   never shaded, no specular request (docs/rendering.md)
   uint64_t divisions = 0;       // gouraud-classical: raster lines with a division
   uint64_t split_parts = 0;     // modified-gouraud: triangles drawn after splitting
   uint64_t normalisations = 0;  // normal-bisection: exact normalisations (nodes)

@@ -83,6 +83,8 @@ LightFactors lightFactors(const ShadeContext& ctx, const Material& m);
 struct DeviceCoding {
   int cos_frac_bits = 15;
   uint32_t shin = 0;  // the PROM address of the material's shininess
+  int64_t zero = -1;  // SpecEngine::zeroCode(shin): a request's cos code at or below it gives 0
+  bool atZero(uint32_t cos) const { return static_cast<int64_t>(cos) <= zero; }
 };
 struct Shade {
   std::array<double, 3> lsb{};  // ambient + diffuse + analytic specular, 0..255 scale

@@ -38,19 +38,6 @@ uint64_t RecordingSpecEngine::evaluate(const std::vector<SpecRequest>& in, std::
   return inner_.evaluate(in, out);
 }
 
-namespace {
-
-// The largest cosine code up to which the unit's output is 0 at every code, or -1.
-int64_t zeroCode(const SpecUnitModel& m, uint32_t shin) {
-  const uint32_t full = static_cast<uint32_t>(m.params().lightMax());
-  const int64_t one = m.params().cosOne();
-  int64_t c = 0;
-  while (c <= one && m.evaluate(shin, static_cast<uint32_t>(c), {full, full, full}).spec == 0) ++c;
-  return c - 1;
-}
-
-}  // namespace
-
 nlohmann::json shinUseJson(const RecordingSpecEngine& rec) {
   const PromTable& t = rec.table();
   const double scale = std::ldexp(1.0, -t.unit.CosFracBits);
@@ -58,7 +45,7 @@ nlohmann::json shinUseJson(const RecordingSpecEngine& rec) {
   for (const auto& [address, u] : rec.use()) {
     nlohmann::json zero, below;
     if (const SpecUnitModel* m = rec.innerModel()) {
-      const int64_t z = zeroCode(*m, address);
+      const int64_t z = m->zeroCode(address);
       uint64_t n = 0;
       for (const auto& [cos, count] : u.by_cos)
         if (static_cast<int64_t>(cos) <= z) n += count;

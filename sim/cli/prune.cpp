@@ -43,6 +43,19 @@ namespace {
 
 constexpr uint64_t kPruneVerifyCycles = 20000;  // the Icarus replay of each pruned configuration
 
+// The units --drop can leave out, and the device lobes each one evaluates (none: the span unit).
+struct DropPart {
+  const char* name;
+  std::vector<Lobe> lobes;
+};
+const std::vector<DropPart>& dropParts() {
+  static const std::vector<DropPart> parts = {{"span", {}},
+                                              {"spec", {Lobe::Quadratic, Lobe::Cubic}},
+                                              {"spec-quadratic", {Lobe::Quadratic}},
+                                              {"spec-cubic", {Lobe::Cubic}}};
+  return parts;
+}
+
 // One device lobe of the scene: its full configuration, what the scene asked of it, its pruned
 // PROM.
 struct LobePrune {
@@ -75,6 +88,7 @@ class PruneCmd final : public Command {
 
  private:
   std::string scene_ = "builtin:sphere", dir_, method_ = "phong-fixed", brdf_;
+  std::vector<std::string> drop_;
   HardwareOptions hardware_;
   LobeConfigs lobes_;
   double target_lsb_ = 0;
@@ -84,6 +98,7 @@ class PruneCmd final : public Command {
     if (!quiet_) std::fprintf(stderr, "prune: %s\n", m.c_str());
   }
   void checkScene(const Scene& sc) const;
+  json checkDropped(const Scene& sc, const RenderOptions& ro) const;
   json laneModes(const Scene& sc, const RenderOptions& ro, const SpecEngines& full, const RenderResult& ref,
                  std::string& best) const;
   void prunePromOf(LobePrune& lp) const;
@@ -118,6 +133,14 @@ void PruneCmd::add(CLI::App& app) {
       ->required()
       ->check(realIn(0, 255));
   app.add_option("-o,--output", dir_, "the directory written (made if missing; its parent must exist)")->required();
+  std::vector<std::string> parts;
+  for (const DropPart& d : dropParts()) parts.emplace_back(d.name);
+  app.add_option("--drop", drop_,
+                 fmt::format("units to leave out ({}), comma-separated: refused when the scene, rendered with --method "
+                             "and --brdf, needs one",
+                             fmt::join(parts, " | ")))
+      ->delimiter(',')
+      ->check(CLI::IsMember(parts));
   hardware_.add(app, "no area and no place and route of the full and pruned units");
   app.add_flag("--quiet", quiet_, "no progress on stderr");
 }
@@ -128,6 +151,41 @@ void PruneCmd::checkScene(const Scene& sc) const {
     throw ArgError(fmt::format("--scene {}: no lights: every pixel is the ambient term; prune a scene that is lit", sc.name));
   existingOrNewDir("-o", dir_, dir_, "");
   hardware_.check();
+}
+
+// The units --drop names, each checked unneeded by the scene as rendered with `ro` (ArgError
+// naming what needs it): [{"part", "why"}], why: the reason the scene does without it.
+json PruneCmd::checkDropped(const Scene& sc, const RenderOptions& ro) const {
+  json dropped = json::array();
+  const std::vector<Lobe> used = deviceLobesUsed(sc, ro);
+  for (const std::string& name : drop_) {
+    if (std::count(drop_.begin(), drop_.end(), name) > 1) throw ArgError(fmt::format("--drop: {} is named twice", name));
+    const auto part = std::find_if(dropParts().begin(), dropParts().end(), [&](const DropPart& d) { return name == d.name; });
+    if (part->lobes.empty()) {  // the span unit
+      if (!traits(ro.method).exact)
+        throw ArgError(fmt::format("--drop span: {} draws every triangle with the span unit; only reference shades without it",
+                                   method_));
+      dropped.push_back({{"part", name}, {"why", fmt::format("{} shades every pixel directly", method_)}});
+      continue;
+    }
+    for (const Lobe l : part->lobes) {
+      if (std::find(used.begin(), used.end(), l) == used.end()) continue;
+      std::vector<std::string> objects;
+      for (const SceneObject& o : sc.objects) {
+        const Material& m = sc.materials.at(static_cast<size_t>(o.material));
+        if (parseLobe(brdf_.empty() ? m.brdf : brdf_) == l) objects.push_back(fmt::format("'{}' (material '{}')", o.name, m.name));
+      }
+      throw ArgError(fmt::format("--drop {}: {} with {} evaluates the {} lobe of {} on the specular unit; leave the unit in, "
+                                 "or give --brdf a lobe without it (blinn, phong, pow, ...)",
+                                 name, sc.name, method_, toString(l), fmt::join(objects, ", ")));
+    }
+    std::vector<std::string> lobes;
+    for (const Lobe l : part->lobes) lobes.emplace_back(toString(l));
+    dropped.push_back({{"part", name},
+                       {"why", traits(ro.method).exact ? fmt::format("{} evaluates the lobes exactly", method_)
+                                                       : fmt::format("no object's lobe is {}", fmt::join(lobes, " or "))}});
+  }
+  return dropped;
 }
 
 // Every lane mode of the registry on the scene, with the full specular units: cycles per frame,
@@ -348,6 +406,7 @@ int PruneCmd::run(const CLI::App&) {
   RenderOptions ro;
   ro.method = parseMethod(method_);
   ro.brdf = brdf_;
+  const json dropped = checkDropped(sc, ro);
   // 1. The full configurations, as rendered: every specular request recorded.
   std::vector<LobePrune> lobes;
   SpecEngines full_view, rec_view;
@@ -428,32 +487,29 @@ int PruneCmd::run(const CLI::App&) {
   // unit under Icarus on the frame's requests and on seeded random vectors.
   out.add((fs::path(dir_) / "analysis.json").string(), analysis.dump(1) + "\n");
   std::error_code ec;
-  fs::create_directories(fs::path(dir_) / "prom", ec);
+  if (!lobes.empty()) fs::create_directories(fs::path(dir_) / "prom", ec);
   if (ec) throw std::runtime_error(fmt::format("cannot make {}: {}", (fs::path(dir_) / "prom").string(), ec.message()));
   out.commit();
   bool rtl_ok = true;
   const json rtl = rtlProof(sc, ro, uses_span ? spanConfig(best) : SpanUnitConfig{}, pruned, rec_pruned, lobes, rtl_ok);
   Hardware hw = hardware_.tools();
   const json hardware = hardwareFigures(lobes, hw);
-  // The work a pixel or a triangle does not need, in the full frame (counted, not skipped: the
-  // images and cycles are the unit's as it is).
-  uint64_t spec_requests = 0, spec_zero = 0;
-  for (const json& lj : lobes_json)
-    for (const json& u : lj["requests"]) {
-      spec_requests += u["requests"].get<uint64_t>();
-      spec_zero += u["at_or_below_zero"].is_null() ? 0 : u["at_or_below_zero"].get<uint64_t>();
-    }
-  const json skippable = {{"spec_requests", spec_requests},
-                          {"spec_at_or_below_zero", spec_zero},
-                          {"triangles", full.stats.triangles},
-                          {"culled_back", full.stats.culled_back},
-                          {"culled_outside", full.stats.culled_outside},
-                          {"culled_no_pixel", full.stats.culled_no_pixel}};
+  // The work the full frame skipped (RenderStats): specular requests answered 0 without an
+  // evaluation, fragments rejected before shading, triangles culled before setup.
+  const json skipped = {{"spec_requests", full.stats.spec_evaluations},
+                        {"spec_at_zero", full.stats.spec_at_zero},
+                        {"fragments", full.stats.fragments},
+                        {"depth_rejected", full.stats.depth_rejected},
+                        {"triangles", full.stats.triangles},
+                        {"culled_back", full.stats.culled_back},
+                        {"culled_outside", full.stats.culled_outside},
+                        {"culled_no_pixel", full.stats.culled_no_pixel}};
   json summary = {{"target_lsb", target_lsb_},
                   {"lane_modes", modes},
                   {"chosen_mode", uses_span ? json(best) : json()},
                   {"unused", unusedParts(ro, mode, lobes)},
-                  {"skippable", skippable},
+                  {"dropped", dropped},
+                  {"skipped", skipped},
                   {"hardware", hardware},
                   {"proof", {{"max_abs_lsb", max_diff}, {"values_differing", differ}, {"within_target", image_ok}, {"rtl", rtl}}}};
   writeFileAtomic((fs::path(dir_) / "prune.json").string(), summary.dump(1) + "\n");

@@ -97,6 +97,8 @@ nlohmann::json frameCounts(const RenderStats& st) {
           {"cycles", st.span_cycles},
           {"spec_cycles", st.spec_cycles},
           {"spec_evaluations", st.spec_evaluations},
+          {"spec_at_zero", st.spec_at_zero},
+          {"depth_rejected", st.depth_rejected},
           {"divisions", st.divisions},
           {"split_parts", st.split_parts},
           {"normalisations", st.normalisations},

@@ -62,8 +62,9 @@ RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& model, const RenderR
 
 // The counts of a frame: {"triangles", "culled" (and its parts "culled_back", "culled_outside",
 // "culled_no_pixel"), "clipped", "drawn", "fragments",
-// "pixels_covered", "cycles" (span unit), "spec_cycles", "spec_evaluations", "divisions",
-// "split_parts", "normalisations", "adaptive_gouraud", "adaptive_phong"}.
+// "pixels_covered", "cycles" (span unit), "spec_cycles", "spec_evaluations", "spec_at_zero",
+// "depth_rejected", "divisions", "split_parts", "normalisations", "adaptive_gouraud",
+// "adaptive_phong"} (RenderStats).
 nlohmann::json frameCounts(const RenderStats& st);
 
 // A frame's model time: `first` (already rendered) and frames - 1 more into `scratch`; the

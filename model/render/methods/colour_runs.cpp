@@ -21,17 +21,21 @@ struct ColourFragment {
   int32_t* depth;
   int W;
   uint64_t& covered;
+  uint64_t& rejected;
   void operator()(int32_t x, int32_t y, const int64_t* attr) const {
     const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
     __builtin_prefetch(depth + p + W);  // the row below: most likely this triangle's next
-    if (attr[3] <= depth[p]) return;
+    if (attr[3] <= depth[p]) {
+      ++rejected;
+      return;
+    }
     covered += write(p, attr[3], {unorm8FromCode(attr[0], kColourFrac), unorm8FromCode(attr[1], kColourFrac),
                                   unorm8FromCode(attr[2], kColourFrac)});
   }
 };
 
 // The same for a whole run of a row (walkSpanUnit's run consumer): the loop in registers, the
-// newly covered pixels counted once per run. When the colour codes at both ends of the run lie
+// newly covered pixels and the rejected fragments counted once per run. When the colour codes at both ends of the run lie
 // in [0, 255 2^12] so do all between (they are affine), and unorm8FromCode is the rounding
 // shift alone.
 struct ColourRunLoop {
@@ -39,6 +43,7 @@ struct ColourRunLoop {
   int32_t* depth;
   int W;
   uint64_t& covered;
+  uint64_t& rejected;
   bool vector_runs;
   const fixed_simd::Target& target;
   uint8_t* rgb;
@@ -58,7 +63,7 @@ struct ColourRunLoop {
       const int64_t end = static_cast<int64_t>(a[k] + da[k] * static_cast<uint64_t>(count - 1));
       in_range = in_range && std::min(r.a0[k], end) >= 0 && std::max(r.a0[k], end) <= (255 << kColourFrac);
     }
-    uint64_t newly = 0;
+    uint64_t newly = 0, passed = 0;
     auto loop = [&](auto clamp) {
       auto unorm8 = [](uint64_t c) {
         if constexpr (decltype(clamp)::value) return unorm8FromCode(static_cast<int64_t>(c), kColourFrac);
@@ -67,13 +72,17 @@ struct ColourRunLoop {
       RunCursor c(r, W);
       for (int64_t i = 0; i < count; ++i, c.next()) {
         __builtin_prefetch(depth + c.p + W);  // as ColourFragment
-        if (c.depth() > depth[c.p]) newly += put(c.p, c.depth(), {unorm8(a[0]), unorm8(a[1]), unorm8(a[2])});
+        if (c.depth() > depth[c.p]) {
+          newly += put(c.p, c.depth(), {unorm8(a[0]), unorm8(a[1]), unorm8(a[2])});
+          ++passed;
+        }
         for (size_t k = 0; k < 3; ++k) a[k] += da[k];
       }
     };
     if (in_range) loop(std::false_type{});
     else loop(std::true_type{});
     covered += newly;
+    rejected += static_cast<uint64_t>(count) - passed;
   }
 
   // A left-to-right run in AVX-512 (fixed_simd::colourRun).
@@ -86,7 +95,9 @@ struct ColourRunLoop {
       run.dc[k] = static_cast<int32_t>(r.da[k]);
     }
     run.frac = kColourFrac;
-    covered += fixed_simd::colourRun(run, target, rgb);
+    uint64_t passed = 0;
+    covered += fixed_simd::colourRun(run, target, rgb, passed);
+    rejected += run.px.count - passed;
   }
 };
 
@@ -96,8 +107,8 @@ void drawColourRuns(Frame& f, const SpanTriangle& t) {
   const int W = f.W;
   const PixelWriter write = f.writer(t.tag);
   const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
-  ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered};
-  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.vector_runs, target, fb.rgb.data()};
+  ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected};
+  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, f.vector_runs, target, fb.rgb.data()};
   f.walk(t, fragment, run);
 }
 

@@ -43,6 +43,7 @@ struct PixelLighting {
     const size_t first = requests.size();
     const std::array<double, 3> lsb = shader.shade(n, pc, &requests).lsb;
     const size_t count = requests.size() - first;
+    for (size_t i = first; i < requests.size(); ++i) req.zero_requests += f.obj.coding.atZero(requests[i].cos);
     if (batched) {
       req.pending.push_back({p, wcode, lsb, first, count});
       return;
@@ -52,7 +53,7 @@ struct PixelLighting {
       for (size_t i = 0; i < count; ++i) {
         const SpecRequest& r = requests[first + i];
         f.obj.direct->checkCosine(r.shin, r.cos);
-        f.device_out[i] = f.obj.direct->evaluate(r.shin, r.cos, r.light).rgb;
+        f.device_out[i] = f.obj.coding.atZero(r.cos) ? std::array<uint32_t, 3>{} : f.obj.direct->evaluate(r.shin, r.cos, r.light).rgb;
       }
       f.st.pixels_covered += write(p, wcode, combine(lsb, f.device_out.data(), count));
       return;
@@ -136,7 +137,10 @@ class PhongUnit final : public MethodUnit {
       const uint64_t sqnorm = M == Method::PhongIncremental ? squaredNorm(x, y, attr) : 0;
       const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x);
       const int64_t wcode = attr[3];
-      if (wcode <= depth[p]) return;
+      if (wcode <= depth[p]) {
+        ++f_.st.depth_rejected;
+        return;
+      }
       const Vec3 nraw = rawNormal(attr);
       // phong-incremental: |N|^2 from the recurrence (exact integers), then the fixed-point 1/sqrt.
       light(p, x, y, wcode, M == Method::Phong ? normalize(nraw) : rsqrtFixed(sqnorm, 2 * kUnitFrac) * nraw);
@@ -152,7 +156,10 @@ class PhongUnit final : public MethodUnit {
       const SpanFragment& fr = frags[fi];
       const size_t p = static_cast<size_t>(fr.y) * f_.W + static_cast<size_t>(fr.x);
       const int64_t wcode = fr.attr[3];
-      if (wcode <= f_.fb.depth[p]) continue;
+      if (wcode <= f_.fb.depth[p]) {
+        ++f_.st.depth_rejected;
+        continue;
+      }
       light(p, fr.x, fr.y, wcode, bisected_[fi]);
     }
   }

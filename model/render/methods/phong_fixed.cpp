@@ -61,11 +61,15 @@ inline void fixedFragment(FixedTriangle& t, int32_t x, int32_t y, const int64_t*
   const size_t p = static_cast<size_t>(y) * t.W + static_cast<size_t>(x);
   const int64_t wcode = attr[3];
   __builtin_prefetch(t.depth + p + t.W);  // the row below: most likely this triangle's next
-  if (wcode <= t.depth[p]) return;
+  if (wcode <= t.depth[p]) {
+    ++t.st.depth_rejected;
+    return;
+  }
   const Vec3 pc = t.shader.needsPosition() ? t.f.proj.pixelCam(x, y, static_cast<double>(wcode) * kUnitLsb) : Vec3{};
   std::vector<SpecRequest>& requests = t.req.requests;
   const size_t first = requests.size();
   const FixedShade fs = t.shader.shade(attr, sqnorm, pc, &requests);
+  t.req.zero_requests += fs.device_zero;
   if (t.batched) {
     std::array<double, 3> lsb{};  // exact: the codes are far below 2^53
     for (size_t k = 0; k < 3; ++k) lsb[k] = std::ldexp(static_cast<double>(fs.code[k]), -kFixedColourFrac);
@@ -88,8 +92,8 @@ inline void fixedRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   SquaredNormRecurrence run_sqn;
   uint64_t sqnorm = run_sqn.start({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
   RunCursor c(r, W);
-  size_t requests_answered = 0;
-  uint64_t newly = 0;
+  size_t requests_answered = 0, at_zero = 0;
+  uint64_t newly = 0, rejected = 0;
   const auto put = t.write;
   kernel.start(r.a0, r.da);
   for (int64_t i = 0;;) {
@@ -97,7 +101,10 @@ inline void fixedRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
     if (c.depth() > depth[c.p]) {
       const FixedShade fs = kernel.shade(sqnorm);
       requests_answered += fs.device_requests;
+      at_zero += fs.device_zero;
       newly += put(c.p, c.depth(), fixedColour(fs));
+    } else {
+      ++rejected;
     }
     if (++i == count) break;
     sqnorm = run_sqn.next();
@@ -105,7 +112,9 @@ inline void fixedRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
     c.next();
   }
   t.req.memo_requests += requests_answered;
+  t.req.zero_requests += at_zero;
   t.st.pixels_covered += newly;
+  t.st.depth_rejected += rejected;
 }
 
 // The batch: shaded 8 at a time, the colours written (bufferRun has z-tested its fragments and
@@ -152,10 +161,16 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   run.dl = kernel.stepL();
   run.h = kernel.dotH();
   run.dh = kernel.stepH();
-  uint64_t newly = 0;
-  for (size_t k = 0; (k = fixed_simd::bufferRun(run, k, t.target, t.batch, newly)) < run.px.count;)
+  uint64_t newly = 0, passed = 0;
+  for (size_t k = 0;;) {
+    const size_t buffered = t.batch.n;
+    k = fixed_simd::bufferRun(run, k, t.target, t.batch, newly);
+    passed += t.batch.n - buffered;  // the fragments that passed the z-test
+    if (k >= run.px.count) break;
     flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
+  }
   t.st.pixels_covered += newly;
+  t.st.depth_rejected += run.px.count - passed;
 }
 
 // The walk with the vector kernel's batch.

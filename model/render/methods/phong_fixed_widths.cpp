@@ -35,10 +35,14 @@ class PhongWidthsUnit final : public MethodUnit {
       const uint64_t sqnorm = squared_norm(x, y, attr);
       const size_t p = static_cast<size_t>(y) * static_cast<size_t>(f_.W) + static_cast<size_t>(x);
       const int64_t wcode = attr[3];
-      if (wcode <= f_.fb.depth[p]) return;
+      if (wcode <= f_.fb.depth[p]) {
+        ++f_.st.depth_rejected;
+        return;
+      }
       const Vec3 pc = sh.needsPosition() ? f_.proj.pixelCam(x, y, static_cast<double>(wcode) * kUnitLsb) : Vec3{};
       const size_t first = req_.requests.size();
       const FixedShade fs = sh.shade(attr, sqnorm, pc, &req_.requests);
+      req_.zero_requests += fs.device_zero;
       if (batched) {
         req_.pending.push_back({p, wcode, {sh.lsb(fs.code[0]), sh.lsb(fs.code[1]), sh.lsb(fs.code[2])}, first,
                                 req_.requests.size() - first});

@@ -35,7 +35,10 @@ class ReferenceUnit final : public MethodUnit {
     for (const SpanFragment& fr : frags) {
       const size_t p = static_cast<size_t>(fr.y) * f_.W + static_cast<size_t>(fr.x);
       const int64_t wcode = fr.attr[3];
-      if (wcode <= fb.depth[p]) continue;
+      if (wcode <= fb.depth[p]) {
+        ++st.depth_rejected;
+        continue;
+      }
       const auto l = barycentric(t.v, fr.x, fr.y);
       const Vec3 n = normalize(l[0] * t.v[0]->n + l[1] * t.v[1]->n + l[2] * t.v[2]->n);
       const double w = l[0] * t.v[0]->w + l[1] * t.v[1]->w + l[2] * t.v[2]->w;
