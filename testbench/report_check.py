@@ -250,6 +250,17 @@ def check_spec_units_table(report, header, body):
         check(cells[1:] == want, f"report.md specular units {name}: {cells[1:]} != {want}")
 
 
+def check_work_skipped_table(report, body):
+    mode = report["options"]["modes"][0]
+    want = []
+    for r in report["rows"]:
+        k = r["counts"]
+        if r["mode"] == mode and k["spec_evaluations"] > 0:
+            n, z = k["spec_evaluations"], k["spec_at_zero"]
+            want.append([r["method"], r["lobe"], f"{z} of {n} ({100 * z / n:.0f} %)"])
+    check(body == want, f"report.md work skipped: {body[:3]}... != {want[:3]}... ({len(body)} and {len(want)} lines)")
+
+
 def check_markdown(d, report):
     md = open(os.path.join(d, "report.md"), encoding="utf-8").read()
     sheet = report["contact_sheet"]
@@ -260,6 +271,8 @@ def check_markdown(d, report):
             seen += 1
         elif heading == "Units":
             check_units_table(report, header, body)
+        elif heading == "Work skipped":
+            check_work_skipped_table(report, body)
         elif heading == "Place and route":
             check_pnr_table(report, body)
         elif heading == "Specular units compared":
@@ -305,6 +318,8 @@ def check_csv(d, report):
             elif re.match(r"^(ice40|xc7)_", k):
                 t, f = k.split("_", 1)
                 v = get(r, ("area", t, f))
+            elif k in ("spec_at_zero", "depth_rejected", "fragments"):
+                v = r["counts"][k]
             else:
                 v = r[k]
             check(same_number(text, v), f"report.csv {r['method']}/{r['lobe']}/{r['mode']} {k}: {text!r} != {v!r}")

@@ -160,6 +160,44 @@ std::string lobeTable(const json& report, const std::string& lobe) {
   return md;
 }
 
+// The work the frames skipped (RenderStats, on the rows of the first lane mode: the counts are
+// the same in every mode): the culled triangles and the fragments the depth test rejected (per
+// method where they differ), then the specular requests at the unit's zero, a row per method and
+// lobe that asks the unit.
+std::string workSkipped(const json& report) {
+  auto of = [](uint64_t part, uint64_t whole) {
+    return whole == 0 ? fmt::format("{}", part) : fmt::format("{} of {} ({:.0f} %)", part, whole, 100.0 * part / whole);
+  };
+  const json& first_mode = report["options"]["modes"].at(0);
+  std::vector<const json*> rows;
+  for (const json& r : report["rows"])
+    if (r["mode"] == first_mode) rows.push_back(&r);
+  if (rows.empty()) return "";
+  const json& k0 = (*rows.front())["counts"];
+  std::set<std::string> depth;
+  for (const json* r : rows)
+    depth.insert(of((*r)["counts"]["depth_rejected"].get<uint64_t>(), (*r)["counts"]["fragments"].get<uint64_t>()));
+  std::string md = fmt::format(
+      "Every frame culls {} of {} triangles before setup ({} back faces, {} outside the near plane or the guard band, {} "
+      "without a pixel centre); the early depth test rejects {} fragments before shading{}. Below: the specular "
+      "requests at or below the unit's zero, answered 0 without an evaluation (the unit as built evaluates them, and "
+      "the cycles count them).\n\n",
+      k0["culled"].get<uint64_t>(), k0["triangles"].get<uint64_t>(), k0["culled_back"].get<uint64_t>(),
+      k0["culled_outside"].get<uint64_t>(), k0["culled_no_pixel"].get<uint64_t>(),
+      of(k0["depth_rejected"].get<uint64_t>(), k0["fragments"].get<uint64_t>()),
+      depth.size() == 1 ? " with every method"
+                        : fmt::format(" with {} (over all methods: {})", (*rows.front())["method"].get<std::string>(),
+                                      fmt::join(depth, "; ")));
+  md += mdHeader({"method", "lobe", "specular requests at the unit's zero"});
+  for (const json* r : rows) {
+    const json& k = (*r)["counts"];
+    if (k["spec_evaluations"].get<uint64_t>() > 0)
+      md += mdRow({(*r)["method"].get<std::string>(), (*r)["lobe"].get<std::string>(),
+                   of(k["spec_at_zero"].get<uint64_t>(), k["spec_evaluations"].get<uint64_t>())});
+  }
+  return md;
+}
+
 // The units and their area.
 std::string unitsTable(const json& report) {
   const std::vector<std::string> targets = targetsOf(report);
@@ -316,6 +354,7 @@ std::string reportCsv(const json& report) {
   for (const char* f : {"ms", "frames", "span_cycles", "spec_cycles", "total_cycles", "spec_evaluations",
                         "image_equals_first_mode"})
     cols.push_back({f, {f}});
+  for (const char* f : {"spec_at_zero", "depth_rejected", "fragments"}) cols.push_back({f, {"counts", f}});
   if (rtl)
     for (const char* f : {"pixel_mismatches", "cycles_equal", "ms"}) cols.push_back({fmt::format("rtl_{}", f), {"rtl", f}});
   for (const auto& [d, title] : devicesOf(report)) cols.push_back({"time_us_" + d, {"time_us", d}});
@@ -354,6 +393,7 @@ std::string reportMarkdown(const json& report) {
     md += fmt::format("## Lobe {}\n\n", name == "material" ? "material (each material's own)" : "`" + name + "`");
     md += lobeTable(report, name) + "\n";
   }
+  if (!report["rows"].empty()) md += "## Work skipped\n\n" + workSkipped(report) + "\n";
   md += "## Units\n\n" + unitsTable(report) + "\n";
   if (!report["units"]["spec"].empty())
     md += "## Specular units compared\n\nThe paper's device (kind poly) beside the alternatives a designer would weigh. "
