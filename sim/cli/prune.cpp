@@ -494,16 +494,13 @@ int PruneCmd::run(const CLI::App&) {
   const json rtl = rtlProof(sc, ro, uses_span ? spanConfig(best) : SpanUnitConfig{}, pruned, rec_pruned, lobes, rtl_ok);
   Hardware hw = hardware_.tools();
   const json hardware = hardwareFigures(lobes, hw);
-  // The work the full frame skipped (RenderStats): specular requests answered 0 without an
-  // evaluation, fragments rejected before shading, triangles culled before setup.
-  const json skipped = {{"spec_requests", full.stats.spec_evaluations},
-                        {"spec_at_zero", full.stats.spec_at_zero},
-                        {"fragments", full.stats.fragments},
-                        {"depth_rejected", full.stats.depth_rejected},
-                        {"triangles", full.stats.triangles},
-                        {"culled_back", full.stats.culled_back},
-                        {"culled_outside", full.stats.culled_outside},
-                        {"culled_no_pixel", full.stats.culled_no_pixel}};
+  // The work the full frame skipped (its counts, as render --json): specular requests answered 0
+  // without an evaluation, fragments rejected before shading, triangles culled before setup.
+  const json counts = frameCounts(full.stats);
+  json skipped = json::object();
+  for (const char* k : {"spec_evaluations", "spec_at_zero", "fragments", "depth_rejected", "triangles", "culled_back",
+                        "culled_outside", "culled_no_pixel"})
+    skipped[k] = counts[k];
   json summary = {{"target_lsb", target_lsb_},
                   {"lane_modes", modes},
                   {"chosen_mode", uses_span ? json(best) : json()},
