@@ -616,3 +616,138 @@ TEST(SpanUnitModel, SharedEdgesOfMeshesDrawnExactlyOnce) {
     }
   }
 }
+
+namespace {
+
+// The full-rate variant of a lane mode's unit (RowAhead = 1).
+SpanParams fullRate(const std::string& mode) {
+  SpanParams p = spanParams(mode);
+  p.RowAhead = 1;
+  return p;
+}
+
+bool sameFragment(const SpanFragment& a, const SpanFragment& b) {
+  return a.tag == b.tag && a.x == b.x && a.y == b.y && a.attr == b.attr;
+}
+
+// The generator's descriptors for a mode's unit (tags 0, 1, ...).
+std::vector<SpanDesc> generatorDescriptors(const SpanParams& unit, uint64_t seed, int count) {
+  RasterConfig c;  // 512 x 512
+  c.unit = unit;
+  TriangleGenerator gen(seed);
+  std::vector<SpanDesc> out;
+  while (static_cast<int>(out.size()) < count) {
+    const GenTriangle t = gen.next();
+    const SetupResult s = setupTriangle(toSetupVertices(t, c.unit.NumAttr), static_cast<uint32_t>(out.size()), c);
+    if (s.desc) out.push_back(*s.desc);
+  }
+  return out;
+}
+
+// descs through the cycle model as a stream: each presented from the cycle after the one before
+// was taken (after a random gap when gaps), out_ready dropped at random when stalls. The
+// fragments in output order and the cycles until the unit is idle after the last.
+struct Streamed {
+  std::vector<SpanFragment> fragments;
+  uint64_t cycles = 0;
+};
+Streamed streamThrough(const SpanParams& p, const std::vector<SpanDesc>& descs, std::mt19937_64* rng) {
+  SpanUnitModel m(p);
+  Streamed s;
+  SpanIn in;
+  SpanOut o;
+  size_t next = 0;
+  while (next < descs.size() || !m.idle()) {
+    in.desc_valid = next < descs.size() && (rng == nullptr || (*rng)() % 4 != 0);
+    in.desc = in.desc_valid ? &descs[next] : nullptr;
+    in.out_ready = rng == nullptr || (*rng)() % 3 != 0;
+    m.tick(in, o);
+    ++s.cycles;
+    if (in.desc_valid && o.desc_ready) ++next;
+    if (o.out_valid && in.out_ready)
+      for (const SpanLaneOut& l : o.lane)
+        if (l.valid) s.fragments.push_back({o.tag, l.x, l.y, l.attr});
+  }
+  return s;
+}
+
+}  // namespace
+
+// The full-rate unit against the paper's, in every lane mode on generator triangles, each
+// descriptor alone: the same fragments in the same order, the same rows and lane groups, never
+// more cycles; and the walker equal to its cycle model, cycles included.
+TEST(SpanUnitModel, FullRateUnitGivesThePapersFragments) {
+  for (const std::string& m : spanModes()) {
+    const SpanParams paper_p = spanParams(m), full_p = fullRate(m);
+    SpanUnitModel paper(paper_p), full(full_p);
+    SpanRun a, b;
+    uint64_t paper_cycles = 0, full_cycles = 0, groups = 0;
+    for (const SpanDesc& d : generatorDescriptors(paper_p, 31, 20000)) {
+      runSpanUnit(paper, d, a);
+      runSpanUnit(full, d, b);
+      ASSERT_EQ(b.fragments.size(), a.fragments.size()) << m << " triangle " << d.tag;
+      for (size_t i = 0; i < a.fragments.size(); ++i)
+        ASSERT_TRUE(sameFragment(a.fragments[i], b.fragments[i])) << m << " triangle " << d.tag << " fragment " << i;
+      ASSERT_EQ(b.span_cycles, a.span_cycles) << m << " triangle " << d.tag;
+      ASSERT_EQ(b.row_cycles, a.row_cycles) << m << " triangle " << d.tag;
+      ASSERT_LE(b.cycles, a.cycles) << m << " triangle " << d.tag;
+      std::vector<SpanFragment> walked;
+      const SpanWalk wk = walkSpanUnit(full_p, d, walked);
+      ASSERT_EQ(wk.cycles, b.cycles) << m << " walker, triangle " << d.tag;
+      ASSERT_EQ(walked.size(), b.fragments.size()) << m << " walker, triangle " << d.tag;
+      paper_cycles += a.cycles;
+      full_cycles += b.cycles;
+      groups += a.span_cycles;
+    }
+    std::printf("%s, each triangle alone: paper %llu cycles, full rate %llu (%.3fx), lane groups %llu\n", m.c_str(),
+                static_cast<unsigned long long>(paper_cycles), static_cast<unsigned long long>(full_cycles),
+                static_cast<double>(full_cycles) / static_cast<double>(paper_cycles),
+                static_cast<unsigned long long>(groups));
+  }
+}
+
+// A stream of generator descriptors back to back through the full-rate unit, out_ready always 1:
+// the cycles until it is idle are the walker's (SpanStream, descriptor by descriptor) and every
+// descriptor's fragments come in order, as alone. With descriptors held back and out_ready
+// dropped at random: the same fragments in the same order. The paper's unit takes a stream in
+// the sum of its descriptors' cycles alone (it cannot overlap them).
+TEST(SpanUnitModel, FullRateStreamKeepsItsTiming) {
+  std::mt19937_64 rng(32);
+  for (const std::string& m : spanModes()) {
+    const SpanParams full_p = fullRate(m), paper_p = spanParams(m);
+    const std::vector<SpanDesc> descs = generatorDescriptors(paper_p, 33, 3000);
+    std::vector<SpanFragment> alone;
+    SpanStream stream;
+    uint64_t walked_cycles = 0, paper_cycles = 0, groups = 0;
+    for (const SpanDesc& d : descs) {
+      const SpanWalk wk = walkSpanUnit(full_p, d, [&](int32_t x, int32_t y, const int64_t* attr) {
+        SpanFragment f;
+        f.tag = d.tag;
+        f.x = x;
+        f.y = y;
+        for (int a = 0; a < full_p.NumAttr; ++a) f.attr.push_back(attr[a]);
+        alone.push_back(f);
+      }, span_detail::NoRuns{}, &stream);
+      walked_cycles += wk.cycles;
+      groups += wk.span_cycles;
+      std::vector<SpanFragment> scratch;
+      paper_cycles += walkSpanUnit(paper_p, d, scratch).cycles;
+    }
+    ASSERT_EQ(walked_cycles, stream.end()) << m;
+    const Streamed fast = streamThrough(full_p, descs, nullptr);
+    EXPECT_EQ(fast.cycles, walked_cycles) << m;
+    EXPECT_EQ(streamThrough(paper_p, descs, nullptr).cycles, paper_cycles) << m;
+    const Streamed slow = streamThrough(full_p, descs, &rng);
+    EXPECT_GT(slow.cycles, fast.cycles) << m;
+    for (const Streamed* s : {&fast, &slow}) {
+      ASSERT_EQ(s->fragments.size(), alone.size()) << m;
+      for (size_t i = 0; i < alone.size(); ++i)
+        ASSERT_TRUE(sameFragment(s->fragments[i], alone[i])) << m << " fragment " << i << " of the stream";
+    }
+    std::printf("%s, 3000 triangles back to back: paper %llu cycles, full rate %llu (%.3fx); lane groups %llu "
+                "(full rate %.3fx of them)\n",
+                m.c_str(), static_cast<unsigned long long>(paper_cycles), static_cast<unsigned long long>(fast.cycles),
+                static_cast<double>(fast.cycles) / static_cast<double>(paper_cycles), static_cast<unsigned long long>(groups),
+                static_cast<double>(fast.cycles) / static_cast<double>(groups));
+  }
+}

@@ -57,38 +57,39 @@ int64_t SpanUnitModel::wrapCoord(int64_t v) const { return wrapTo(u(v), p_.Coord
 
 void SpanUnitModel::reset() {
   state_ = State::Idle;
+  f_busy_ = q_valid_ = b_valid_ = e_valid_ = false;
+  f_slot_ = q_slot_ = 0;
+  b_ = er_ = RowRec{};
   e_.fill(SpanDdaState{});
   irow_.fill(0);
   icur_.fill(0);
-  lo_.fill(0);
-  hi_.fill(0);
-  ne_.fill(false);
   cycle_ = row_cycles_ = span_cycles_ = 0;
 }
 
 void SpanUnitModel::outputs(SpanOut& o) const {
-  o.desc_ready = state_ == State::Idle;
+  o.desc_ready = p_.RowAhead ? !q_valid_ : state_ == State::Idle;
   o.out_valid = false;
   o.tag = 0;
   const size_t lanes = static_cast<size_t>(p_.lanes());
   o.lane.resize(lanes);  // no-op (no allocation) after the first cycle
-  if (state_ != State::Span) {
+  if (p_.RowAhead ? !e_valid_ : state_ != State::Span) {
     for (SpanLaneOut& l : o.lane) l.valid = false;
     return;
   }
-  o.tag = d_.tag;
+  const SpanDesc& d = slot_[er_.slot];
+  o.tag = d.tag;
   const int L = p_.LanesPerTri;
   const size_t K = static_cast<size_t>(p_.NumAttr);
   for (int j = 0; j < p_.NumTri; ++j) {
     const size_t ju = static_cast<size_t>(j);
-    const SpanLaneTri& t = d_.tri[ju];
+    const SpanLaneTri& t = d.tri[ju];
     for (int i = 0; i < L; ++i) {
       SpanLaneOut& lane = o.lane[static_cast<size_t>(j * L + i)];
       const int64_t x = xg_ + i;  // CoordBits + 1 bits: no wrap
-      lane.valid = ne_[ju] && lo_[ju] <= x && x <= hi_[ju];
+      lane.valid = er_.ne[ju] && er_.lo[ju] <= x && x <= er_.hi[ju];
       if (!lane.valid) continue;
       lane.attr.resize(K);
-      laneFragment(p_, d_, t, x, wspan_, icur_.data(), i, lane.x, lane.y, lane.attr.data());
+      laneFragment(p_, d, t, x, er_.wspan, icur_.data(), i, lane.x, lane.y, lane.attr.data());
       o.out_valid = true;
     }
   }
@@ -102,78 +103,177 @@ SpanOut SpanUnitModel::tick(const SpanIn& in) {
 
 void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
   outputs(out);
+  if (in.desc_valid && out.desc_ready) {
+    if (in.desc == nullptr) throw std::invalid_argument("span descriptor missing");
+    checkDescriptor(p_, *in.desc);
+  }
+  if (p_.RowAhead) tickRowAhead(in, out);
+  else tickPaper(in, out);
+  ++cycle_;
+}
+
+bool SpanUnitModel::formRow(RowRec& r) const {
+  const SpanDesc& d = slot_[f_slot_];
+  const int L = p_.LanesPerTri;
+  bool any = false;
+  int64_t xs = 0;
+  for (int j = 0; j < p_.NumTri; ++j) {
+    const size_t ju = static_cast<size_t>(j);
+    r.ne[ju] = laneRowBounds(d.tri[ju], w_, &e_[ju * 3], r.lo[ju], r.hi[ju]);
+    if (r.ne[ju]) {
+      xs = any ? std::min(xs, r.lo[ju]) : r.lo[ju];
+      r.xe = any ? std::max(r.xe, r.hi[ju]) : r.hi[ju];
+      any = true;
+    }
+  }
+  if (!any) return false;
+  r.xg0 = p_.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+  for (int a = 0; a < p_.NumAttr; ++a) {
+    const size_t ai = static_cast<size_t>(a);
+    r.icur0[ai] = wrapAttr(u(irow_[ai]) + u(d.didx[ai]) * u(r.xg0 - d.xref));
+  }
+  r.wspan = w_;
+  r.slot = f_slot_;
+  return true;
+}
+
+void SpanUnitModel::stepRow() {
+  const SpanDesc& d = slot_[f_slot_];
+  // DDA steps of the edges active at w that stay active.
+  for (int j = 0; j < p_.NumTri; ++j)
+    stepEdges(d.tri[static_cast<size_t>(j)], w_, &e_[static_cast<size_t>(j) * 3], p_.CoordBits);
+  for (int a = 0; a < p_.NumAttr; ++a) {
+    const size_t ai = static_cast<size_t>(a);
+    irow_[ai] = wrapAttr(u(irow_[ai]) + u(d.didy[ai]));
+  }
+  w_ = wrapCoord(w_ + 1);
+}
+
+void SpanUnitModel::startDescriptor(size_t slot) {
+  f_slot_ = slot;
+  const SpanDesc& d = slot_[slot];
+  w_ = d.row_first;
+  for (int j = 0; j < p_.NumTri; ++j)
+    for (int s = 0; s < 3; ++s) {
+      const SpanEdge& e = d.tri[static_cast<size_t>(j)].edge[s];
+      e_[static_cast<size_t>(j * 3 + s)] = {e.q, e.r};
+    }
+  std::copy(d.iref.begin(), d.iref.end(), irow_.begin());
+}
+
+size_t SpanUnitModel::freeSlot() const {
+  for (size_t s = 0; s < slot_.size(); ++s)
+    if (!(e_valid_ && er_.slot == s) && !(b_valid_ && b_.slot == s) && !(f_busy_ && f_slot_ == s) &&
+        !(q_valid_ && q_slot_ == s))
+      return s;
+  throw std::logic_error("SpanUnitModel: every descriptor slot is held");  // E, B, F and Q hold at most 4
+}
+
+void SpanUnitModel::tickPaper(const SpanIn& in, const SpanOut& out) {
   const int L = p_.LanesPerTri;
   if (state_ == State::Row) ++row_cycles_;
   if (state_ == State::Span) ++span_cycles_;
   switch (state_) {
     case State::Idle:
       if (in.desc_valid) {
-        if (in.desc == nullptr) throw std::invalid_argument("span descriptor missing");
-        checkDescriptor(p_, *in.desc);
-        d_ = *in.desc;
-        w_ = d_.row_first;
-        for (int j = 0; j < p_.NumTri; ++j)
-          for (int s = 0; s < 3; ++s) {
-            const SpanEdge& e = d_.tri[static_cast<size_t>(j)].edge[s];
-            e_[static_cast<size_t>(j * 3 + s)] = {e.q, e.r};
-          }
-        std::copy(d_.iref.begin(), d_.iref.end(), irow_.begin());
+        slot_[0] = *in.desc;
+        startDescriptor(0);
         state_ = State::Row;
       }
       break;
     case State::Row: {
-      bool any = false;
-      int64_t xs = 0, xe = 0;
-      for (int j = 0; j < p_.NumTri; ++j) {
-        const size_t ju = static_cast<size_t>(j);
-        int64_t lo = 0, hi = 0;
-        const bool ne = laneRowBounds(d_.tri[ju], w_, &e_[ju * 3], lo, hi);
-        lo_[ju] = lo;
-        hi_[ju] = hi;
-        ne_[ju] = ne;
-        if (ne) {
-          xs = any ? std::min(xs, lo) : lo;
-          xe = any ? std::max(xe, hi) : hi;
-          any = true;
-        }
-      }
-      if (any) {
-        xe_ = xe;
-        xg_ = p_.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
-        for (int a = 0; a < p_.NumAttr; ++a) {
-          const size_t ai = static_cast<size_t>(a);
-          icur_[ai] = wrapAttr(u(irow_[ai]) + u(d_.didx[ai]) * u(xg_ - d_.xref));
-        }
-        wspan_ = w_;
+      const int64_t w = w_;
+      if (formRow(er_)) {
+        xg_ = er_.xg0;
+        icur_ = er_.icur0;
         state_ = State::Span;
       } else {
-        state_ = (w_ == d_.row_last) ? State::Idle : State::Row;
+        state_ = (w == slot_[0].row_last) ? State::Idle : State::Row;
       }
-      // Advance to the next row: DDA steps of the edges active here that stay active.
-      for (int j = 0; j < p_.NumTri; ++j)
-        stepEdges(d_.tri[static_cast<size_t>(j)], w_, &e_[static_cast<size_t>(j) * 3], p_.CoordBits);
-      for (int a = 0; a < p_.NumAttr; ++a) {
-        const size_t ai = static_cast<size_t>(a);
-        irow_[ai] = wrapAttr(u(irow_[ai]) + u(d_.didy[ai]));
-      }
-      w_ = wrapCoord(w_ + 1);
+      stepRow();
       break;
     }
     case State::Span:
       if (!out.out_valid || in.out_ready) {
-        if (xg_ + L > xe_) {
-          state_ = (wspan_ == d_.row_last) ? State::Idle : State::Row;
+        if (xg_ + L > er_.xe) {
+          state_ = (er_.wspan == slot_[0].row_last) ? State::Idle : State::Row;
         } else {
           xg_ += L;
           for (int a = 0; a < p_.NumAttr; ++a) {
             const size_t ai = static_cast<size_t>(a);
-            icur_[ai] = wrapAttr(u(icur_[ai]) + static_cast<uint64_t>(L) * u(d_.didx[ai]));
+            icur_[ai] = wrapAttr(u(icur_[ai]) + static_cast<uint64_t>(L) * u(slot_[0].didx[ai]));
           }
         }
       }
       break;
   }
-  ++cycle_;
+}
+
+void SpanUnitModel::tickRowAhead(const SpanIn& in, const SpanOut& out) {
+  const int L = p_.LanesPerTri;
+  if (e_valid_) ++span_cycles_;
+  // E: its lane group leaves (or shows nothing); the row's last group frees E.
+  bool e_done = false, e_step = false;
+  if (e_valid_ && (!out.out_valid || in.out_ready)) (xg_ + L > er_.xe ? e_done : e_step) = true;
+  const bool e_free = !e_valid_ || e_done;
+  const bool take_b = b_valid_ && e_free;
+  const bool b_free = !b_valid_ || take_b;
+  // F: row w formed; it goes to E when E is free and B empty, else to B when B is free; F moves
+  // on unless the row has pixels and B stays full.
+  RowRec formed;
+  bool f_moves = false, f_puts = false, bypass = false;
+  if (f_busy_) {
+    const bool any = formRow(formed);
+    bypass = any && e_free && !b_valid_;
+    f_puts = any && b_free && !bypass;
+    f_moves = !any || b_free;
+  }
+  const bool f_takes = !f_busy_ || (f_moves && w_ == slot_[f_slot_].row_last);
+  const bool accept = in.desc_valid && out.desc_ready;
+  // E, B, then F and Q (each from the values before the edge).
+  if (take_b || bypass) {
+    er_ = take_b ? b_ : formed;
+    xg_ = er_.xg0;
+    icur_ = er_.icur0;
+    e_valid_ = true;
+  } else if (e_done) {
+    e_valid_ = false;
+  } else if (e_step) {
+    xg_ += L;
+    for (int a = 0; a < p_.NumAttr; ++a) {
+      const size_t ai = static_cast<size_t>(a);
+      icur_[ai] = wrapAttr(u(icur_[ai]) + static_cast<uint64_t>(L) * u(slot_[er_.slot].didx[ai]));
+    }
+  }
+  if (f_puts) {
+    b_ = formed;
+    b_valid_ = true;
+  } else if (take_b) {
+    b_valid_ = false;
+  }
+  if (f_moves) {
+    ++row_cycles_;
+    stepRow();
+  }
+  bool accepted_by_f = false;
+  if (f_takes) {
+    f_busy_ = false;  // its descriptor's slot is free unless B or E holds a row of it
+    if (q_valid_) {
+      q_valid_ = false;
+      startDescriptor(q_slot_);
+      f_busy_ = true;
+    } else if (accept) {
+      const size_t s = freeSlot();
+      slot_[s] = *in.desc;
+      startDescriptor(s);
+      f_busy_ = accepted_by_f = true;
+    }
+  }
+  if (accept && !accepted_by_f) {
+    q_slot_ = freeSlot();
+    slot_[q_slot_] = *in.desc;
+    q_valid_ = true;
+  }
 }
 
 SpanRun runSpanUnit(SpanUnitModel& m, const SpanDesc& d) {

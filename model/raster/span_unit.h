@@ -74,11 +74,39 @@
 //             else:                     xg <- xg + LanesPerTri; icur <- icur + LanesPerTri*didx
 //   Cycles per triangle without stalls: 1 (IDLE, accepting) + sum over walker rows of
 //   (1 + the SPAN cycles of the row), SPAN cycles = floor((xe - xg0)/LanesPerTri) + 1.
+//
+// The full-rate unit (RowAhead = 1): the same rows, fragments and order per descriptor, without
+//   the ROW cycle between rows and the IDLE cycle between descriptors. Three stages:
+//     F, the former: the walker (w, irow, the edges' DDAs) and its descriptor; in each busy
+//       cycle it forms row w exactly as ROW above (lo_j, hi_j, ne_j, xe, xg0 = the row's first
+//       xg, icur0 = irow + didx*(xg0 - xref)), and moves on (the DDA steps, irow, w + 1) unless
+//       the row has pixels and B stays full. After its descriptor's row_last it takes the next
+//       descriptor in the same edge: Q's, else the one accepted in this cycle; else it idles.
+//     Q, one descriptor register: desc_ready = !Q.valid. An accepted descriptor goes straight
+//       to F when F takes one in the same edge (F idle or finishing) and Q is empty, else to Q.
+//     B, one row register: the row F formed with pixels, with its descriptor's output map.
+//     E, the emitter: shows its row's lane groups as SPAN above (xg from xg0, icur from icur0,
+//       the same lanes and outputs). When its row's last group leaves (or E is empty) it takes
+//       B's row in the same edge, or with B empty the row F forms in that cycle (as the paper's
+//       SPAN follows its ROW cycle); so a row's first group follows the last group of the row
+//       before with no cycle between, while F keeps ahead.
+//   At the rising edge, in this order of dependence: E's group leaves (!out_valid || out_ready);
+//   E takes B's row if E is free, or F's row if E is free and B empty; B takes F's row if E did
+//   not and B is empty or taken in this edge; F moves on or stalls; F takes the next descriptor;
+//   Q accepts.
+//   Cycles, out_ready always 1, descriptors back to back (SpanStream, which the walker uses):
+//   F forms walker row after walker row, one per cycle, from cycle 1 (cycle 0 accepts the first
+//   descriptor), stalled only while B holds a row E has not taken; a row with pixels formed in
+//   cycle f enters E after the later of cycle f and the previous row's last group, and stays
+//   for its lane groups. The unit is idle after E's last group and F's last row. A descriptor
+//   alone takes the paper's cycles less its ROW cycles after the first row, at most.
+//   desc_ready = !Q.valid and the outputs are still functions of registers only.
 //   Register widths: w, q, xg, xe, lo, hi: CoordBits signed; r, D, m: RemBits unsigned;
 //   attributes: AttrBits signed, wrapping (two's complement) like the RTL. Setup guarantees that
 //   every value a valid lane shows fits, so wrapping only ever touches masked lanes.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -106,6 +134,11 @@ struct SpanParams {
   int RemBits = 27;     // unsigned DDA divisor, remainder and m
   int PixBits = 12;     // unsigned screen pixel coordinates on the fragment ports
   int TagBits = 32;     // triangle tag carried to the fragments
+  // 0: the paper's unit (a ROW cycle per walker row, an IDLE cycle per descriptor); 1: the
+  // full-rate unit (rows formed ahead into a row register, the next descriptor queued). The
+  // model's alone so far: not yet a member of a configuration's "rtl" object or of the vector
+  // files, which the RTL reads (rtl/shd_span_unit.v has no such parameter yet).
+  int RowAhead = 0;
 
   int lanes() const { return NumTri * LanesPerTri; }
   void validate() const;  // std::invalid_argument naming the parameter
@@ -182,6 +215,40 @@ struct SpanDdaState {
   int64_t q = 0, r = 0;
 };
 
+// The full-rate unit's cycles (RowAhead = 1) over a stream of descriptors presented back to back
+// (each from the cycle the unit can take it) with out_ready always 1: the recurrence of the
+// cycle behaviour above, fed walker row by walker row. end() is the cycle count until the unit is
+// idle if no descriptor followed; a later descriptor never moves an earlier row, so end() only
+// grows, and its growth over a descriptor is that descriptor's share of the stream's cycles.
+class SpanStream {
+ public:
+  // A walker row of the current descriptor (the first row of the stream starts it): the lane
+  // groups E shows for it, 0 for a row without pixels.
+  void row(uint64_t groups) {
+    ++walker_rows_;
+    if (groups == 0) {
+      f_last_ = f_;
+      ++f_;
+      return;
+    }
+    // B is free for this row once E has taken the row before (at the edge before its start).
+    const uint64_t f = rows_ > 0 ? std::max(f_, e_start_ - 1) : f_;
+    e_start_ = std::max(rows_ > 0 ? e_end_ : 0, f) + 1;
+    e_end_ = e_start_ + groups - 1;
+    f_last_ = f;
+    f_ = f + 1;
+    ++rows_;
+  }
+  uint64_t end() const { return walker_rows_ == 0 ? 0 : std::max(rows_ > 0 ? e_end_ : 0, f_last_) + 1; }
+
+ private:
+  uint64_t f_ = 1;        // the cycle F forms its next walker row (cycle 0 accepts the first)
+  uint64_t f_last_ = 0;   // the cycle of F's last row
+  uint64_t e_start_ = 0, e_end_ = 0;  // the cycles of E's last row: its first and last group
+  uint64_t rows_ = 0;     // rows with pixels so far
+  uint64_t walker_rows_ = 0;
+};
+
 class SpanUnitModel {
  public:
   explicit SpanUnitModel(SpanParams p);
@@ -194,27 +261,48 @@ class SpanUnitModel {
   SpanOut tick(const SpanIn& in);
   void tick(const SpanIn& in, SpanOut& out);
   uint64_t cycle() const { return cycle_; }
-  bool idle() const { return state_ == State::Idle; }
-  // Cycles spent in ROW and in SPAN since reset (for utilisation figures).
+  bool idle() const {
+    return p_.RowAhead ? !f_busy_ && !q_valid_ && !b_valid_ && !e_valid_ : state_ == State::Idle;
+  }
+  // Cycles spent in ROW and in SPAN since reset (for utilisation figures); the full-rate unit:
+  // the rows F formed (stalls not counted) and the cycles E showed a lane group.
   uint64_t rowCycles() const { return row_cycles_; }
   uint64_t spanCycles() const { return span_cycles_; }
 
  private:
   enum class State { Idle, Row, Span };
+  // A row formed (ROW, or F): the lane-triangles' bounds, the span's end and first group, the
+  // plane there, its walker row and the slot of its descriptor.
+  struct RowRec {
+    std::array<int64_t, kMaxLaneTri> lo{}, hi{};
+    std::array<bool, kMaxLaneTri> ne{};
+    int64_t xe = 0, xg0 = 0, wspan = 0;
+    std::array<int64_t, kMaxAttr> icur0{};
+    size_t slot = 0;
+  };
   void outputs(SpanOut& o) const;
   int64_t wrapAttr(uint64_t v) const;
   int64_t wrapCoord(int64_t v) const;
+  bool formRow(RowRec& r) const;          // row w_ of slot f_slot_'s descriptor; false: no pixels
+  void stepRow();                         // the walker to the next row
+  void startDescriptor(size_t slot);      // the walker at the first row of slot's descriptor
+  size_t freeSlot() const;                // a slot no stage holds
+  void tickPaper(const SpanIn& in, const SpanOut& out);
+  void tickRowAhead(const SpanIn& in, const SpanOut& out);
 
   SpanParams p_;
+  // The descriptors held: the paper's unit uses slot 0; the full-rate unit one per stage that
+  // holds one (E's row, B's row, F, Q), so a stage refers to its slot instead of a copy.
+  std::array<SpanDesc, 4> slot_;
+  size_t f_slot_ = 0, q_slot_ = 0;
+  // The paper's unit: its state (E shows er_ in Span). The full-rate unit: F busy, Q, B and E.
   State state_ = State::Idle;
-  SpanDesc d_;
-  int64_t w_ = 0, wspan_ = 0, xg_ = 0, xe_ = 0;
-  // Registers held in place, sized for the largest unit; the first NumTri*3, NumAttr and NumTri
-  // are used.
+  bool f_busy_ = false, q_valid_ = false, b_valid_ = false, e_valid_ = false;
+  RowRec b_, er_;
+  int64_t w_ = 0, xg_ = 0;
+  // Registers held in place, sized for the largest unit; the first NumTri*3 and NumAttr are used.
   std::array<SpanDdaState, kMaxLaneTri * 3> e_{};
   std::array<int64_t, kMaxAttr> irow_{}, icur_{};
-  std::array<int64_t, kMaxLaneTri> lo_{}, hi_{};
-  std::array<bool, kMaxLaneTri> ne_{};
   uint64_t cycle_ = 0, row_cycles_ = 0, span_cycles_ = 0;
 };
 

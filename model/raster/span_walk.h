@@ -152,12 +152,15 @@ struct NoRuns {};
 
 // The fragments of one descriptor, in the order SpanUnitModel hands them over with out_ready
 // always 1, each passed to emit(x, y, attr) (attr: NumAttr codes, valid during the call), and
-// the cycles counted as runSpanUnit counts them. See walkSpanUnit in raster/span_unit.h.
+// the cycles counted as runSpanUnit counts them. See walkSpanUnit in raster/span_unit.h. The
+// full-rate unit (RowAhead): the cycles are those the descriptor adds to `stream` (a stream of
+// descriptors back to back), or without one those of the descriptor alone.
 // With a run consumer, a row of a single lane-triangle (serial, evenodd, segments) whose
 // values provably do not wrap goes to run_consumer(const RowRun&) instead, as one run (the
 // same fragments; the consumer's own loop over them; see RowRun); other rows as above.
 template <class Sink, class RunSink = span_detail::NoRuns>
-SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, RunSink&& run_consumer = {}) {
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, RunSink&& run_consumer = {},
+                      SpanStream* stream = nullptr) {
   using namespace span_detail;
   // A local copy of the consumer (a closure of pointers and references): the compiler may then
   // keep what it captured in registers across the consumer's own stores (a byte store may
@@ -167,7 +170,10 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   checkDescriptor(p, d);
   const int L = p.LanesPerTri, T = p.NumTri, K = p.NumAttr;
   SpanWalk walk;
-  walk.cycles = 1;  // IDLE, accepting the descriptor
+  SpanStream alone;
+  SpanStream& timing = stream != nullptr ? *stream : alone;
+  const uint64_t stream_end = timing.end();
+  uint64_t groups = 0;  // the lane groups (SPAN cycles) of the current row
   std::array<SpanDdaState, kMaxLaneTri * 3> e;  // the first 3 T set here (zeroing all costs more than a row)
   for (int j = 0; j < T; ++j)
     for (int s = 0; s < 3; ++s) {
@@ -195,7 +201,8 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     int64_t lo = 0, hi = 0;
     if (!laneRowBounds(t, w, e.data(), lo, hi)) return;
     const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
-    walk.span_cycles += static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
+    groups = static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
+    walk.span_cycles += groups;
     bool ran = false;
     if constexpr (!std::is_same_v<std::decay_t<RunSink>, NoRuns>)
       ran = runRow<KC, AB>(p, d, t, w, lo, hi, irow.data(), emit_run);
@@ -229,6 +236,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     }
     for (;;) {  // SPAN cycles
       ++walk.span_cycles;
+      ++groups;
       for (int j = 0; j < T; ++j) {
         const size_t ju = static_cast<size_t>(j);
         if (!ne[ju]) continue;
@@ -254,15 +262,18 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   auto rows = [&](auto kc, auto ab) {
     for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
       ++walk.row_cycles;
+      groups = 0;
       if (T == 1) singleLaneRow(w, kc, ab);
       else laneTrianglesRow(w);
+      if (p.RowAhead) timing.row(groups);
       stepRow(w, kc, ab);
       if (w == d.row_last) break;
     }
   };
   if (K == 4 && p.AttrBits == 32) rows(std::integral_constant<int, 4>{}, std::integral_constant<int, 32>{});
   else rows(std::integral_constant<int, 0>{}, std::integral_constant<int, 0>{});
-  walk.cycles += walk.row_cycles + walk.span_cycles;
+  // The paper's unit: the IDLE cycle accepting the descriptor, its ROW and SPAN cycles.
+  walk.cycles = p.RowAhead ? timing.end() - stream_end : 1 + walk.row_cycles + walk.span_cycles;
   return walk;
 }
 

@@ -26,6 +26,10 @@ struct ModeCycles {
   uint64_t fragments = 0;
   uint64_t cycles = 0;
   uint64_t row_cycles = 0, span_cycles = 0;
+  // The same triangles back to back through the full-rate unit (SpanParams::RowAhead, the
+  // walker's SpanStream). span_cycles is the no-overhead bound of the lane layout: its lane
+  // groups alone, as if every row and triangle transition were free.
+  uint64_t full_rate_cycles = 0;
   int lanes = 1;
   double utilisation() const {
     return span_cycles ? static_cast<double>(fragments) / (static_cast<double>(span_cycles) * lanes) : 0.0;
