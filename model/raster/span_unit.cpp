@@ -76,7 +76,7 @@ void SpanUnitModel::outputs(SpanOut& o) const {
     for (SpanLaneOut& l : o.lane) l.valid = false;
     return;
   }
-  const SpanDesc& d = slot_[er_.slot];
+  const SpanDesc& d = slot_[p_.RowAhead ? er_.slot : 0];  // the paper's unit: slot 0
   o.tag = d.tag;
   const int L = p_.LanesPerTri;
   const size_t K = static_cast<size_t>(p_.NumAttr);
@@ -116,17 +116,22 @@ bool SpanUnitModel::formRow(RowRec& r) const {
   const SpanDesc& d = slot_[f_slot_];
   const int L = p_.LanesPerTri;
   bool any = false;
-  int64_t xs = 0;
+  int64_t xs = 0, xe = 0;
   for (int j = 0; j < p_.NumTri; ++j) {
     const size_t ju = static_cast<size_t>(j);
-    r.ne[ju] = laneRowBounds(d.tri[ju], w_, &e_[ju * 3], r.lo[ju], r.hi[ju]);
-    if (r.ne[ju]) {
-      xs = any ? std::min(xs, r.lo[ju]) : r.lo[ju];
-      r.xe = any ? std::max(r.xe, r.hi[ju]) : r.hi[ju];
+    int64_t lo = 0, hi = 0;
+    const bool ne = laneRowBounds(d.tri[ju], w_, &e_[ju * 3], lo, hi);
+    r.lo[ju] = lo;
+    r.hi[ju] = hi;
+    r.ne[ju] = ne;
+    if (ne) {
+      xs = any ? std::min(xs, lo) : lo;
+      xe = any ? std::max(xe, hi) : hi;
       any = true;
     }
   }
   if (!any) return false;
+  r.xe = xe;
   r.xg0 = p_.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
   for (int a = 0; a < p_.NumAttr; ++a) {
     const size_t ai = static_cast<size_t>(a);
@@ -185,7 +190,7 @@ void SpanUnitModel::tickPaper(const SpanIn& in, const SpanOut& out) {
       const int64_t w = w_;
       if (formRow(er_)) {
         xg_ = er_.xg0;
-        icur_ = er_.icur0;
+        std::copy_n(er_.icur0.begin(), p_.NumAttr, icur_.begin());
         state_ = State::Span;
       } else {
         state_ = (w == slot_[0].row_last) ? State::Idle : State::Row;
@@ -234,7 +239,7 @@ void SpanUnitModel::tickRowAhead(const SpanIn& in, const SpanOut& out) {
   if (take_b || bypass) {
     er_ = take_b ? b_ : formed;
     xg_ = er_.xg0;
-    icur_ = er_.icur0;
+    std::copy_n(er_.icur0.begin(), p_.NumAttr, icur_.begin());
     e_valid_ = true;
   } else if (e_done) {
     e_valid_ = false;
