@@ -720,14 +720,7 @@ TEST(SpanUnitModel, FullRateStreamKeepsItsTiming) {
     SpanStream stream;
     uint64_t walked_cycles = 0, paper_cycles = 0, groups = 0;
     for (const SpanDesc& d : descs) {
-      const SpanWalk wk = walkSpanUnit(full_p, d, [&](int32_t x, int32_t y, const int64_t* attr) {
-        SpanFragment f;
-        f.tag = d.tag;
-        f.x = x;
-        f.y = y;
-        for (int a = 0; a < full_p.NumAttr; ++a) f.attr.push_back(attr[a]);
-        alone.push_back(f);
-      }, span_detail::NoRuns{}, &stream);
+      const SpanWalk wk = walkSpanUnit(full_p, d, alone, &stream);
       walked_cycles += wk.cycles;
       groups += wk.span_cycles;
       std::vector<SpanFragment> scratch;

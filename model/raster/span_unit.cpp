@@ -315,7 +315,7 @@ void runSpanUnit(SpanUnitModel& m, const SpanDesc& d, SpanRun& run) {
   run.span_cycles = m.spanCycles() - spans0;
 }
 
-SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out) {
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out, SpanStream* stream) {
   SpanFragment f;
   f.tag = d.tag;
   f.attr.resize(static_cast<size_t>(p.NumAttr));
@@ -324,7 +324,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFr
     f.y = y;
     std::copy(attr, attr + p.NumAttr, f.attr.begin());
     out.push_back(f);
-  });
+  }, span_detail::NoRuns{}, stream);
 }
 
 }  // namespace shd

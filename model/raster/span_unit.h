@@ -338,6 +338,8 @@ struct RowRun {
 struct SpanWalk {
   uint64_t cycles = 0, row_cycles = 0, span_cycles = 0, fragments = 0;
 };
-SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out);
+// stream: as for the template form (raster/span_walk.h), the full-rate unit's stream.
+SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, std::vector<SpanFragment>& out,
+                      SpanStream* stream = nullptr);
 
 }  // namespace shd
