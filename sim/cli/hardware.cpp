@@ -35,8 +35,7 @@ void HardwareOptions::add(CLI::App& app, const std::string& no_hardware_help) {
 
 void HardwareOptions::check() const {
   if (!cache.empty()) existingOrNewDir("--hardware-cache", cache, cache, "");
-  for (const std::string& n : devices)
-    if (std::count(devices.begin(), devices.end(), n) > 1) throw ArgError(fmt::format("--pnr-devices: {} is named twice", n));
+  for (const std::string& n : devices) refuseRepeat("--pnr-devices", devices, n);
 }
 
 std::vector<PnrDevice> HardwareOptions::chosenDevices() const {

@@ -10,6 +10,7 @@
 // range. CLI11's own conversion runs only on text that passed.
 #pragma once
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdint>
@@ -18,6 +19,7 @@
 #include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -48,6 +50,12 @@ constexpr double kMaxGap = 0.9;                           // probabilities of a 
 inline void requireAbsent(const CLI::App& app, std::initializer_list<const char*> options, const std::string& why) {
   for (const char* o : options)
     if (app.count(o) > 0) throw ArgError(fmt::format("{} {}", o, why));
+}
+
+// A comma-separated list option (--modes, --drop, --pnr-devices) names each entry once:
+// ArgError "<option>: <entry> is named twice" when `entry` is in `names` more than once.
+inline void refuseRepeat(const char* option, const std::vector<std::string>& names, const std::string& entry) {
+  if (std::count(names.begin(), names.end(), entry) > 1) throw ArgError(fmt::format("{}: {} is named twice", option, entry));
 }
 
 // A directory option (--fail-dir): an existing directory; ArgError otherwise. The programs

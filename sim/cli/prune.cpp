@@ -159,7 +159,7 @@ json PruneCmd::checkDropped(const Scene& sc, const RenderOptions& ro) const {
   json dropped = json::array();
   const std::vector<Lobe> used = deviceLobesUsed(sc, ro);
   for (const std::string& name : drop_) {
-    if (std::count(drop_.begin(), drop_.end(), name) > 1) throw ArgError(fmt::format("--drop: {} is named twice", name));
+    refuseRepeat("--drop", drop_, name);
     const auto part = std::find_if(dropParts().begin(), dropParts().end(), [&](const DropPart& d) { return name == d.name; });
     if (part->lobes.empty()) {  // the span unit
       if (!traits(ro.method).exact)

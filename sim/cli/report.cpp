@@ -131,7 +131,7 @@ std::vector<SpanUnitConfig> ReportCmd::modeConfigs() const {
   std::vector<SpanUnitConfig> modes;
   for (const std::string& n : names) {
     if (n.empty()) throw ArgError("--modes: an empty entry (name the span configurations, comma-separated)");
-    if (std::count(names.begin(), names.end(), n) > 1) throw ArgError(fmt::format("--modes: {} is named twice", n));
+    refuseRepeat("--modes", names, n);
     modes.push_back(spanConfigArg("--modes", n));
     // The rows and units are keyed by the configuration's name: a file may not reuse one.
     for (size_t k = 0; k + 1 < modes.size(); ++k)
