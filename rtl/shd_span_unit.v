@@ -46,6 +46,15 @@
 //             wraps around to row_last (up to 2^CoordBits rows). Setup must not send one.
 //           - Parameters are not checked: LanesPerTri must be 1, 2, 4 or 8 (lane i adds i*didx
 //             as at most three shifted copies of didx, i < 8).
+// RowAhead: 0 is the paper's unit above. 1 is the full-rate unit (model/raster/span_unit.h
+//           gives its cycle behaviour): a row former F (the walker and the ROW logic above, one
+//           walker row per cycle), a row register B, an emitter E (the SPAN lanes above) and a
+//           one-descriptor queue Q; desc_ready_o = !Q.valid. F's descriptor registers are the
+//           ones above, loaded when F takes a descriptor (from Q, else from the inputs); a row
+//           F forms carries its output map (tag, didx, the lane-triangles' ox, oy, flip, aoff)
+//           to B and E, so E shows a row of one descriptor while F walks the next. lo_q, hi_q,
+//           ne_q, xe_q, wspan_q, xg_q, icur_q are E's and load when E takes a row. Q, B and E
+//           hold data registers without reset; their valid bits and F's busy bit reset to 0.
 // Model:    model/raster/span_unit.h SpanUnitModel, bit-exact and cycle-accurate.
 module shd_span_unit #(
   parameter integer NumTri      = 1,
@@ -56,7 +65,8 @@ module shd_span_unit #(
   parameter integer CoordBits   = 16,
   parameter integer RemBits     = 27,
   parameter integer PixBits     = 12,
-  parameter integer TagBits     = 32
+  parameter integer TagBits     = 32,
+  parameter integer RowAhead    = 0
 ) (
   input  wire                                  clk_i,
   input  wire                                  rst_ni,
@@ -106,10 +116,8 @@ module shd_span_unit #(
   // Pixel sums, exact: C+2 bits, and at least one bit above the PixBits kept.
   localparam integer PXW   = (PixBits >= C + 2) ? PixBits + 1 : C + 2;
   localparam integer MW    = A + C + 1;                  // didx*(xg - xref), natural width
-
-  localparam [1:0] ST_IDLE = 2'd0;
-  localparam [1:0] ST_ROW  = 2'd1;
-  localparam [1:0] ST_SPAN = 2'd2;
+  // A descriptor as one word, in the order the walker loads it (the full-rate unit's queue).
+  localparam integer DW    = TagBits + 3*C + 3*AV + NumTri*(6*C + 1 + AV) + NE*(1 + 4*C + 3*R);
 
   // The most negative / positive C+1-bit and C-bit values: empty min/max reductions give them.
   localparam [C:0]   EXT_MIN    = {1'b1, {C{1'b0}}};
@@ -119,10 +127,7 @@ module shd_span_unit #(
   localparam [C-1:0] ALIGN_MASK = {C{1'b1}} << ((AlignLanes != 0) ? LOG2L : 0);
 
   // ---------------------------------------------------------------- registers
-  reg  [1:0]             state_q;
-  reg  [1:0]             state_d;
-
-  // Descriptor: loaded when a descriptor is accepted.
+  // The walker's descriptor (F's in the full-rate unit): loaded when the walker takes one.
   reg  [TagBits-1:0]     tag_q;
   reg  [C-1:0]           row_last_q;
   reg  [C-1:0]           xref_q;
@@ -153,86 +158,78 @@ module shd_span_unit #(
   wire [NE*C-1:0]        quo_d;
   wire [NE*R-1:0]        rem_d;
 
-  // Row results: each lane-triangle's bounds in the row being spanned.
-  reg  [NumTri*C-1:0]    lo_q;
-  reg  [NumTri*C-1:0]    hi_q;
-  reg  [NumTri-1:0]      ne_q;
+  // The row formed at w (ROW; F): each lane-triangle's bounds.
   wire [NumTri*C-1:0]    lo_d;
   wire [NumTri*C-1:0]    hi_d;
   wire [NumTri-1:0]      ne_d;
 
-  // Span: the lane group's first column, the span end, its row and the plane at (xg, wspan).
+  // The row shown (SPAN; E): each lane-triangle's bounds, the span end, its row, the lane
+  // group's first column and the plane there.
+  reg  [NumTri*C-1:0]    lo_q;
+  reg  [NumTri*C-1:0]    hi_q;
+  reg  [NumTri-1:0]      ne_q;
   reg  [C-1:0]           xg_q;
   reg  [C-1:0]           xe_q;
   reg  [C-1:0]           wspan_q;
   reg  [AV-1:0]          icur_q;
+  // Its output map: the walker's descriptor registers (paper), E's copy (full rate).
+  wire [TagBits-1:0]     em_tag;
+  wire [AV-1:0]          em_didx;
+  wire [NumTri*C-1:0]    em_ox;
+  wire [NumTri*C-1:0]    em_oy;
+  wire [NumTri-1:0]      em_flip;
+  wire [NumTri*AV-1:0]   em_aoff;
 
-  // ---------------------------------------------------------------- control
-  wire in_idle  = (state_q == ST_IDLE);
-  wire in_row   = (state_q == ST_ROW);
-  wire in_span  = (state_q == ST_SPAN);
-  wire accept   = in_idle && desc_valid_i;
+  // ---------------------------------------------------------------- control, shared
+  // Each mode's section at the end of the module drives these.
+  wire          f_load;     // the walker takes a descriptor: Q's if f_from_q, else the ports'
+  wire          f_from_q;   // (0 in the paper's unit)
+  wire [DW-1:0] q_word;     // Q's descriptor, in the walker's load order (0 in the paper's unit)
+  wire          f_step;     // the walker steps to the next row
+  wire          form_en;    // the ROW logic's result is used (ROW; F busy)
+  wire          show;       // the lanes show a row (SPAN; E holds one)
+  wire          any_ne;     // row w has pixels in some lane-triangle
+  wire          span_done;  // the lane group shown is its row's last
+  wire          span_adv = !out_valid_o || out_ready_i;  // the lane group shown leaves (or is empty)
 
-  wire span_adv;    // SPAN: the lane group is taken (or shows nothing)
-  wire span_done;   // SPAN: the lane group is the row's last
-  wire any_ne;      // ROW: some lane-triangle has pixels in row w
-  wire span_load  = in_row && any_ne;
-  wire span_step  = in_span && span_adv && !span_done;
-
-  always @* begin
-    state_d = state_q;
-    case (state_q)
-      ST_IDLE: if (desc_valid_i) state_d = ST_ROW;
-      ST_ROW: begin
-        if (any_ne)                 state_d = ST_SPAN;
-        else if (w_q == row_last_q) state_d = ST_IDLE;
-      end
-      ST_SPAN: begin
-        if (span_adv && span_done) state_d = (wspan_q == row_last_q) ? ST_IDLE : ST_ROW;
-      end
-      default: state_d = ST_IDLE;
-    endcase
-  end
-
-  always @(posedge clk_i or negedge rst_ni) begin
-    if (!rst_ni) state_q <= ST_IDLE;
-    else         state_q <= state_d;
-  end
-
+  // Taking a descriptor loads the descriptor registers and starts the walker at row_first with
+  // iref and every edge's (q0, r0); f_step steps the walker. The ports are concatenated here,
+  // in the clocked block, and not in a wire: a simulator then reads them only when a descriptor
+  // is taken, not on every input change (Verilator's input logic runs on every eval); the
+  // hardware is the same two-input mux. q_word holds the same fields in the same order
+  // (g_ahead's Q load).
   always @(posedge clk_i) begin
-    if (accept) begin
-      tag_q          <= desc_tag_i;
-      row_last_q     <= desc_row_last_i;
-      xref_q         <= desc_xref_i;
-      didx_q         <= desc_didx_i;
-      didy_q         <= desc_didy_i;
-      lt_row_first_q <= lt_row_first_i;
-      lt_row_last_q  <= lt_row_last_i;
-      lt_clip_x0_q   <= lt_clip_x0_i;
-      lt_clip_x1_q   <= lt_clip_x1_i;
-      lt_ox_q        <= lt_ox_i;
-      lt_oy_q        <= lt_oy_i;
-      lt_flip_q      <= lt_flip_i;
-      lt_aoff_q      <= lt_aoff_i;
-      e_right_q      <= e_right_i;
-      e_row_first_q  <= e_row_first_i;
-      e_row_last_q   <= e_row_last_i;
-      e_k_q          <= e_k_i;
-      e_div_q        <= e_div_i;
-      e_m_q          <= e_m_i;
+    if (f_load) begin
+      if (f_from_q)
+        {tag_q, row_last_q, xref_q, didx_q, didy_q, lt_row_first_q, lt_row_last_q, lt_clip_x0_q,
+         lt_clip_x1_q, lt_ox_q, lt_oy_q, lt_flip_q, lt_aoff_q, e_right_q, e_row_first_q,
+         e_row_last_q, e_k_q, e_div_q, e_m_q, w_q, irow_q, quo_q, rem_q} <= q_word;
+      else
+        {tag_q, row_last_q, xref_q, didx_q, didy_q, lt_row_first_q, lt_row_last_q, lt_clip_x0_q,
+         lt_clip_x1_q, lt_ox_q, lt_oy_q, lt_flip_q, lt_aoff_q, e_right_q, e_row_first_q,
+         e_row_last_q, e_k_q, e_div_q, e_m_q, w_q, irow_q, quo_q, rem_q} <=
+        {desc_tag_i, desc_row_last_i, desc_xref_i, desc_didx_i, desc_didy_i, lt_row_first_i,
+         lt_row_last_i, lt_clip_x0_i, lt_clip_x1_i, lt_ox_i, lt_oy_i, lt_flip_i, lt_aoff_i,
+         e_right_i, e_row_first_i, e_row_last_i, e_k_i, e_div_i, e_m_i, desc_row_first_i,
+         desc_iref_i, e_q_i, e_r_i};
+    end else if (f_step) begin
+      w_q    <= w_d;
+      irow_q <= irow_d;
+      quo_q  <= quo_d;
+      rem_q  <= rem_d;
     end
   end
 
   // ---------------------------------------------------------------- ROW datapath
-  // The logic of this section feeds only registers that load in ROW (w, irow, the edges'
-  // (q, r), lo, hi, ne; xg, xe, icur, wspan on span_load) and state_d's ROW branch (any_ne).
-  // It is written as combinational blocks that compute it under `if (in_row)` and leave it
-  // don't-care ('x) otherwise: a simulator that evaluates every block on every clock
-  // (Verilator) then skips it in SPAN and IDLE cycles, and synthesis may simplify with the
-  // don't-care (the registers load these values only in ROW, where they are unchanged). The
-  // functions carry `verilator no_inline_task`: Verilator then makes them C++ functions with
-  // local variables instead of copying every argument and local into a member of the model at
-  // each call site, which is faster; other tools ignore the comment.
+  // The logic of this section feeds only the walker's step, the row's registers (lo, hi, ne,
+  // xg, xe, icur, wspan; the full-rate unit's B and E) and the control (any_ne). It is written
+  // as combinational blocks that compute it under `if (form_en)` and leave it don't-care ('x)
+  // otherwise: a simulator that evaluates every block on every clock (Verilator) then skips it
+  // in the paper's SPAN and IDLE cycles, and synthesis may simplify with the don't-care (the
+  // registers load these values only when form_en is 1). The functions carry
+  // `verilator no_inline_task`: Verilator then makes them C++ functions with local variables
+  // instead of copying every argument and local into a member of the model at each call site,
+  // which is faster; other tools ignore the comment.
 
   // One edge slot in row w: the DDA state of row w+1, stepped iff row_first <= w < row_last
   // (active at w and w < row_last): r' = r - m; if r' < 0 { r' += D; q' = q + k + 1 } else
@@ -300,8 +297,9 @@ module shd_span_unit #(
     end
   endfunction
 
-  // IDLE (accepting) loads row_first, iref and every edge's (q0, r0); ROW steps them.
-  assign w_d = w_q + {{(C-1){1'b0}}, 1'b1};  // ROW: next row, wraps at CoordBits
+
+  // Taking a descriptor loads row_first, iref and every edge's (q0, r0); f_step steps them.
+  assign w_d = w_q + {{(C-1){1'b0}}, 1'b1};  // next row, wraps at CoordBits
 
   genvar e;
   generate
@@ -309,7 +307,7 @@ module shd_span_unit #(
       reg [C+R-1:0] qr_d;
       always @* begin
         qr_d = {(C+R){1'bx}};
-        if (in_row)
+        if (form_en)
           qr_d = dda_row(w_q, e_row_first_q[e*C +: C], e_row_last_q[e*C +: C], quo_q[e*C +: C],
                          rem_q[e*R +: R], e_k_q[e*C +: C], e_m_q[e*R +: R], e_div_q[e*R +: R]);
       end
@@ -318,24 +316,6 @@ module shd_span_unit #(
     end
   endgenerate
 
-  // The walker registers load the descriptor on accept and step in ROW. The descriptor mux
-  // sits in the clocked block (not in the _d logic) so that a simulator re-evaluates the
-  // register-only ROW logic once per clock, not on every input change (Verilator's input
-  // logic runs on every eval); the hardware is the same two-input mux.
-  always @(posedge clk_i) begin
-    if (accept) begin
-      w_q    <= desc_row_first_i;
-      irow_q <= desc_iref_i;
-      quo_q  <= e_q_i;
-      rem_q  <= e_r_i;
-    end else if (in_row) begin
-      w_q    <= w_d;
-      irow_q <= irow_d;
-      quo_q  <= quo_d;
-      rem_q  <= rem_d;
-    end
-  end
-
   // ---------------------------------------------------------------- ROW: lane-triangle bounds
   genvar j;
   generate
@@ -343,7 +323,7 @@ module shd_span_unit #(
       reg [2*C+2:0] b_d;   // {ne, lo, hi}, lo and hi in CoordBits+1 bits
       always @* begin
         b_d = {(2*C+3){1'bx}};
-        if (in_row)
+        if (form_en)
           b_d = tri_row(w_q, lt_row_first_q[j*C +: C], lt_row_last_q[j*C +: C],
                         lt_clip_x0_q[j*C +: C], lt_clip_x1_q[j*C +: C],
                         e_row_first_q[j*3*C +: 3*C], e_row_last_q[j*3*C +: 3*C],
@@ -358,14 +338,6 @@ module shd_span_unit #(
     end
   endgenerate
 
-  always @(posedge clk_i) begin
-    if (in_row) begin
-      lo_q <= lo_d;
-      hi_q <= hi_d;
-      ne_q <= ne_d;
-    end
-  end
-
   // xs = min lo_j, xe = max hi_j over the lane-triangles with ne_j (NumTri <= 4 terms).
   reg signed [C-1:0] xs_r;
   reg signed [C-1:0] xe_r;
@@ -374,7 +346,7 @@ module shd_span_unit #(
     t    = 0;  // the loop variable too is assigned on every path (no latch)
     xs_r = {C{1'bx}};
     xe_r = {C{1'bx}};
-    if (in_row) begin
+    if (form_en) begin
       xs_r = COORD_MAX;
       xe_r = COORD_MIN;
       for (t = 0; t < NumTri; t = t + 1) begin
@@ -406,39 +378,19 @@ module shd_span_unit #(
     for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
       wire signed [A-1:0]  didx_a = didx_q[a*A +: A];
       // Signed A x (C+1) product (the sign copies are removed by synthesis); only its low
-      // AttrBits are needed: the plane is computed modulo 2^AttrBits. ROW only.
+      // AttrBits are needed: the plane is computed modulo 2^AttrBits. form_en only.
       reg signed [MW-1:0] prod_a;
       always @* begin
         prod_a = {MW{1'bx}};
-        if (in_row)
+        if (form_en)
           prod_a = $signed({{(C+1){didx_a[A-1]}}, didx_a}) * $signed({{A{dx_row[C]}}, dx_row});
       end
       wire unused_prod_msbs = ^prod_a[MW-1:A];
       assign icur_row[a*A +: A]  = irow_q[a*A +: A] + prod_a[A-1:0];
-      assign icur_step[a*A +: A] = icur_q[a*A +: A] + (didx_q[a*A +: A] << LOG2L);
+      assign icur_step[a*A +: A] = icur_q[a*A +: A] + (em_didx[a*A +: A] << LOG2L);
       assign irow_d[a*A +: A]    = irow_q[a*A +: A] + didy_q[a*A +: A];
     end
   endgenerate
-
-  // xg, icur load the row's start (span_load) or step (span_step), xe and wspan the row's span.
-  // The muxes sit in the clocked block, like the walker's, so that Verilator's input logic
-  // (span_step depends on out_ready_i) does not re-evaluate the row-start multiply.
-  always @(posedge clk_i) begin
-    if (span_load) begin
-      xg_q   <= xg_row;
-      icur_q <= icur_row;
-    end else if (span_step) begin
-      xg_q   <= xg_next[C-1:0];
-      icur_q <= icur_step;
-    end
-  end
-
-  always @(posedge clk_i) begin
-    if (span_load) begin
-      xe_q    <= xe_r;
-      wspan_q <= w_q;
-    end
-  end
 
   // ---------------------------------------------------------------- lanes
   // Lane i of every lane-triangle shows column x = xg + i and the plane value icur + i*didx
@@ -452,7 +404,7 @@ module shd_span_unit #(
       wire signed [C:0] x_i = $signed({xg_q[C-1], xg_q}) + $signed(LANE_OFF);
       wire [AV-1:0]     v_i;
       for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
-        wire [A-1:0] d_a  = didx_q[a*A +: A];
+        wire [A-1:0] d_a  = em_didx[a*A +: A];
         wire [A-1:0] s0_a = ((i & 1) != 0) ? d_a        : {A{1'b0}};
         wire [A-1:0] s1_a = ((i & 2) != 0) ? (d_a << 1) : {A{1'b0}};
         wire [A-1:0] s2_a = ((i & 4) != 0) ? (d_a << 2) : {A{1'b0}};
@@ -463,10 +415,10 @@ module shd_span_unit #(
         localparam integer LN = j * L + i;
         wire signed [C-1:0] lo_l = lo_q[j*C +: C];
         wire signed [C-1:0] hi_l = hi_q[j*C +: C];
-        wire [C-1:0]        ox_l = lt_ox_q[j*C +: C];
-        wire [C-1:0]        oy_l = lt_oy_q[j*C +: C];
-        wire                flip = lt_flip_q[j];
-        assign lane_valid[LN] = in_span && ne_q[j]
+        wire [C-1:0]        ox_l = em_ox[j*C +: C];
+        wire [C-1:0]        oy_l = em_oy[j*C +: C];
+        wire                flip = em_flip[j];
+        assign lane_valid[LN] = show && ne_q[j]
                                 && ($signed({lo_l[C-1], lo_l}) <= x_i)
                                 && (x_i <= $signed({hi_l[C-1], hi_l}));
 
@@ -483,7 +435,7 @@ module shd_span_unit #(
 
         for (a = 0; a < NumAttr; a = a + 1) begin : g_attr
           wire [A-1:0] v_a    = v_i[a*A +: A];
-          wire [A-1:0] aoff_a = lt_aoff_q[(j*NumAttr+a)*A +: A];
+          wire [A-1:0] aoff_a = em_aoff[(j*NumAttr+a)*A +: A];
           assign out_attr_o[(LN*NumAttr+a)*A +: A] = flip ? aoff_a - v_a : v_a + aoff_a;
         end
       end
@@ -491,10 +443,166 @@ module shd_span_unit #(
   endgenerate
 
   // ---------------------------------------------------------------- outputs
-  assign span_adv         = !out_valid_o || out_ready_i;
-  assign desc_ready_o     = in_idle;
   assign out_valid_o      = |lane_valid;
-  assign out_tag_o        = tag_q;
+  assign out_tag_o        = em_tag;
   assign out_lane_valid_o = lane_valid;
+
+  // ---------------------------------------------------------------- control, per mode
+  generate
+    if (RowAhead == 0) begin : g_paper
+      // The paper's unit: IDLE -> ROW -> (SPAN ...) -> ROW ... -> IDLE.
+      localparam [1:0] ST_IDLE = 2'd0;
+      localparam [1:0] ST_ROW  = 2'd1;
+      localparam [1:0] ST_SPAN = 2'd2;
+      reg  [1:0] state_q;
+      reg  [1:0] state_d;
+      wire in_idle   = (state_q == ST_IDLE);
+      wire in_row    = (state_q == ST_ROW);
+      wire in_span   = (state_q == ST_SPAN);
+      wire span_load = in_row && any_ne;
+      wire span_step = in_span && span_adv && !span_done;
+
+      always @* begin
+        state_d = state_q;
+        case (state_q)
+          ST_IDLE: if (desc_valid_i) state_d = ST_ROW;
+          ST_ROW: begin
+            if (any_ne)                 state_d = ST_SPAN;
+            else if (w_q == row_last_q) state_d = ST_IDLE;
+          end
+          ST_SPAN: begin
+            if (span_adv && span_done) state_d = (wspan_q == row_last_q) ? ST_IDLE : ST_ROW;
+          end
+          default: state_d = ST_IDLE;
+        endcase
+      end
+
+      always @(posedge clk_i or negedge rst_ni) begin
+        if (!rst_ni) state_q <= ST_IDLE;
+        else         state_q <= state_d;
+      end
+
+      always @(posedge clk_i) begin
+        if (in_row) begin
+          lo_q <= lo_d;
+          hi_q <= hi_d;
+          ne_q <= ne_d;
+        end
+      end
+
+      // xg, icur load the row's start (span_load) or step (span_step), xe and wspan the row's
+      // span. The muxes sit in the clocked block, like the walker's, so that Verilator's input
+      // logic (span_step depends on out_ready_i) does not re-evaluate the row-start multiply.
+      always @(posedge clk_i) begin
+        if (span_load) begin
+          xg_q   <= xg_row;
+          icur_q <= icur_row;
+        end else if (span_step) begin
+          xg_q   <= xg_next[C-1:0];
+          icur_q <= icur_step;
+        end
+      end
+
+      always @(posedge clk_i) begin
+        if (span_load) begin
+          xe_q    <= xe_r;
+          wspan_q <= w_q;
+        end
+      end
+
+      assign f_from_q     = 1'b0;
+      assign q_word       = {DW{1'b0}};
+      assign f_load       = in_idle && desc_valid_i;
+      assign f_step       = in_row;
+      assign form_en      = in_row;
+      assign show         = in_span;
+      assign desc_ready_o = in_idle;
+      assign em_tag       = tag_q;
+      assign em_didx      = didx_q;
+      assign em_ox        = lt_ox_q;
+      assign em_oy        = lt_oy_q;
+      assign em_flip      = lt_flip_q;
+      assign em_aoff      = lt_aoff_q;
+    end else begin : g_ahead
+      // The full-rate unit: F (the walker) forms a row per busy cycle into B or straight into
+      // E; E shows its row's lane groups; Q holds the next descriptor.
+      // A row: {ne, lo, hi, xe, xg0, wspan, icur0, map}, map = {tag, didx, ox, oy, flip, aoff}.
+      localparam integer MAPW = TagBits + AV + NumTri*(2*C + 1 + AV);
+      localparam integer RW   = NumTri*(1 + 2*C) + 3*C + AV + MAPW;
+      reg             f_busy_q, q_valid_q, b_valid_q, e_valid_q;
+      reg             f_held_q;  // F stalled in the last cycle: its row has pixels, B is full
+      reg  [DW-1:0]   qd_q;   // Q
+      reg  [RW-1:0]   b_q;    // B
+      reg  [MAPW-1:0] em_q;   // E's row's map
+      wire [RW-1:0]   formed = {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q,
+                                lt_ox_q, lt_oy_q, lt_flip_q, lt_aoff_q};
+
+      // F holding a row while E shows a group other than its row's last: B cannot be taken in this
+      // cycle, so F stalls again whatever the row logic gives; it is not computed (form_en 0) and
+      // the row counts as one with pixels (f_any).
+      wire f_skip  = f_held_q && e_valid_q && !span_done;
+      wire f_any   = f_skip || any_ne;
+      wire e_done  = e_valid_q && span_adv && span_done;   // E's row's last group leaves
+      wire e_step  = e_valid_q && span_adv && !span_done;  // E's next group
+      wire e_free  = !e_valid_q || e_done;
+      wire take_b  = b_valid_q && e_free;                  // E takes B's row
+      wire b_free  = !b_valid_q || take_b;
+      wire bypass  = f_busy_q && f_any && e_free && !b_valid_q;  // E takes F's row
+      wire f_puts  = f_busy_q && f_any && b_free && !bypass;     // B takes F's row
+      wire f_moves = f_busy_q && (!f_any || b_free);
+      wire f_takes = !f_busy_q || (f_moves && w_q == row_last_q); // F is free for a descriptor
+      wire accept  = desc_valid_i && !q_valid_q;
+      wire e_load  = take_b || bypass;
+
+      always @(posedge clk_i or negedge rst_ni) begin
+        if (!rst_ni) begin
+          f_busy_q  <= 1'b0;
+          f_held_q  <= 1'b0;
+          q_valid_q <= 1'b0;
+          b_valid_q <= 1'b0;
+          e_valid_q <= 1'b0;
+        end else begin
+          if (f_takes) f_busy_q <= q_valid_q || accept;
+          f_held_q <= f_busy_q && !f_moves;
+          // Q empties when F takes its descriptor; it fills with one F does not take.
+          q_valid_q <= q_valid_q ? !f_takes : (accept && !f_takes);
+          if (f_puts)      b_valid_q <= 1'b1;
+          else if (take_b) b_valid_q <= 1'b0;
+          if (e_load)      e_valid_q <= 1'b1;
+          else if (e_done) e_valid_q <= 1'b0;
+        end
+      end
+
+      always @(posedge clk_i) begin
+        if (accept && !f_takes)
+          qd_q <= {desc_tag_i, desc_row_last_i, desc_xref_i, desc_didx_i, desc_didy_i,
+                   lt_row_first_i, lt_row_last_i, lt_clip_x0_i, lt_clip_x1_i, lt_ox_i, lt_oy_i,
+                   lt_flip_i, lt_aoff_i, e_right_i, e_row_first_i, e_row_last_i, e_k_i, e_div_i,
+                   e_m_i, desc_row_first_i, desc_iref_i, e_q_i, e_r_i};
+      end
+
+      always @(posedge clk_i) begin
+        if (f_puts) b_q <= formed;
+      end
+
+      always @(posedge clk_i) begin
+        if (e_load) begin
+          {ne_q, lo_q, hi_q, xe_q, xg_q, wspan_q, icur_q, em_q} <= take_b ? b_q : formed;
+        end else if (e_step) begin
+          xg_q   <= xg_next[C-1:0];
+          icur_q <= icur_step;
+        end
+      end
+
+      assign f_from_q     = q_valid_q;
+      assign q_word       = qd_q;
+      assign f_load       = f_takes && (q_valid_q || accept);
+      assign f_step       = f_moves;
+      assign form_en      = f_busy_q && !f_skip;
+      assign show         = e_valid_q;
+      assign desc_ready_o = !q_valid_q;
+      assign {em_tag, em_didx, em_ox, em_oy, em_flip, em_aoff} = em_q;
+    end
+  endgenerate
 
 endmodule

@@ -196,7 +196,9 @@ TEST(CliSpanCycles, ReportChecksTheRtlCycles) {
   // Every span configuration of the registry is measured, the serial unit first.
   const auto configs = nlohmann::json::parse(run("configs --unit span --json").out);
   ASSERT_GE(configs.size(), 2u);
-  ASSERT_EQ(j["sets"].size(), 7u);  // five size classes, the mixed stream, the sphere
+  ASSERT_EQ(j["sets"].size(), 8u);  // five size classes, the mixed stream, the sphere and the torus
+  EXPECT_EQ(j["sets"][6]["set"], "builtin:sphere");
+  EXPECT_EQ(j["sets"][7]["set"], "builtin:torus");
   for (const auto& set : j["sets"]) {
     ASSERT_EQ(set["modes"].size(), configs.size());
     EXPECT_EQ(set["modes"][0]["lanes"], 1);
@@ -205,8 +207,9 @@ TEST(CliSpanCycles, ReportChecksTheRtlCycles) {
       EXPECT_EQ(m["rtl_cycles"], m["cycles"]) << set["set"] << " " << m["mode"];
       EXPECT_EQ(m["rtl_mismatches"], 0);
       EXPECT_EQ(m["fragments"], set["modes"][0]["fragments"]);  // every mode draws the same pixels
-      // No lane mode is slower than the serial unit.
+      // No lane mode is slower than the serial unit, or faster than its lane groups alone.
       EXPECT_LE(m["cycles"].get<double>(), serial) << set["set"] << " " << m["mode"];
+      EXPECT_GE(m["cycles"], m["no_overhead_bound"]) << set["set"] << " " << m["mode"];
     }
   }
 }

@@ -34,6 +34,41 @@ std::function<bool(SpanDesc&)> stream(const std::string& mode, uint64_t seed, lo
   return [s](SpanDesc& d) { return s->next(d); };
 }
 
+// Whether units of two parameter sets show a descriptor alike: each alone, every output equal on
+// every cycle (compareSpanOutputs).
+bool showAlike(const SpanParams& a, const SpanParams& b, const SpanDesc& d) {
+  SpanUnitModel ua(a), ub(b);
+  SpanIn in;
+  in.desc_valid = true;
+  in.desc = &d;
+  SpanOut oa, ob;
+  do {
+    ua.tick(in, oa);
+    ub.tick(in, ob);
+    in.desc_valid = false;
+    if (!compareSpanOutputs(oa, ob).empty()) return false;
+  } while (!ua.idle() || !ub.idle());
+  return true;
+}
+
+// The stream of `rtl`'s generator triangles whose first `alike` descriptors are ones the units
+// of `rtl` and `model` show alike (the others of the stream's start skipped): a run comparing the
+// two then fails after them.
+std::function<bool(SpanDesc&)> alikeFirst(const std::string& rtl, const std::string& model, int alike, uint64_t seed,
+                                          long count) {
+  auto next = std::make_shared<std::function<bool(SpanDesc&)>>(stream(rtl, seed, count));
+  auto left = std::make_shared<int>(alike);
+  const SpanParams a = spanParams(rtl), b = spanParams(model);
+  return [=](SpanDesc& d) {
+    while ((*next)(d))
+      if (*left == 0 || showAlike(a, b, d)) {
+        if (*left > 0) --*left;
+        return true;
+      }
+    return false;
+  };
+}
+
 // That stream offered to a unit cycle by cycle: the descriptor on offer, if any, and the next
 // one once the unit has accepted it.
 struct Offer {
@@ -65,33 +100,56 @@ TEST_P(SpanCosimModes, RandomTrianglesWithBackPressure) {
 INSTANTIATE_TEST_SUITE_P(Modes, SpanCosimModes,
                          testing::ValuesIn(shd::testutil::spanModes()));
 
-TEST(SpanCosim, DetectsAModelOfAnotherLaneLayout) {
-  // The checker must be able to fail: seg2 and evenodd draw the same pixels with the same
-  // values but put them in different lanes and cycles.
+// The checker must be able to fail: seg2 and evenodd draw the same pixels with the same values
+// but put them in different lanes and cycles; so do their full-rate units. The stream starts
+// with `alike` descriptors both show alike, so the run fails after them. The full-rate unit,
+// draining every `drain_every` descriptors (SpanCosimOptions::drain_every), then saves a case
+// that starts at its last idle cycle with the descriptors accepted since; the paper's unit one
+// that starts at the failing triangle's acceptance.
+struct WrongModelCase {
+  const char* rtl;
+  const char* model;
+  int alike;
+  uint64_t drain_every;
+};
+
+class SpanCosimWrongModel : public testing::TestWithParam<WrongModelCase> {};
+
+TEST_P(SpanCosimWrongModel, IsDetectedAndItsSavedCaseFailsAloneAtItsLastCycle) {
+  const WrongModelCase w = GetParam();
   SpanCosimOptions o;
   o.fail_dir = shd::testutil::freshTestDir("span_cosim").string();
-  o.model_params = spanParams("evenodd");
-  const SpanCosimResult r = runSpanCosim("seg2", stream("seg2", 5, 200), o);
+  o.model_params = spanParams(w.model);
+  o.drain_every = w.drain_every;
+  const SpanCosimResult r = runSpanCosim(w.rtl, alikeFirst(w.rtl, w.model, w.alike, 5, 400), o);
   ASSERT_GT(r.mismatches, 0u);
   ASSERT_TRUE(r.first.has_value());
   std::printf("as expected: cycle %llu triangle %u: %s\n", static_cast<unsigned long long>(r.first->cycle),
               r.first->tag, r.first->what.c_str());
+  ASSERT_TRUE(r.case_note.empty()) << r.case_note;
   ASSERT_TRUE(fs::exists(r.fst_path));
   EXPECT_GT(fs::file_size(r.fst_path), 100u);
   std::ifstream c(r.case_path);
   std::string text((std::istreambuf_iterator<char>(c)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"descriptor\""), std::string::npos);
   EXPECT_NE(text.find("out_ready_after_accept"), std::string::npos);
-  // The failing triangle saved as a vector file: replayed alone on the real seg2 RTL it fails
-  // at its last cycle (the run's failing one), and nowhere before.
+  // The failing case saved as a vector file: replayed alone on the real RTL it fails at its last
+  // cycle (the run's failing one), and nowhere before.
   ASSERT_TRUE(fs::exists(r.vector_path));
   const ReplayResult rr = replayVectorFile(r.vector_path);
   ASSERT_TRUE(rr.first.has_value()) << "the saved case replays clean: it does not reproduce the mismatch";
   EXPECT_EQ(rr.first->cycle, rr.cycles);
   EXPECT_EQ(rr.mismatching_cycles, 1u);
+  EXPECT_LT(rr.cycles, r.first->cycle + 1) << "the saved case starts at reset";
+  EXPECT_GT(r.first->cycle, 100u) << "the run fails after the alike descriptors";
   std::printf("replayed alone: %llu cycles, first mismatch %s\n", static_cast<unsigned long long>(rr.cycles),
               rr.first->describe().c_str());
 }
+
+INSTANTIATE_TEST_SUITE_P(Pairs, SpanCosimWrongModel,
+                         testing::Values(WrongModelCase{"seg2", "evenodd", 8, 32},
+                                         WrongModelCase{"seg2full", "evenoddfull", 8, 3}),
+                         [](const testing::TestParamInfo<WrongModelCase>& i) { return std::string(i.param.rtl); });
 
 TEST(SpanCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
   // The counterpart of the saved failing case: the correct model's expectations pass.

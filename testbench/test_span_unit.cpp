@@ -20,6 +20,7 @@
 using namespace shd;
 using shd::testutil::spanModes;
 using shd::testutil::spanParams;
+using shd::testutil::paperSpanModes;
 
 namespace {
 
@@ -351,10 +352,10 @@ TEST(SpanUnitModel, EveryModeEqualsSerial) {
   }
 }
 
-TEST(SpanUnitModel, CycleCountFollowsTheFormula) {
+TEST(SpanUnitModel, CycleCountFollowsTheFormula) {  // the paper's unit (the full-rate unit: FullRate* below)
   const RasterConfig c = configFor("serial");
   std::mt19937_64 rng(13);
-  for (const std::string& m : spanModes()) {
+  for (const std::string& m : paperSpanModes()) {
     RasterConfig cm = c;
     cm.unit = spanParams(m);
     for (int n = 0; n < 2000; ++n) {
@@ -677,7 +678,14 @@ Streamed streamThrough(const SpanParams& p, const std::vector<SpanDesc>& descs, 
 // descriptor alone: the same fragments in the same order, the same rows and lane groups, never
 // more cycles; and the walker equal to its cycle model, cycles included.
 TEST(SpanUnitModel, FullRateUnitGivesThePapersFragments) {
+  // The registry holds each lane mode as both units: <mode>full is <mode> with RowAhead 1.
   for (const std::string& m : spanModes()) {
+    if (spanParams(m).RowAhead) {
+      EXPECT_EQ(m.substr(m.size() - 4), "full");
+    }
+  }
+  for (const std::string& m : paperSpanModes()) {
+    ASSERT_EQ(spanParams(m + "full").toJson(), fullRate(m).toJson()) << m;
     const SpanParams paper_p = spanParams(m), full_p = fullRate(m);
     SpanUnitModel paper(paper_p), full(full_p);
     SpanRun a, b;
@@ -713,7 +721,7 @@ TEST(SpanUnitModel, FullRateUnitGivesThePapersFragments) {
 // the sum of its descriptors' cycles alone (it cannot overlap them).
 TEST(SpanUnitModel, FullRateStreamKeepsItsTiming) {
   std::mt19937_64 rng(32);
-  for (const std::string& m : spanModes()) {
+  for (const std::string& m : paperSpanModes()) {
     const SpanParams full_p = fullRate(m), paper_p = spanParams(m);
     const std::vector<SpanDesc> descs = generatorDescriptors(paper_p, 33, 3000);
     std::vector<SpanFragment> alone;

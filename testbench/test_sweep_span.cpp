@@ -36,7 +36,7 @@ nlohmann::json baseOf(const std::string& config, uint64_t triangles, const std::
 // The lane layout of a registry mode as grid values.
 PointValues modeValues(const std::string& mode) {
   const SpanParams p = testutil::spanParams(mode);
-  return {{"NumTri", p.NumTri}, {"LanesPerTri", p.LanesPerTri}, {"AlignLanes", p.AlignLanes}};
+  return {{"NumTri", p.NumTri}, {"LanesPerTri", p.LanesPerTri}, {"AlignLanes", p.AlignLanes}, {"RowAhead", p.RowAhead}};
 }
 
 double err(const nlohmann::json& record, const std::string& figure) { return record.at("error").at(figure).get<double>(); }

@@ -27,9 +27,16 @@ inline Vec3 centroid(const Mesh& m, const std::array<uint32_t, 3>& t) {
   return (1.0 / 3.0) * (m.positions[t[0]] + m.positions[t[1]] + m.positions[t[2]]);
 }
 
-// The registry's span configurations (the lane modes), and one's parameters.
+// The registry's span configurations (the lane modes, as the paper's and as the full-rate unit),
+// one's parameters, and the paper's units alone (RowAhead 0).
 inline std::vector<std::string> spanModes() { return builtinConfigNames("span"); }
 inline SpanParams spanParams(const std::string& mode) { return spanConfig(mode).rtl; }
+inline std::vector<std::string> paperSpanModes() {
+  std::vector<std::string> out;
+  for (const std::string& m : spanModes())
+    if (spanParams(m).RowAhead == 0) out.push_back(m);
+  return out;
+}
 
 // A fresh, empty directory for the running test: <TempDir>/<area>/<Suite.Test> ('/' of
 // parameterised names replaced). ctest runs the tests of a file as parallel processes, so each

@@ -27,6 +27,7 @@ void SpanParams::validate() const {
   need(RemBits >= 2 && RemBits <= 60, "RemBits", RemBits, "must be in 2..60");
   need(PixBits >= 1 && PixBits < CoordBits, "PixBits", PixBits, "must be in 1..CoordBits-1");
   need(TagBits >= 1 && TagBits <= 32, "TagBits", TagBits, "must be in 1..32");
+  need(RowAhead == 0 || RowAhead == 1, "RowAhead", RowAhead, "must be 0 or 1");
 }
 
 namespace {
@@ -37,7 +38,7 @@ constexpr ParamMember<SpanParams> kSpanMembers[] = {
     {"AlignLanes", &SpanParams::AlignLanes}, {"NumAttr", &SpanParams::NumAttr},
     {"AttrBits", &SpanParams::AttrBits},     {"CoordBits", &SpanParams::CoordBits},
     {"RemBits", &SpanParams::RemBits},       {"PixBits", &SpanParams::PixBits},
-    {"TagBits", &SpanParams::TagBits}};
+    {"TagBits", &SpanParams::TagBits},       {"RowAhead", &SpanParams::RowAhead, true}};
 
 }  // namespace
 
@@ -57,9 +58,9 @@ int64_t SpanUnitModel::wrapCoord(int64_t v) const { return wrapTo(u(v), p_.Coord
 
 void SpanUnitModel::reset() {
   state_ = State::Idle;
-  f_busy_ = q_valid_ = b_valid_ = e_valid_ = false;
+  f_busy_ = f_held_ = q_valid_ = b_valid_ = e_valid_ = false;
   f_slot_ = q_slot_ = 0;
-  b_ = er_ = RowRec{};
+  b_ = er_ = f_row_ = RowRec{};
   e_.fill(SpanDdaState{});
   irow_.fill(0);
   icur_.fill(0);
@@ -224,17 +225,18 @@ void SpanUnitModel::tickRowAhead(const SpanIn& in, const SpanOut& out) {
   const bool take_b = b_valid_ && e_free;
   const bool b_free = !b_valid_ || take_b;
   // F: row w formed; it goes to E when E is free and B empty, else to B when B is free; F moves
-  // on unless the row has pixels and B stays full.
-  RowRec formed;
+  // on unless the row has pixels and B stays full. A row F stalled on is the one it formed last.
+  const RowRec& formed = f_row_;
   bool f_moves = false, f_puts = false, bypass = false;
   if (f_busy_) {
-    const bool any = formRow(formed);
+    const bool any = f_held_ || formRow(f_row_);
     bypass = any && e_free && !b_valid_;
     f_puts = any && b_free && !bypass;
     f_moves = !any || b_free;
   }
   const bool f_takes = !f_busy_ || (f_moves && w_ == slot_[f_slot_].row_last);
   const bool accept = in.desc_valid && out.desc_ready;
+  f_held_ = f_busy_ && !f_moves;
   // E, B, then F and Q (each from the values before the edge).
   if (take_b || bypass) {
     er_ = take_b ? b_ : formed;

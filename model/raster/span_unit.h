@@ -135,9 +135,8 @@ struct SpanParams {
   int PixBits = 12;     // unsigned screen pixel coordinates on the fragment ports
   int TagBits = 32;     // triangle tag carried to the fragments
   // 0: the paper's unit (a ROW cycle per walker row, an IDLE cycle per descriptor); 1: the
-  // full-rate unit (rows formed ahead into a row register, the next descriptor queued). The
-  // model's alone so far: not yet a member of a configuration's "rtl" object or of the vector
-  // files, which the RTL reads (rtl/shd_span_unit.v has no such parameter yet).
+  // full-rate unit (rows formed ahead into a row register, the next descriptor queued). May be
+  // left out of a configuration's "rtl" object: 0, the Verilog default.
   int RowAhead = 0;
 
   int lanes() const { return NumTri * LanesPerTri; }
@@ -298,7 +297,8 @@ class SpanUnitModel {
   // The paper's unit: its state (E shows er_ in Span). The full-rate unit: F busy, Q, B and E.
   State state_ = State::Idle;
   bool f_busy_ = false, q_valid_ = false, b_valid_ = false, e_valid_ = false;
-  RowRec b_, er_;
+  bool f_held_ = false;  // F stalled in the last cycle on row f_row_ (the RTL's f_held_q)
+  RowRec b_, er_, f_row_;
   int64_t w_ = 0, xg_ = 0;
   // Registers held in place, sized for the largest unit; the first NumTri*3 and NumAttr are used.
   std::array<SpanDdaState, kMaxLaneTri * 3> e_{};

@@ -208,7 +208,11 @@ class Frame {
   template <class Sink, class... Runs>
   void walk(const SpanTriangle& t, Sink& sink, Runs&... runs) {
     if (walker != nullptr) {
-      const SpanWalk wk = walkSpanUnit(*walker, *t.setup.desc, sink, runs...);
+      SpanWalk wk;
+      if constexpr (sizeof...(Runs) == 0)
+        wk = walkSpanUnit(*walker, *t.setup.desc, sink, span_detail::NoRuns{}, span.streamOrNull());
+      else
+        wk = walkSpanUnit(*walker, *t.setup.desc, sink, runs..., span.streamOrNull());
       st.span_cycles += wk.cycles;
       st.fragments += wk.fragments;
       return;

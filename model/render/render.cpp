@@ -250,7 +250,9 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   clearFramebuffer(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);
   Frame frame(scene, opt, span, res.fb, res.stats);
   SceneDrawer drawer(frame, scene, engines, res.triangles);
+  span.beginFrame();
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+  span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 

@@ -67,15 +67,27 @@ const char* toString(Method m);
 std::vector<Method> allMethods();
 
 // The span unit: the fragments of one descriptor, appended to `out` in the unit's output order,
-// and the cycles they took (IDLE to IDLE, the consumer always ready).
+// and the cycles they took, the consumer always ready. A frame's descriptors go to the unit back
+// to back: the paper's unit takes each from IDLE to IDLE; the full-rate unit (RowAhead)
+// overlaps them, and run() gives each descriptor's share of the frame's stream (frameStream(),
+// SpanStream), so the frame's cycles are the stream's. render() calls beginFrame() before the
+// frame's first descriptor and endFrame() after its last.
 class SpanEngine {
  public:
   virtual ~SpanEngine() = default;
   virtual const SpanParams& params() const = 0;
   virtual SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) = 0;
   // Non-null when the engine is the model's walk (walkSpanUnit) with these parameters: the
-  // renderer may then walk descriptors itself and shade each fragment as it is produced.
+  // renderer may then walk descriptors itself and shade each fragment as it is produced, with
+  // streamOrNull() as the walk's stream.
   virtual const SpanParams* walker() const { return nullptr; }
+  virtual void beginFrame() { stream_ = SpanStream{}; }
+  virtual void endFrame() {}
+  // The frame's stream for the full-rate unit; null for the paper's unit.
+  SpanStream* streamOrNull() { return params().RowAhead ? &stream_ : nullptr; }
+
+ private:
+  SpanStream stream_;
 };
 
 // The model: walkSpanUnit, bit- and cycle-exact to the cycle-by-cycle SpanUnitModel.
@@ -83,7 +95,9 @@ class ModelSpanEngine final : public SpanEngine {
  public:
   explicit ModelSpanEngine(SpanParams p) : p_(p) { p_.validate(); }
   const SpanParams& params() const override { return p_; }
-  SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override { return walkSpanUnit(p_, d, out); }
+  SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override {
+    return walkSpanUnit(p_, d, out, streamOrNull());
+  }
   const SpanParams* walker() const override { return &p_; }
 
  private:

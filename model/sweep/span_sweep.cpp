@@ -445,6 +445,7 @@ SetFigures evaluateSet(const SpanPoint& p, const SpanBase& b) {
   TriangleGenerator gen(b.seed, triangleOptions(b));
   SetFigures f;
   std::optional<SetupResult> s;
+  SpanStream stream;  // the full-rate unit's: the set's triangles back to back
   for (uint64_t i = 0; i < b.triangles; ++i) {
     const GenTriangle t = gen.next();
     try {
@@ -461,7 +462,7 @@ SetFigures evaluateSet(const SpanPoint& p, const SpanBase& b) {
     TriangleErrors e(*s, rc);
     const SpanWalk w = walkSpanUnit(
         p.rtl, *s->desc, [&e](int32_t x, int32_t y, const int64_t* a) { e.fragment(x, y, a); },
-        [&e](const RowRun& r) { e.run(r); });
+        [&e](const RowRun& r) { e.run(r); }, p.rtl.RowAhead ? &stream : nullptr);
     f.cycles += w.cycles;
     f.fragments += w.fragments;
     f.colour.add(e.kind(0), e.det(), t.id);

@@ -35,6 +35,10 @@ class CosimCmd final : public Command {
         ->check(countIn(1, kMaxStreamTriangles));
     app.add_option("--ready", ready_prob_, "span unit: probability that the consumer is ready on a cycle")
         ->check(realIn(kMinReady, 1.0));
+    app.add_option("--drain-every", drain_every_,
+                   "span unit: after this many descriptors, offer none until the unit is idle, so that a failing "
+                   "case replays from a short window (the full-rate unit is otherwise never idle); 0: never")
+        ->check(countIn(0, kMaxStreamTriangles));
     table_.add(app);
     app.add_option("--prom", prom_, "PROM hex file the RTL loads (default: the table written to a temporary file); "
                                     "it must hold the table the options describe");
@@ -56,7 +60,7 @@ class CosimCmd final : public Command {
                     "applies to --unit spec only");
       return runSpan();
     }
-    requireAbsent(app, {"--mode", "--triangles", "--ready"}, "applies to --unit span only");
+    requireAbsent(app, {"--mode", "--triangles", "--ready", "--drain-every"}, "applies to --unit span only");
     if (exhaustive_) requireAbsent(app, {"--vectors", "--gap"}, "and --exhaustive exclude each other");
     return runSpec();
   }
@@ -64,7 +68,7 @@ class CosimCmd final : public Command {
  private:
   TableOptions table_;
   std::string unit_ = "spec", prom_, fail_dir_ = ".", mode_ = "serial";
-  uint64_t triangles_ = 100000;
+  uint64_t triangles_ = 100000, drain_every_ = SpanCosimOptions{}.drain_every;
   double ready_prob_ = 0.8;
   bool exhaustive_ = false, json_ = false, quiet_ = false;
   uint64_t vectors_ = 1'000'000, seed_ = 1;
@@ -90,6 +94,7 @@ int CosimCmd::runSpan() {
   SpanCosimOptions o;
   o.seed = seed_;
   o.ready_prob = ready_prob_;
+  o.drain_every = drain_every_;
   o.fail_dir = fs::absolute(fail_dir_).string();
   o.progress = [&](uint64_t) {
     progress.update(static_cast<double>(descs.generated()), static_cast<double>(triangles_), "triangles");
@@ -121,9 +126,14 @@ int CosimCmd::runSpan() {
                 r.seconds > 0 ? r.fragments / r.seconds / 1e6 : 0.0);
   }
   if (r.first) {
-    std::fprintf(stderr, "MISMATCH (first of %llu) cycle %llu, triangle %u: %s\nwaveform: %s\nvectors:  %s\ncase:     %s\n",
+    std::fprintf(stderr, "MISMATCH (first of %llu) cycle %llu, triangle %u: %s\n",
                  static_cast<unsigned long long>(r.mismatches), static_cast<unsigned long long>(r.first->cycle),
-                 r.first->tag, r.first->what.c_str(), r.fst_path.c_str(), r.vector_path.c_str(), r.case_path.c_str());
+                 r.first->tag, r.first->what.c_str());
+    if (r.case_note.empty())
+      std::fprintf(stderr, "waveform: %s\nvectors:  %s\ncase:     %s\n", r.fst_path.c_str(), r.vector_path.c_str(),
+                   r.case_path.c_str());
+    else
+      std::fprintf(stderr, "%s\n", r.case_note.c_str());
     return 1;
   }
   return 0;

@@ -1,5 +1,6 @@
-// shadesim span-cycles: the span unit's cycles per lane mode on the generator's size classes and
-// the idx3d sphere, the paper's speed-up claims, optionally checked against the RTL
+// shadesim span-cycles: the span unit's cycles per configuration (lane mode, paper's or full-rate
+// unit) on the generator's size classes and on scenes (builtin:sphere and builtin:torus unless
+// --scene names others), the paper's speed-up claims, optionally checked against the RTL
 // (report/span_cycles.h).
 #include <algorithm>
 #include <cstdio>
@@ -40,6 +41,8 @@ class SpanCyclesCmd final : public Command {
         ->check(countIn(1, 1000));
     app.add_flag("--json", json_, "print one JSON object instead of the tables");
     app.add_option("--json-out", json_out_, "also write the JSON object to this file");
+    app.add_option("--scene", scenes_, "scenes whose front faces are sets too: builtin:<name>, a scene file or a mesh file")
+        ->delimiter(',');
     app.add_flag("--rtl", rtl_, "also run every set through the verilated unit of every mode and check its cycles");
   }
 
@@ -74,8 +77,9 @@ class SpanCyclesCmd final : public Command {
   int soft_repeats_ = 5;
   bool json_ = false, rtl_ = false;
   std::string json_out_;
+  std::vector<std::string> scenes_{"builtin:sphere", "builtin:torus"};
 
-  // The generator's size classes, the mixed stream and the built-in sphere.
+  // The generator's size classes, the mixed stream and the scenes (--scene).
   std::vector<NamedList> triangleSets() const;
   // The cycle counts checked against the RTL: the same triangles through the verilated unit of
   // each mode, consumer always ready, compared cycle by cycle with the model.
@@ -103,18 +107,22 @@ std::vector<NamedList> SpanCyclesCmd::triangleSets() const {
   const char* names[] = {"pixel1", "small", "mesh 10-100px", "large", "screen"};
   for (int cls = 0; cls < kNumSizeClasses; ++cls) classStream(names[cls], cls);
   classStream("mixed", -1);
-  // The default scene's sphere: idx3d SPHERE(1, 64) seen from (0, 0, -3), front faces;
+  // Each scene's front faces (every object, in scene order) as its camera sees them;
   // attributes: the normal mapped to colour, and depth.
-  TriangleList sphere;
-  for (const ScreenTriangle& t : projectFrontFaces(idx3dSphere(1, 64), Camera{})) {
-    std::array<SetupVertex, 3> v;
-    for (size_t i = 0; i < 3; ++i)
-      v[i] = {t.v[i].x,
-              t.v[i].y,
-              {127.5 * (t.v[i].n.x + 1), 127.5 * (t.v[i].n.y + 1), 127.5 * (t.v[i].n.z + 1), t.v[i].z / 4}};
-    sphere.push_back(v);
+  for (const std::string& spec : scenes_) {
+    const Scene scene = loadScene(spec);
+    TriangleList tris;
+    for (const SceneObject& obj : scene.objects)
+      for (const ScreenTriangle& t : projectFrontFaces(worldMesh(obj), scene.camera)) {
+        std::array<SetupVertex, 3> v;
+        for (size_t i = 0; i < 3; ++i)
+          v[i] = {t.v[i].x,
+                  t.v[i].y,
+                  {127.5 * (t.v[i].n.x + 1), 127.5 * (t.v[i].n.y + 1), 127.5 * (t.v[i].n.z + 1), t.v[i].z / 4}};
+        tris.push_back(v);
+      }
+    lists.emplace_back(spec, std::move(tris));
   }
-  lists.emplace_back("builtin:sphere", std::move(sphere));
   return lists;
 }
 
@@ -130,6 +138,7 @@ bool SpanCyclesCmd::checkRtl(const std::vector<NamedList>& lists, const std::vec
       SpanCosimOptions o;
       o.ready_prob = 1.0;
       o.desc_gap_prob = 0.0;
+      o.drain_every = 0;  // back to back, as measured
       const SpanCosimResult r = runSpanCosim(
           modes[mi].name,
           [&](SpanDesc& d) {

@@ -10,6 +10,7 @@
 #include "cosim/replay.h"
 #include "cosim/span_cosim.h"
 #include "cosim/spec_cosim.h"
+#include "raster/span_walk.h"
 #include "vectors/vector_file.h"
 #include "io/files.h"
 
@@ -33,9 +34,48 @@ RtlSpanEngine::RtlSpanEngine(const SpanUnitConfig& config, std::string fail_dir,
     : mode_(config.name),
       fail_dir_(std::move(fail_dir)),
       dut_(makeSpanDut(config, "")),
-      model_(model_params ? *model_params : dut_->params()) {
+      model_(model_params ? *model_params : dut_->params()),
+      stream_model_(model_.params()) {
   dut_->reset();
   model_.reset();
+  if (dut_->params().RowAhead) stream_dut_ = makeSpanDut(config, "");
+}
+
+void RtlSpanEngine::beginFrame() {
+  SpanEngine::beginFrame();
+  if (!stream_dut_) return;
+  stream_dut_->reset();
+  stream_model_.reset();
+  stream_queue_.clear();
+  stream_descs_ = 0;
+}
+
+void RtlSpanEngine::streamTick() {
+  SpanIn in;
+  in.desc_valid = !stream_queue_.empty();
+  in.desc = in.desc_valid ? &stream_queue_.front() : nullptr;
+  in.out_ready = true;
+  stream_model_.tick(in, stream_expected_);
+  stream_dut_->tick(in, stream_out_);
+  if (const std::string diff = compareSpanOutputs(stream_expected_, stream_out_); !diff.empty())
+    throw std::runtime_error(fmt::format(
+        "span unit ({}): the RTL differs from the model at cycle {} of the frame's stream, after {} descriptors "
+        "accepted: {}",
+        mode_, stream_model_.cycle() - 1, stream_descs_, diff));
+  if (in.desc_valid && stream_expected_.desc_ready) {
+    stream_queue_.pop_front();
+    ++stream_descs_;
+  }
+}
+
+void RtlSpanEngine::endFrame() {
+  if (!stream_dut_) return;
+  while (!stream_queue_.empty() || !stream_model_.idle()) streamTick();
+  const uint64_t want = streamOrNull()->end();
+  if (stream_model_.cycle() != want)
+    throw std::runtime_error(fmt::format("span unit ({}): the frame's {} descriptors took {} cycles back to back on the "
+                                         "RTL, the model's stream counts {}",
+                                         mode_, stream_descs_, stream_model_.cycle(), want));
 }
 
 SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
@@ -90,10 +130,14 @@ SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
         out.push_back({out_.tag, l.x, l.y, l.attr});
         ++run.fragments;
       }
-    if (out_.desc_ready) {  // back in IDLE: this cycle belongs to the next descriptor
-      --run.cycles;
-      break;
-    }
+    if (model_.idle()) break;  // the RTL equal so far, so idle too (the full-rate unit's desc_ready is 1 throughout)
+  }
+  if (stream_dut_) {
+    // The descriptor's share of the frame's stream, and the stream instance up to its acceptance.
+    run.cycles = walkSpanUnit(params(), d, [](int32_t, int32_t, const int64_t*) {}, span_detail::NoRuns{},
+                              streamOrNull()).cycles;
+    stream_queue_.push_back(d);
+    while (!stream_queue_.empty()) streamTick();
   }
   return run;
 }

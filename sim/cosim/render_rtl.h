@@ -2,6 +2,7 @@
 // scene rendered with the RTL in the loop can be compared pixel for pixel with the model's.
 #pragma once
 
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -12,8 +13,13 @@
 
 namespace shd {
 
-// Each descriptor runs from IDLE to IDLE with the consumer always ready. The ports show the
-// cycles and the fragments; the ROW/SPAN split of the cycles is internal (left 0).
+// Each descriptor runs alone, from idle to idle, with the consumer always ready: the ports show the
+// fragments, and the paper's unit's cycles; the ROW/SPAN split of the cycles is internal (left 0).
+// The full-rate unit's cycles are the descriptor's share of the frame's stream (SpanEngine), as
+// the model's walk counts them. A second verilated instance then takes the frame's descriptors back
+// to back, each offered from the cycle after the one before was accepted, its outputs compared
+// with a second cycle-by-cycle model on every cycle; endFrame() checks that it took the stream's
+// cycles. A difference there throws std::runtime_error naming the cycle and the descriptor.
 // The cycle-accurate model ticks beside the RTL and every output is compared on every cycle. On
 // the first difference the triangle is saved alone, from reset, as a vector file
 // <fail_dir>/render_span_<config>_fail.vec with the model's expected outputs, replayed into an FST
@@ -26,12 +32,22 @@ class RtlSpanEngine final : public SpanEngine {
                          std::optional<SpanParams> model_params = {});
   const SpanParams& params() const override { return dut_->params(); }
   SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override;
+  void beginFrame() override;
+  void endFrame() override;
 
  private:
+  // The full-rate unit's stream instance: one cycle, offering the oldest descriptor not yet taken.
+  void streamTick();
+
   std::string mode_, fail_dir_;
   std::unique_ptr<SpanDut> dut_;
   SpanUnitModel model_;
   SpanOut out_, expected_;
+  std::unique_ptr<SpanDut> stream_dut_;  // the full-rate unit only
+  SpanUnitModel stream_model_;
+  SpanOut stream_out_, stream_expected_;
+  std::deque<SpanDesc> stream_queue_;
+  uint64_t stream_descs_ = 0;  // descriptors of the frame accepted by the stream instance
 };
 
 // A batch streams through the pipeline with valid_i high on every cycle; the results are

@@ -79,6 +79,69 @@ std::string compareSpanOutputs(const SpanOut& exp, const SpanOut& got) {
   return "";
 }
 
+namespace {
+
+// The failing case from reset: the window's inputs with the descriptors accepted in it (`held`,
+// in order) and `next`, offered and not yet accepted when the run failed, replayed into a traced
+// instance (FST) and, with the model's expected outputs, a vector file that `shadesim replay`
+// and the Icarus testbench replay; the descriptor accepted last and the out_ready pattern as
+// JSON.
+template <class Window>
+void saveSpanFailingCase(const std::string& mode, const SpanParams& model_params, const SpanMismatch& first,
+                         const Window& window, const std::vector<SpanDesc>& held, const SpanDesc& next,
+                         const SpanCosimOptions& opts, SpanCosimResult& res) {
+  std::filesystem::create_directories(opts.fail_dir);
+  res.fst_path = fmt::format("{}/span_{}_fail.fst", opts.fail_dir, mode);
+  res.case_path = fmt::format("{}/span_{}_fail.json", opts.fail_dir, mode);
+  res.vector_path = fmt::format("{}/span_{}_fail.vec", opts.fail_dir, mode);
+  auto traced = makeSpanDut(mode, res.fst_path);
+  SpanVectors v;
+  v.config = mode;
+  v.params = traced->params();
+  v.source = fmt::format("shadesim cosim: the failing triangle (tag {}), cycles {}..{} of the run, replayed from reset",
+                         first.tag, first.cycle + 1 - window.size(), first.cycle);
+  v.descs = held;
+  size_t on_ports = 0;  // the descriptor offered in the current cycle: accepted ones so far
+  for (const auto& w : window) {
+    SpanVectorCycle c;
+    c.desc_valid = w.desc_valid;
+    c.out_ready = w.out_ready;
+    if (w.desc_valid && on_ports == v.descs.size()) v.descs.push_back(next);  // offered, not accepted
+    c.desc = v.descs.empty() ? -1 : static_cast<int>(std::min(on_ports, v.descs.size() - 1));
+    on_ports += w.accepted ? 1 : 0;
+    v.cycles.push_back(std::move(c));
+  }
+  SpanUnitModel replay(model_params);
+  traced->reset();
+  replay.reset();
+  SpanOut ignored;
+  for (SpanVectorCycle& c : v.cycles) {
+    SpanIn in;
+    in.desc_valid = c.desc_valid;
+    in.out_ready = c.out_ready;
+    in.desc = c.desc >= 0 ? &v.descs[static_cast<size_t>(c.desc)] : nullptr;
+    replay.tick(in, c.expected);
+    traced->tick(in, ignored);
+  }
+  traced->finish();
+  writeSpanVectors(res.vector_path, v);
+  std::vector<bool> ready_after_accept;
+  bool after = false;
+  for (const auto& w : window) {
+    if (after) ready_after_accept.push_back(w.out_ready);
+    after = after || w.accepted;
+  }
+  nlohmann::json j = {{"mode", mode},
+                      {"mismatch", {{"cycle", first.cycle}, {"what", first.what}}},
+                      {"descriptor", held.empty() ? toJson(next) : toJson(held.back())},
+                      {"descriptors_replayed", v.descs.size()},
+                      {"out_ready_after_accept", ready_after_accept},
+                      {"vectors", res.vector_path}};
+  writeFileAtomic(res.case_path, j.dump(1) + "\n");
+}
+
+}  // namespace
+
 SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(SpanDesc&)>& next,
                              const SpanCosimOptions& opts) {
   SpanCosimResult res;
@@ -92,35 +155,52 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
 
   dut->reset();
   model.reset();
-  // The accepted descriptor and the pending one, in two buffers that swap roles on accepting
-  // (no copy per triangle).
-  std::array<SpanDesc, 2> desc_buf;
-  SpanDesc* cur = &desc_buf[0];
-  SpanDesc* pending = &desc_buf[1];
-  bool have_cur = false;  // a descriptor has been accepted
+  // The failing case is the run's inputs from the last cycle that began with the unit idle,
+  // with the descriptors accepted since (`held`): from reset they reproduce the unit's state.
+  // The paper's unit is idle when it accepts each descriptor; the full-rate unit, which takes
+  // the next one while it works, is idle only where the stream lets it drain (opts.drain_every).
+  // Past kMaxHeld descriptors or kMaxWindow cycles without an idle cycle the window is dropped
+  // (a failure there is reported without a saved case).
+  constexpr size_t kMaxHeld = 64, kMaxWindow = size_t{1} << 20;
+  struct WindowCycle {
+    bool desc_valid, out_ready, accepted;
+  };
+  std::vector<WindowCycle> window;
+  bool window_lost = false;
+  // The descriptors in a ring, read into place (no copy per triangle): accepted ones from
+  // held_begin to accepted (the window's), then the pending one.
+  std::vector<SpanDesc> ring(kMaxHeld + 2);
+  uint64_t held_begin = 0, accepted = 0;
+  auto slot = [&](uint64_t i) -> SpanDesc& { return ring[i % ring.size()]; };
+  SpanDesc* pending = &slot(0);
   bool have_pending = next(*pending);
   int wait = have_pending && gap(rng) ? 1 + static_cast<int>(rng() % 3) : 0;
-  // The inputs (desc_valid, out_ready) from the cycle that accepted `cur` (from reset before
-  // the first one) to now: with `cur` and `pending` they reproduce the unit's state, because
-  // the unit loads every register it uses when it accepts a descriptor.
-  std::vector<std::pair<bool, bool>> window;
+  uint64_t since_drain = 0;
+  bool draining = false;  // desc_valid held low until the unit is idle
   SpanOut exp, got;
-  bool failed_triangle_saved = false;
-  SpanDesc fail_desc, fail_next;
-  bool fail_has_cur = false;
-  std::vector<std::pair<bool, bool>> fail_window;
+  std::vector<WindowCycle> fail_window;
+  std::vector<SpanDesc> fail_held;
+  SpanDesc fail_next;
+  bool fail_saved = false;
   const auto t0 = std::chrono::steady_clock::now();
   while (have_pending || !model.idle()) {
+    if (model.idle()) {
+      window.clear();
+      held_begin = accepted;
+      window_lost = false;
+      draining = false;
+    }
     SpanIn in;
     in.out_ready = ready(rng);
-    in.desc_valid = have_pending && wait == 0;
+    in.desc_valid = have_pending && wait == 0 && !draining;
     in.desc = pending;
     if (wait > 0) --wait;
     model.tick(in, exp);
     // The comparison is done on the ports (SpanDut::tickCheck, equal to compareSpanOutputs);
     // the RTL's outputs are read out for the message only when they differ.
     const bool same = dut->tickCheck(in, exp, got);
-    window.emplace_back(in.desc_valid, in.out_ready);
+    const bool taken = in.desc_valid && exp.desc_ready;
+    window.push_back({in.desc_valid, in.out_ready, taken});
     if (exp.out_valid && in.out_ready)
       for (const SpanLaneOut& l : exp.lane) res.fragments += l.valid ? 1 : 0;
     if (!same) {
@@ -130,80 +210,40 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
                                            model.cycle()));
       ++res.mismatches;
       if (!res.first) {
-        res.first = SpanMismatch{model.cycle(), cur->tag, diff};
-        fail_desc = *cur;
-        fail_has_cur = have_cur;
-        fail_next = *pending;
-        fail_window = window;
-        failed_triangle_saved = true;
+        res.first = SpanMismatch{model.cycle(), accepted > 0 ? slot(accepted - 1).tag : 0, diff};
+        if (window_lost) {
+          res.case_note = fmt::format("no failing case saved: the unit was not idle in the {} descriptors or {} cycles "
+                                      "before the mismatch (set a drain interval)", kMaxHeld, kMaxWindow);
+        } else {
+          fail_window = window;
+          fail_held.clear();
+          for (uint64_t i = held_begin; i < accepted + (taken ? 1 : 0); ++i) fail_held.push_back(slot(i));
+          fail_next = *pending;
+          fail_saved = true;
+        }
       }
       if (res.mismatches >= opts.max_mismatches) break;
     }
-    if (in.desc_valid && exp.desc_ready) {  // accepted at this edge
-      std::swap(cur, pending);
-      have_cur = true;
-      window.assign(1, {true, in.out_ready});
+    if (window.size() > kMaxWindow || (taken && accepted + 1 - held_begin > kMaxHeld)) {
+      window_lost = true;  // until the unit is idle again
+      window.clear();
+    }
+    if (taken) {
+      pending = &slot(++accepted);
       ++res.triangles;
       if (opts.progress && (res.triangles & 4095) == 0) opts.progress(res.triangles);
       have_pending = next(*pending);
       wait = have_pending && gap(rng) ? 1 + static_cast<int>(rng() % 3) : 0;
+      if (opts.drain_every > 0 && ++since_drain == opts.drain_every) {
+        since_drain = 0;
+        draining = true;
+      }
     }
   }
   res.cycles = model.cycle();
   res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   dut->finish();
-
-  if (failed_triangle_saved) {
-    // The failing triangle alone: from reset, the cycle that accepted it, then the run's inputs
-    // up to the failing cycle (the next descriptor too if it was offered meanwhile), into a
-    // traced instance (FST) and, with the model's expected outputs, a vector file that
-    // `shadesim replay` and the Icarus testbench replay.
-    std::filesystem::create_directories(opts.fail_dir);
-    res.fst_path = fmt::format("{}/span_{}_fail.fst", opts.fail_dir, mode);
-    res.case_path = fmt::format("{}/span_{}_fail.json", opts.fail_dir, mode);
-    res.vector_path = fmt::format("{}/span_{}_fail.vec", opts.fail_dir, mode);
-    SpanVectors v;
-    v.config = mode;
-    v.params = dut->params();
-    v.source = fmt::format("shadesim cosim: the failing triangle (tag {}), cycles {}..{} of the run, replayed from reset",
-                           fail_desc.tag, res.first->cycle + 1 - fail_window.size(), res.first->cycle);
-    if (fail_has_cur) v.descs.push_back(fail_desc);
-    bool next_on_ports = false;
-    for (size_t i = 0; i < fail_window.size(); ++i) {
-      SpanVectorCycle c;
-      c.desc_valid = fail_window[i].first;
-      c.out_ready = fail_window[i].second;
-      if (c.desc_valid && !(fail_has_cur && i == 0) && !next_on_ports) {
-        v.descs.push_back(fail_next);
-        next_on_ports = true;
-      }
-      c.desc = static_cast<int>(v.descs.size()) - 1;
-      v.cycles.push_back(std::move(c));
-    }
-    auto traced = makeSpanDut(mode, res.fst_path);
-    SpanUnitModel replay(model_params);
-    traced->reset();
-    replay.reset();
-    SpanOut ignored;
-    for (SpanVectorCycle& c : v.cycles) {
-      SpanIn in;
-      in.desc_valid = c.desc_valid;
-      in.out_ready = c.out_ready;
-      in.desc = c.desc >= 0 ? &v.descs[static_cast<size_t>(c.desc)] : nullptr;
-      replay.tick(in, c.expected);
-      traced->tick(in, ignored);
-    }
-    traced->finish();
-    writeSpanVectors(res.vector_path, v);
-    std::vector<bool> ready_after_accept;
-    for (size_t i = fail_has_cur ? 1 : 0; i < fail_window.size(); ++i) ready_after_accept.push_back(fail_window[i].second);
-    nlohmann::json j = {{"mode", mode},
-                        {"mismatch", {{"cycle", res.first->cycle}, {"what", res.first->what}}},
-                        {"descriptor", toJson(fail_desc)},
-                        {"out_ready_after_accept", ready_after_accept},
-                        {"vectors", res.vector_path}};
-    writeFileAtomic(res.case_path, j.dump(1) + "\n");
-  }
+  if (fail_saved) saveSpanFailingCase(mode, model_params, *res.first, fail_window, fail_held, fail_next, opts, res);
   return res;
 }
 

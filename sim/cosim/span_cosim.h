@@ -3,11 +3,12 @@
 // every output is compared on every cycle: desc_ready, out_valid, the tag, each lane's valid
 // bit, and each valid lane's pixel and attributes.
 //
-// On the first mismatch the failing triangle is replayed alone from reset, with the run's
-// inputs from the cycle that accepted it to the failing one, into a traced instance (an FST
-// waveform), and saved as a vector file (sim/vectors/vector_file.h: the descriptor, the inputs and the
-// model's expected outputs, cycle by cycle) that `shadesim replay` and the Icarus testbench
-// replay alone; its descriptor and out_ready pattern are also written as JSON.
+// On the first mismatch the failing case is replayed from reset: the run's inputs from the last
+// cycle that began with the unit idle (for the paper's unit, the one that accepted the failing
+// triangle) to the failing one, with the descriptors accepted since, into a traced instance (an
+// FST waveform), and saved as a vector file (sim/vectors/vector_file.h: the descriptors, the
+// inputs and the model's expected outputs, cycle by cycle) that `shadesim replay` and the Icarus
+// testbench replay alone; the last descriptor and the out_ready pattern are also written as JSON.
 #pragma once
 
 #include <cstdint>
@@ -30,6 +31,11 @@ struct SpanCosimOptions {
   double desc_gap_prob = 0.1;    // a descriptor waits 1..3 cycles before being offered
   std::string fail_dir = ".";
   uint64_t max_mismatches = 16;
+  // After this many descriptors accepted, desc_valid stays low until the unit is idle (0: never).
+  // The paper's unit is idle after each descriptor anyway; the full-rate unit, which takes the
+  // next descriptor while it works, is otherwise never idle in a stream, and the failing case
+  // (below) is replayed from the last idle cycle.
+  uint64_t drain_every = 32;
   std::function<void(uint64_t done)> progress;  // called every 4096 triangles
   // Fault injection for the checker's own tests: run the model with other parameters than
   // the verilated unit (e.g. another lane layout) so that the comparison must fail.
@@ -51,6 +57,7 @@ struct SpanCosimResult {
   double seconds = 0;
   std::optional<SpanMismatch> first;
   std::string fst_path, case_path, vector_path;
+  std::string case_note;  // why no case was saved for the first mismatch, if none was
 };
 
 // The co-simulation's out_ready draw: bit for bit std::bernoulli_distribution(p) on the same

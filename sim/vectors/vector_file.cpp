@@ -21,7 +21,7 @@ const char* const kHeaderKeys[] = {"unit", "config", "params", "prom", "latency"
 
 const char* const kSpecParamOrder = "Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits "
                                     "SpecFracBits LightBits PipeStages Kind TableBits Segments";
-const char* const kSpanParamOrder = "NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits";
+const char* const kSpanParamOrder = "NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits RowAhead";
 
 std::vector<int> specParamList(const SpecUnitParams& p) {
   return {p.Degree,       p.CosFracBits,    p.ShinBits,     p.CoefIntBits, p.CoefFracBits,
@@ -30,7 +30,7 @@ std::vector<int> specParamList(const SpecUnitParams& p) {
 }
 
 std::vector<int> spanParamList(const SpanParams& p) {
-  return {p.NumTri, p.LanesPerTri, p.AlignLanes, p.NumAttr, p.AttrBits, p.CoordBits, p.RemBits, p.PixBits, p.TagBits};
+  return {p.NumTri, p.LanesPerTri, p.AlignLanes, p.NumAttr, p.AttrBits, p.CoordBits, p.RemBits, p.PixBits, p.TagBits, p.RowAhead};
 }
 
 uint64_t lowBits(int64_t v, int bits) {

@@ -29,7 +29,8 @@ module tb_span_unit #(
   parameter integer CoordBits   = 16,
   parameter integer RemBits     = 27,
   parameter integer PixBits     = 12,
-  parameter integer TagBits     = 32
+  parameter integer TagBits     = 32,
+  parameter integer RowAhead    = 0
 ) ();
 
   localparam integer L         = NumTri * LanesPerTri;
@@ -77,7 +78,8 @@ module tb_span_unit #(
 
   shd_span_unit #(
     .NumTri(NumTri), .LanesPerTri(LanesPerTri), .AlignLanes(AlignLanes), .NumAttr(NumAttr),
-    .AttrBits(AttrBits), .CoordBits(CoordBits), .RemBits(RemBits), .PixBits(PixBits), .TagBits(TagBits)
+    .AttrBits(AttrBits), .CoordBits(CoordBits), .RemBits(RemBits), .PixBits(PixBits), .TagBits(TagBits),
+    .RowAhead(RowAhead)
   ) dut (
     .clk_i(clk_i), .rst_ni(rst_ni),
     .desc_valid_i(desc_valid_i), .desc_ready_o(desc_ready_o), .desc_tag_i(desc_tag_i),
@@ -100,7 +102,7 @@ module tb_span_unit #(
   reg     cycle_bad, params_seen, pending, have_desc, done, dumping;
   reg [63:0] v, exp_mask, exp_tag, exp_dr, exp_ov;
   reg [8*40-1:0] signal;
-  integer hp [0:9];
+  integer hp [0:10];
 
   // The file is read character by character ($fgetc): ch is the next unread one (-1 at the end),
   // so a record's fields are taken from its own line only.
@@ -264,16 +266,16 @@ module tb_span_unit #(
         // A header or comment line: the rest of it at once.
         line = 0;
         n = $fgets(line, fd);
-        for (a = 0; a < 10; a = a + 1) hp[a] = 32'bx;
-        if ($sscanf(line, " params %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4], hp[5],
-                    hp[6], hp[7], hp[8], hp[9]) >= 1) begin
+        for (a = 0; a < 11; a = a + 1) hp[a] = 32'bx;
+        if ($sscanf(line, " params %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4], hp[5],
+                    hp[6], hp[7], hp[8], hp[9], hp[10]) >= 1) begin
           if (hp[0] !== NumTri || hp[1] !== LanesPerTri || hp[2] !== AlignLanes || hp[3] !== NumAttr ||
               hp[4] !== AttrBits || hp[5] !== CoordBits || hp[6] !== RemBits || hp[7] !== PixBits ||
-              hp[8] !== TagBits || hp[9] !== 32'bx) begin
+              hp[8] !== TagBits || hp[9] !== RowAhead || hp[10] !== 32'bx) begin
             if (line[7:0] == "\n") line = line >> 8;
             $display("tb_span_unit: error: %0s, line %0d: '#%0s' differs from the parameters compiled in:", path, lineno, line);
-            $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d (NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits)",
-                     NumTri, LanesPerTri, AlignLanes, NumAttr, AttrBits, CoordBits, RemBits, PixBits, TagBits);
+            $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits RowAhead)",
+                     NumTri, LanesPerTri, AlignLanes, NumAttr, AttrBits, CoordBits, RemBits, PixBits, TagBits, RowAhead);
             $fatal(1);
           end
           params_seen = 1'b1;
