@@ -163,7 +163,7 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   // (a failure there is reported without a saved case).
   constexpr size_t kMaxHeld = 64, kMaxWindow = size_t{1} << 20;
   struct WindowCycle {
-    bool desc_valid, out_ready, accepted;
+    bool desc_valid, out_ready, accepted, unused;  // 4 bytes: size() without a division
   };
   std::vector<WindowCycle> window;
   bool window_lost = false;
@@ -183,8 +183,9 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   SpanDesc fail_next;
   bool fail_saved = false;
   const auto t0 = std::chrono::steady_clock::now();
-  while (have_pending || !model.idle()) {
+  for (;;) {
     if (model.idle()) {
+      if (!have_pending) break;
       window.clear();
       held_begin = accepted;
       window_lost = false;
@@ -200,7 +201,7 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
     // the RTL's outputs are read out for the message only when they differ.
     const bool same = dut->tickCheck(in, exp, got);
     const bool taken = in.desc_valid && exp.desc_ready;
-    window.push_back({in.desc_valid, in.out_ready, taken});
+    window.push_back({in.desc_valid, in.out_ready, taken, false});
     if (exp.out_valid && in.out_ready)
       for (const SpanLaneOut& l : exp.lane) res.fragments += l.valid ? 1 : 0;
     if (!same) {
