@@ -184,13 +184,9 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   bool fail_saved = false;
   const auto t0 = std::chrono::steady_clock::now();
   for (;;) {
-    if (model.idle()) {
-      if (!have_pending) break;
-      window.clear();
-      held_begin = accepted;
-      window_lost = false;
-      draining = false;
-    }
+    const bool idle = model.idle();  // before this cycle's edge
+    if (idle && !have_pending) break;
+    if (idle) draining = false;
     SpanIn in;
     in.out_ready = ready(rng);
     in.desc_valid = have_pending && wait == 0 && !draining;
@@ -224,6 +220,13 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
         }
       }
       if (res.mismatches >= opts.max_mismatches) break;
+    }
+    // The window starts again at an idle cycle, after its comparison: a mismatch in that cycle
+    // keeps the cycles before it, which may be what the RTL still shows.
+    if (idle) {
+      window.assign(1, window.back());
+      held_begin = accepted;  // this cycle's descriptor, if it takes one, is the window's first
+      window_lost = false;
     }
     if (window.size() > kMaxWindow || (taken && accepted + 1 - held_begin > kMaxHeld)) {
       window_lost = true;  // until the unit is idle again

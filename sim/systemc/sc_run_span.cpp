@@ -99,11 +99,12 @@ SpanFault spanFault(const ScOptions& o) {
   return o.fault == "latency" ? SpanFault::Latency : o.fault == "value" ? SpanFault::Value : SpanFault::None;
 }
 
-SpanDriverOptions driverOptions(const ScOptions& o) {
+SpanDriverOptions driverOptions(const ScOptions& o, const SpanParams& p) {
   SpanDriverOptions dopt;
   dopt.seed = o.seed;
   dopt.ready_prob = o.ready;
   dopt.desc_gap_prob = o.desc_gap;
+  dopt.drain_every = p.RowAhead ? 32 : 0;  // as shadesim cosim's default
   return dopt;
 }
 
@@ -112,7 +113,7 @@ struct SpanFailCapture {
   std::optional<ScFirstMismatch<SpanOut>> first;
   SpanVectors cycles;        // the captured cycles up to the failing one (SpanGolden::capturedCase)
   uint64_t run_first = 0;    // the run's cycle of the first of them
-  bool from_accept = false;  // ... the cycle that accepted the current triangle (else the run's first)
+  bool from_idle = false;  // ... the last cycle the golden model was idle before (else the run's first)
 };
 
 // The testbench around the verilated unit (the diagram in span_tb.h): the driver (the vector
@@ -133,7 +134,7 @@ struct SpanBench {
   SpanBench(const ScOptions& o, SpanRtl& rtl, const SpanStimulus& stim, sc_core::sc_clock& clk,
             sc_core::sc_signal<bool>& rst_n)
       : file_driver(stim.file ? std::make_unique<SpanFileDriver>("driver", *stim.file, ctl) : nullptr),
-        driver(stim.file ? nullptr : std::make_unique<SpanDriver>("driver", stim.next, driverOptions(o), ctl)),
+        driver(stim.file ? nullptr : std::make_unique<SpanDriver>("driver", stim.next, driverOptions(o, rtl.params()), ctl)),
         golden("golden", rtl.params(), spanFault(o), !o.save_vectors.empty(), o.save_fail),
         board("scoreboard", ctl) {
     ctl.max_mismatches = o.max_mismatches;
@@ -180,7 +181,7 @@ struct SpanBench {
     if (o.save_fail)
       board.on_first_mismatch = [this](const sc_core::sc_time& t, const SpanOut& e, bool from_file) {
         fail.first = ScFirstMismatch<SpanOut>{t, e, from_file};  // the outputs during the cycle sampled at t
-        fail.cycles = golden.capturedCase(t, fail.run_first, fail.from_accept);
+        fail.cycles = golden.capturedCase(t, fail.run_first, fail.from_idle);
       };
   }
 
@@ -214,7 +215,8 @@ ScFailCase saveSpanFail(const ScOptions& o, SpanFailCapture cap, const std::stri
     spanGoldenReplay(v, v.params, spanFault(o));
     if (first.from_file) v.cycles.back().expected = first.expected;
     v.source = failCaseSource(o, cap.run_first, v.cycles.size());
-    v.notes = {cap.from_accept ? "the failing triangle alone: from the cycle that accepted it to the failing cycle"
+    v.notes = {cap.from_idle ? "from the last cycle the unit was idle (the paper's unit: the one that accepted the failing "
+                               "triangle) to the failing cycle"
                                : "from the run's first cycle (no triangle accepted before) to the failing cycle",
                failCaseExpectedNote(o, first.from_file),
                fmt::format("the run's first mismatch (the outputs during the last cycle): {}", what)};

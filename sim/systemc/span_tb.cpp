@@ -22,7 +22,7 @@ std::ostream& operator<<(std::ostream& os, const SpanExpect& e) {
 SpanDriver::SpanDriver(const sc_core::sc_module_name& name, std::function<bool(SpanDesc&)> next,
                        const SpanDriverOptions& opt, ScRunControl& ctl)
     : sc_module(name), next_(std::move(next)), rng_(opt.seed), ready_(opt.ready_prob), gap_(opt.desc_gap_prob),
-      ctl_(ctl) {
+      ctl_(ctl), drain_every_(opt.drain_every) {
   SC_METHOD(onEdge);
   sensitive << clk.pos() << rst_n.pos();
   dont_initialize();
@@ -49,8 +49,14 @@ void SpanDriver::onEdge() {
     offering_ = false;
     ++accepted_;
     have_pending_ = fetch();
+    draining_ = draining_ || (drain_every_ > 0 && accepted_ % drain_every_ == 0);
   }
   if (offering_) return;  // valid/ready: the descriptor stays on the pins until accepted
+  if (draining_ && model_idle.read()) draining_ = false;
+  if (draining_) {
+    desc_valid_i.write(false);
+    return;
+  }
   if (have_pending_ && wait_ == 0) {
     pins->driveDesc(*pending_);
     if (!offered.nb_write(DescToken{pending_})) SC_REPORT_FATAL("shadesim/span_driver", "descriptor FIFO full");
@@ -178,12 +184,12 @@ SpanVectors SpanGolden::recorded() const {
   return v;
 }
 
-SpanVectors SpanGolden::capturedCase(const sc_time& last_edge, uint64_t& first_cycle, bool& from_accept) const {
+SpanVectors SpanGolden::capturedCase(const sc_time& last_edge, uint64_t& first_cycle, bool& from_idle) const {
   SpanVectors v;
   v.params = core_.model().params();
   const SpanDesc* last = nullptr;
   first_cycle = cap_.empty() ? 0 : cap_.front().cycle;
-  from_accept = cap_from_accept_;
+  from_idle = cap_from_idle_;
   for (const Captured& e : cap_) {
     if (e.edge > last_edge) break;
     if (e.on_ports && e.on_ports.get() != last) {  // a D record: on the ports from this cycle on
@@ -212,20 +218,21 @@ void SpanGolden::onEdge() {
     return;
   }
   const bool pin_valid = desc_valid_i.read(), pin_ready = out_ready_i.read();
+  const bool was_idle = core_.idle();
   const SpanOut& out = core_.tick(pin_valid, pin_ready);
   if (!expect.nb_write(SpanExpect{sc_time_stamp(), out, core_.readyTaken(), -1}))
     SC_REPORT_FATAL("shadesim/span_golden", "expectation FIFO full");
   ++active_edges_;
   if (capture_) {
-    if (accept_at_ >= 0) {  // the current triangle was accepted at the previous edge: start there
-      cap_.erase(cap_.begin(), cap_.begin() + accept_at_);
-      cap_from_accept_ = true;
-      accept_at_ = -1;
+    if (idle_at_ >= 0) {  // the model was idle before the previous edge: start there
+      cap_.erase(cap_.begin(), cap_.begin() + idle_at_);
+      cap_from_idle_ = true;
+      idle_at_ = -1;
     }
     cap_.push_back(Captured{sc_time_stamp(), active_edges_, pin_valid, pin_ready, on_ports_});
-    // Accepted at this edge: desc_valid on the ports and desc_ready (the model's, equal to the
-    // RTL's up to the first mismatch, which is all a failing case needs).
-    if (pin_valid && out.desc_ready) accept_at_ = static_cast<int64_t>(cap_.size()) - 1;
+    // From an idle state the inputs from this cycle on reproduce the unit's (the paper's unit is
+    // idle in the cycle that accepts each triangle).
+    if (was_idle) idle_at_ = static_cast<int64_t>(cap_.size()) - 1;
   }
   if (record_) {
     SpanVectorCycle c;

@@ -53,6 +53,10 @@ struct SpanDriverOptions {
   uint64_t seed = 1;
   double ready_prob = 0.8;     // out_ready high on a cycle with this probability
   double desc_gap_prob = 0.1;  // a descriptor waits 1..3 cycles before being offered
+  // After this many descriptors accepted, none is offered until the golden model is idle (0:
+  // never): the full-rate unit, which takes the next descriptor while it works, is otherwise
+  // never idle in a stream, and the failing case starts at its last idle cycle.
+  uint64_t drain_every = 0;
 };
 
 class SpanDriver : public sc_core::sc_module {
@@ -81,7 +85,8 @@ class SpanDriver : public sc_core::sc_module {
   std::shared_ptr<SpanDesc> pending_;
   bool have_pending_ = false, offering_ = false;
   int wait_ = 0, idle_edges_ = 0;
-  uint64_t offered_ = 0, accepted_ = 0;
+  uint64_t offered_ = 0, accepted_ = 0, drain_every_ = 0;
+  bool draining_ = false;
 };
 
 // Replays a vector file's cycles (sim/vectors/vector_file.h): desc_valid, out_ready and the
@@ -159,11 +164,11 @@ class SpanGolden : public sc_core::sc_module {
   // Fault injection, to prove the scoreboard can fail (SpanGoldenCore).
   // record: keep every active cycle's inputs (as on the ports) and the model's outputs, and the
   // descriptors, as a vector file's cycles (--save-vectors).
-  // capture: keep what the failing case is saved from, bounded by one triangle: the inputs on
-  // the ports (desc_valid, out_ready, the descriptor) of every active cycle since the one at
-  // which the current triangle was accepted (from reset before the first), as
-  // sim/cosim/span_cosim.cpp does: the unit loads every register it uses when it accepts a
-  // descriptor.
+  // capture: keep what the failing case is saved from: the inputs on the ports (desc_valid,
+  // out_ready, the descriptor) of every active cycle since the last one the model was idle
+  // before (from reset before the first), as sim/cosim/span_cosim.cpp does: from an idle unit
+  // the inputs reproduce its state. The paper's unit is idle in the cycle that accepts each
+  // triangle; the full-rate unit where the driver lets it drain (SpanDriverOptions::drain_every).
   SpanGolden(const sc_core::sc_module_name& name, SpanParams p, SpanFault fault, bool record, bool capture = false);
   SC_HAS_PROCESS(SpanGolden);
   uint64_t accepted() const { return core_.accepted(); }
@@ -172,9 +177,10 @@ class SpanGolden : public sc_core::sc_module {
   SpanVectors recorded() const;
   // The captured cycles up to the one sampled at last_edge, as a vector file's cycles without
   // expected outputs (params, descs, cycles; spanGoldenReplay fills them in). first_cycle gets
-  // the run's cycle (1-based from reset) of the first one, from_accept whether it is the cycle
-  // that accepted the current triangle (else the run's first).
-  SpanVectors capturedCase(const sc_core::sc_time& last_edge, uint64_t& first_cycle, bool& from_accept) const;
+  // the run's cycle (1-based from reset) of the first one, from_idle whether it is the last cycle
+  // the golden model was idle before (for the paper's unit, the one that accepted the current
+  // triangle; else the run's first).
+  SpanVectors capturedCase(const sc_core::sc_time& last_edge, uint64_t& first_cycle, bool& from_idle) const;
 
  private:
   void onEdge();
@@ -190,9 +196,9 @@ class SpanGolden : public sc_core::sc_module {
     std::shared_ptr<const SpanDesc> on_ports;  // as offered (before the Value fault); null: none yet
   };
   std::deque<Captured> cap_;
-  bool cap_from_accept_ = false;
-  int64_t accept_at_ = -1;  // index in cap_ of an acceptance not yet applied (the window moves
-                            // at the next edge, so a mismatch at the accepting cycle keeps its triangle)
+  bool cap_from_idle_ = false;
+  int64_t idle_at_ = -1;  // index in cap_ of an idle cycle not yet applied (the window moves at the
+                          // next edge, so a mismatch in the idle cycle keeps the cycles before it)
   std::shared_ptr<const SpanDesc> on_ports_;
   uint64_t active_edges_ = 0;
 };
