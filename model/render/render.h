@@ -69,7 +69,7 @@ std::vector<Method> allMethods();
 // The span unit: the fragments of one descriptor, appended to `out` in the unit's output order,
 // and the cycles they took, the consumer always ready. A frame's descriptors go to the unit back
 // to back: the paper's unit takes each from IDLE to IDLE; the full-rate unit (RowAhead)
-// overlaps them, and run() gives each descriptor's share of the frame's stream (frameStream(),
+// overlaps them, and run() gives each descriptor's share of the frame's stream (streamOrNull(),
 // SpanStream), so the frame's cycles are the stream's. render() calls beginFrame() before the
 // frame's first descriptor and endFrame() after its last.
 class SpanEngine {
