@@ -534,8 +534,6 @@ module shd_span_unit #(
       reg  [DW-1:0]   qd_q;   // Q
       reg  [RW-1:0]   b_q;    // B
       reg  [MAPW-1:0] em_q;   // E's row's map
-      wire [RW-1:0]   formed = {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q,
-                                lt_ox_q, lt_oy_q, lt_flip_q, lt_aoff_q};
 
       // F holding a row while E shows a group other than its row's last: B cannot be taken in this
       // cycle, so F stalls again whatever the row logic gives; it is not computed (form_en 0) and
@@ -582,12 +580,19 @@ module shd_span_unit #(
       end
 
       always @(posedge clk_i) begin
-        if (f_puts) b_q <= formed;
+        // F's row, concatenated here and not in a wire (a simulator then builds it only when
+        // it is loaded; the hardware is the same).
+        if (f_puts)
+          b_q <= {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q, lt_ox_q, lt_oy_q, lt_flip_q,
+                  lt_aoff_q};
       end
 
       always @(posedge clk_i) begin
         if (e_load) begin
-          {ne_q, lo_q, hi_q, xe_q, xg_q, wspan_q, icur_q, em_q} <= take_b ? b_q : formed;
+          if (take_b) {ne_q, lo_q, hi_q, xe_q, xg_q, wspan_q, icur_q, em_q} <= b_q;
+          else        {ne_q, lo_q, hi_q, xe_q, xg_q, wspan_q, icur_q, em_q} <=
+                      {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q, lt_ox_q, lt_oy_q,
+                       lt_flip_q, lt_aoff_q};
         end else if (e_step) begin
           xg_q   <= xg_next[C-1:0];
           icur_q <= icur_step;

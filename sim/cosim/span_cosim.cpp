@@ -165,7 +165,8 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   struct WindowCycle {
     bool desc_valid, out_ready, accepted, unused;  // 4 bytes: size() without a division
   };
-  std::vector<WindowCycle> window;
+  std::vector<WindowCycle> window;  // from window_begin on (the prefix is dropped now and then)
+  size_t window_begin = 0;
   bool window_lost = false;
   // The descriptors in a ring, read into place (no copy per triangle): accepted ones from
   // held_begin to accepted (the window's), then the pending one.
@@ -184,9 +185,12 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
   bool fail_saved = false;
   const auto t0 = std::chrono::steady_clock::now();
   for (;;) {
-    const bool idle = model.idle();  // before this cycle's edge
-    if (idle && !have_pending) break;
-    if (idle) draining = false;
+    bool idle = false;  // before this cycle's edge
+    if (model.idle()) {
+      if (!have_pending) break;
+      idle = true;
+      draining = false;
+    }
     SpanIn in;
     in.out_ready = ready(rng);
     in.desc_valid = have_pending && wait == 0 && !draining;
@@ -212,7 +216,7 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
           res.case_note = fmt::format("no failing case saved: the unit was not idle in the {} descriptors or {} cycles "
                                       "before the mismatch (set a drain interval)", kMaxHeld, kMaxWindow);
         } else {
-          fail_window = window;
+          fail_window.assign(window.begin() + static_cast<ptrdiff_t>(window_begin), window.end());
           fail_held.clear();
           for (uint64_t i = held_begin; i < accepted + (taken ? 1 : 0); ++i) fail_held.push_back(slot(i));
           fail_next = *pending;
@@ -224,13 +228,18 @@ SpanCosimResult runSpanCosim(const std::string& mode, const std::function<bool(S
     // The window starts again at an idle cycle, after its comparison: a mismatch in that cycle
     // keeps the cycles before it, which may be what the RTL still shows.
     if (idle) {
-      window.assign(1, window.back());
+      window_begin = window.size() - 1;
       held_begin = accepted;  // this cycle's descriptor, if it takes one, is the window's first
       window_lost = false;
+      if (window_begin >= 4096) {  // drop the prefix now and then, not at every idle cycle
+        window.erase(window.begin(), window.begin() + static_cast<ptrdiff_t>(window_begin));
+        window_begin = 0;
+      }
     }
-    if (window.size() > kMaxWindow || (taken && accepted + 1 - held_begin > kMaxHeld)) {
+    if (window.size() - window_begin > kMaxWindow || (taken && accepted + 1 - held_begin > kMaxHeld)) {
       window_lost = true;  // until the unit is idle again
       window.clear();
+      window_begin = 0;
     }
     if (taken) {
       pending = &slot(++accepted);
