@@ -18,15 +18,16 @@ here=$(cd "$(dirname "$0")" && pwd)
 source "$here/fresh_work.sh"
 fresh_work "$work"
 cd "$work"
-# SHD_REPORT_ARGS: more options for the first report (the sanitizer build: fewer units).
+# SHD_REPORT_ARGS: more options for the reports (fewer units: the sanitizer build, other scenes).
 # shellcheck disable=SC2086
 "$shadesim" report --scene "$scene" --modes serial,evenodd --bench 1 --no-hardware ${SHD_REPORT_ARGS:-} -o r --quiet > report.out
 cat report.out
 if [ "${4:-}" = tools-absent ]; then
   mkdir -p nobin cache
   status=0
-  PATH=$work/nobin "$shadesim" report --scene "$scene" --modes serial --bench 1 --hardware-cache cache -o r2 --quiet \
-    > r2.out 2> r2.err || status=$?
+  # shellcheck disable=SC2086
+  PATH=$work/nobin "$shadesim" report --scene "$scene" --modes serial --bench 1 --hardware-cache cache ${SHD_REPORT_ARGS:-} \
+    -o r2 --quiet > r2.out 2> r2.err || status=$?
   [ "$status" -eq 1 ] || { cat r2.err; echo "report_test: without the tools: exit $status, expected 1" >&2; exit 1; }
   grep -q '^report: area absent: yosys' r2.err && grep -q '^report: fmax, time absent: place and route' r2.err \
     || { cat r2.err; echo "report_test: the absent figures are not named" >&2; exit 1; }
