@@ -299,6 +299,9 @@ TEST(TriangleSetup, DegenerateAndOutsideAreDroppedWithAReason) {
   EXPECT_EQ(setupTriangle({vtx(1, 1), vtx(3, 3), vtx(7, 7)}, 1, c).dropped, "zero area");
   EXPECT_EQ(setupTriangle({vtx(-20, -20), vtx(-10, -20), vtx(-20, -5)}, 1, c).dropped,
             "no pixel centre of its bounding box in the viewport");
+  // A sliver whose box holds pixel centre rows and columns, but no centre between its edges.
+  EXPECT_EQ(setupTriangle({vtx(0, 0.1), vtx(3, 1.1), vtx(3, 1.3)}, 1, c).dropped,
+            "no pixel centre inside it in the viewport");
   EXPECT_THROW(setupTriangle({vtx(NAN, 1), vtx(3, 3), vtx(7, 1)}, 1, c), std::invalid_argument);
   EXPECT_THROW(setupTriangle({vtx(1e6, 1), vtx(3, 3), vtx(7, 1)}, 1, c), std::invalid_argument);
   EXPECT_THROW(setupTriangle({vtx(1, 1, {1e30, 0, 0, 0}), vtx(3, 3), vtx(7, 1)}, 1, c), std::invalid_argument);
@@ -427,6 +430,35 @@ TEST(TriangleSetup, PlaneWithinTheDerivedBoundOfTheExactPlane) {
       }
   }
   RecordProperty("worst_error_over_bound", std::to_string(worst));
+}
+
+// Setup trims each lane-triangle's rows to the first and the last that hold a pixel (a row whose
+// centre lies within the vertical extent can hold none: a sliver's tip), so that the unit spends
+// no cycle on them. Checked with the walker's own ROW logic: the bounds at the first row from
+// the descriptor's edges, at the last row after the DDA steps through every row.
+TEST(TriangleSetup, EveryLaneTrianglesFirstAndLastRowsHoldAPixel) {
+  for (const std::string& m : paperSpanModes()) {
+    RasterConfig c;
+    c.unit = spanParams(m);
+    DescriptorStream stream(23, 20000, c);
+    SpanDesc d;
+    long lanes = 0;
+    while (stream.next(d)) {
+      for (const SpanLaneTri& t : d.tri) {
+        if (t.row_first > t.row_last) continue;
+        ++lanes;
+        std::array<SpanDdaState, 3> e;
+        for (size_t s = 0; s < 3; ++s) e[s] = {t.edge[s].q, t.edge[s].r};
+        int64_t lo = 0, hi = 0;
+        ASSERT_TRUE(span_detail::laneRowBounds(t, t.row_first, e.data(), lo, hi))
+            << m << ": first row " << t.row_first << " without a pixel, " << describe(stream.last());
+        for (int64_t w = t.row_first; w < t.row_last; ++w) span_detail::stepEdges(t, w, e.data(), c.unit.CoordBits);
+        ASSERT_TRUE(span_detail::laneRowBounds(t, t.row_last, e.data(), lo, hi))
+            << m << ": last row " << t.row_last << " without a pixel, " << describe(stream.last());
+      }
+    }
+    EXPECT_GT(lanes, 15000) << m;
+  }
 }
 
 TEST(SpanUnitModel, SerialEqualsDirectEvaluationOnGeneratorClasses) {

@@ -756,7 +756,8 @@ TEST(Stiff, SpecClampBoundaries) {
 TEST(Stiff, ZeroAreaAndCollinearTrianglesAreDropped) {
   // det == 0 after snapping (repeated or collinear vertices): no descriptor, dropped as "zero
   // area" before any division, in every mode; the RTL never sees them. A triangle collinear
-  // before snapping but not after is a real (tiny) triangle and is drawn like any other.
+  // before snapping but not after is a real (tiny) triangle: set up like any other, and dropped
+  // because no pixel centre lies inside it (setup trims rows without a pixel).
   const std::vector<std::pair<const char*, Tri>> zero = {
       {"two equal vertices", {vtx(10.3, 10.3, {1, 2, 3, 0.5}), vtx(10.3, 10.3, {4, 5, 6, 0.5}), vtx(30.7, 20.1, {7, 8, 9, 0.5})}},
       {"three equal vertices", {vtx(20.5, 20.5, {1, 2, 3, 0.5}), vtx(20.5, 20.5, {4, 5, 6, 0.5}), vtx(20.5, 20.5, {7, 8, 9, 0.5})}},
@@ -775,18 +776,17 @@ TEST(Stiff, ZeroAreaAndCollinearTrianglesAreDropped) {
   const Tri snapped = {vtx(0.5, 0.5, {0, 0, 0, 0.5}), vtx(1.53125, 0.84375, {255, 0, 0, 0.5}),
                        vtx(300.5, 100.5, {0, 255, 0, 0.5})};
   const ModesResult r = checkAllModes(snapped, 512, 512, "collinear before snapping only");
-  EXPECT_TRUE(r.drawn);
-  std::printf("  collinear before snapping only: drawn, %zu fragments per mode\n", r.fragments);
-  record("zero_area_snapped_sliver_plane_error", static_cast<double>(r.worst_lsb), "output LSB");
-  expectSpanRtlEqualsModel({r}, "snapped sliver");
+  EXPECT_FALSE(r.drawn);
+  EXPECT_EQ(r.dropped, "no pixel centre inside it in the viewport");
+  std::printf("  collinear before snapping only: %s\n", r.dropped.c_str());
 }
 
 TEST(Stiff, OnePixelTriangles) {
   // Triangles of about a pixel: one that covers exactly the centre of pixel (10, 10); the two
   // halves of the unit square of pixel (3, 3), whose shared diagonal runs through its centre;
-  // one whose rows hold pixel centres but no column does (a descriptor that yields no
-  // fragment: the unit spends its accepting cycle and one ROW cycle); one with no pixel-centre
-  // row at all (dropped). The fragments are exact pixel sets.
+  // one whose box holds a pixel-centre row and column but no centre (dropped by setup: no
+  // cycle of the unit, where the unit once spent two on it); one with no pixel-centre row at
+  // all (dropped). The fragments are exact pixel sets.
   struct Case {
     const char* what;
     Tri v;
@@ -810,20 +810,18 @@ TEST(Stiff, OnePixelTriangles) {
       const SpanRun run = runSpanUnit(unit, *s.desc);
       for (const SpanFragment& f : sortedFragments(run.fragments)) got.push_back({f.x, f.y});
       std::printf("  %s: %zu fragment(s), %llu cycles (serial)\n", c.what, got.size(), static_cast<unsigned long long>(run.cycles));
-      if (std::string(c.what) == "a row, no column") {
-        EXPECT_EQ(run.cycles, 2u);
-      }
+      EXPECT_EQ(run.cycles, 3u) << c.what << ": accept, one ROW, one SPAN";
     } else {
       std::printf("  %s: dropped (%s)\n", c.what, s.dropped.c_str());
+      EXPECT_TRUE(c.pixels.empty()) << c.what;
     }
     EXPECT_EQ(got, c.pixels) << c.what;
     if (r.drawn) drawn.push_back(r);
   }
   // The two halves of the unit square share the diagonal through the centre (3.5, 3.5): the
-  // top-left rule gives it to the half for which it is a left edge (the lower right one).
-  // Only "no row" is dropped at setup; the two without a pixel centre but with a row are
-  // walked and yield nothing.
-  EXPECT_EQ(drawn.size(), 4u);
+  // top-left rule gives it to the half for which it is a left edge (the lower right one), and
+  // setup drops the other. Only the two with a pixel reach the unit.
+  EXPECT_EQ(drawn.size(), 2u);
   expectSpanRtlEqualsModel(drawn, "one-pixel triangles");
 }
 

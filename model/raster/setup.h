@@ -22,8 +22,10 @@
 //   covers no pixel and is dropped at setup without a division; so is a triangle whose bounding
 //   box holds no pixel centre of the viewport (wholly above, below, left or right of it, or too
 //   small to reach a centre row or column). setupTriangle() then returns no descriptor and says
-//   why. A triangle whose box holds centres but that covers none (a sliver passing between them)
-//   is walked and yields no fragment: knowing that takes the walk.
+//   why. Each lane-triangle's rows are trimmed to the first and the last that hold a pixel (a
+//   sliver's tip can pass between the centres of a row), so the unit spends no cycle on a row
+//   without a pixel at either end; a triangle whose box holds centres but that covers none (a
+//   sliver passing between them) is dropped as well ("no pixel centre inside it").
 //
 // Attribute planes (the corrected 4.1 of docs/paper-corrections.md: the plane gradient with det as denominator)
 //   Vertex attribute k is quantised to a code a_i = round(value * 2^F_k) (F_k = attr_frac_bits).
@@ -108,7 +110,9 @@ struct AttributePlane {
 
 struct SetupResult {
   std::optional<SpanDesc> desc;  // empty: nothing to draw, see `dropped`
-  std::string dropped;           // "zero area", "no pixel centre of its bounding box in the viewport"
+  // "zero area", "no pixel centre of its bounding box in the viewport", "no pixel centre inside
+  // it in the viewport" (its box has one: a sliver between pixel centres)
+  std::string dropped;
   SnappedTriangle tri;
   std::array<EdgeFunction, 3> edges;  // of the whole triangle, screen pixel coordinates
   AttributePlane plane;               // screen pixel coordinates

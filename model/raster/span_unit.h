@@ -42,7 +42,8 @@
 //   -q (right). From row w to w+1, N grows by -B = k*D + m with 0 <= m < D:
 //       r' = r - m;  if r' < 0 { r' += D; q' = q + k + 1 } else { q' = q + k }
 //   exactly (no division per row). An edge bounds the span only in its active rows
-//   [row_first, row_last] (the rows whose pixel centre lies within the edge's vertical extent);
+//   [row_first, row_last] (the rows whose pixel centre lies within the edge's vertical extent,
+//   within its lane-triangle's rows: setup trims those to the first and last with a pixel);
 //   a lane-triangle's horizontal edge has no DDA: setup folds it into the lane-triangle's row
 //   range. Unused edge slots have row_first > row_last.
 //
