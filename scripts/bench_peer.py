@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""bench_peer.py: the model's time per frame against a peer renderer's, measured side by side.
+
+  scripts/bench_peer.py --pair METHOD 'PEER COMMAND' [--pair ...] [--rounds R] [--frames N]
+                        [--scene SCENE] [--shadesim BIN] [--peer-pattern REGEX] [--json-out FILE]
+
+Each --pair names a shadesim method (`shadesim render --method`) and a shell command that prints
+the peer's time per frame in milliseconds. Every round runs, for every pair, shadesim
+(`render --scene SCENE --method METHOD --bench N`, the median of N frames) and the peer, in the
+order shadesim, peer on odd rounds and peer, shadesim on even ones, so that a machine drifting
+during the run weighs on both alike. Only ratios taken this way mean anything: never compare with
+a figure from another run, day or machine.
+
+--peer-pattern: a regular expression whose first group is the peer's ms per frame, searched in
+its output; the last match counts (default: a number followed by "ms").
+
+Prints, per pair, every round's two times and their ratio, then the median of the rounds'
+ratios (shadesim / peer: below 1, shadesim is faster) with its range. The environment is
+passed on (SHD_SCALAR=1 measures the scalar paths). Exit status: 0, or 2 on bad input or a
+command that fails or prints no time.
+"""
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DEFAULT_PATTERN = r"([0-9]+(?:\.[0-9]+)?)\s*ms\b"
+
+
+class BenchError(Exception):
+    pass
+
+
+def run(cmd, shell=False):
+    p = subprocess.run(cmd, shell=shell, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    if p.returncode != 0:
+        tail = "\n".join((p.stdout + p.stderr).strip().splitlines()[-10:])
+        raise BenchError(f"{cmd if shell else ' '.join(cmd)}: exit {p.returncode}\n{tail}")
+    return p.stdout
+
+
+def shadesim_ms(a, method, work):
+    js = os.path.join(work, "render.json")
+    run([a.shadesim, "render", "--scene", a.scene, "--method", method, "--bench", str(a.frames), "--quiet",
+         "-o", os.path.join(work, "render.png"), "--json", js])
+    with open(js, encoding="utf-8") as f:
+        return float(json.load(f)["ms"])
+
+
+def peer_ms(a, cmd):
+    out = run(cmd, shell=True)
+    found = re.findall(a.peer_pattern, out)
+    if not found:
+        tail = "\n".join(out.strip().splitlines()[-5:])
+        raise BenchError(f"{cmd}: no time per frame matching --peer-pattern '{a.peer_pattern}' in its output:\n{tail}")
+    return float(found[-1] if isinstance(found[-1], str) else found[-1][0])
+
+
+def measure(a):
+    results = [{"method": m, "peer": c, "rounds": []} for m, c in a.pair]
+    with tempfile.TemporaryDirectory(prefix="bench_peer_") as work:
+        for r in range(a.rounds):
+            for res in results:
+                order = ("shadesim", "peer") if r % 2 == 0 else ("peer", "shadesim")
+                t = {}
+                for who in order:
+                    t[who] = shadesim_ms(a, res["method"], work) if who == "shadesim" else peer_ms(a, res["peer"])
+                t["ratio"] = t["shadesim"] / t["peer"]
+                res["rounds"].append(t)
+                print(f"bench_peer: round {r + 1}/{a.rounds} {res['method']}: shadesim {t['shadesim']:.3f} ms, "
+                      f"peer {t['peer']:.3f} ms, ratio {t['ratio']:.3f}", file=sys.stderr, flush=True)
+    for res in results:
+        ratios = [t["ratio"] for t in res["rounds"]]
+        res["ratio_median"] = statistics.median(ratios)
+        res["ratio_min"], res["ratio_max"] = min(ratios), max(ratios)
+    return results
+
+
+def report(a, results):
+    env = " SHD_SCALAR=1" if os.environ.get("SHD_SCALAR") else ""
+    print(f"{a.scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds; ratio = shadesim / peer")
+    for res in results:
+        print(f"\n{res['method']} against: {res['peer']}")
+        print(f"{'round':>5} {'shadesim ms':>12} {'peer ms':>10} {'ratio':>7}")
+        for i, t in enumerate(res["rounds"]):
+            print(f"{i + 1:>5} {t['shadesim']:>12.3f} {t['peer']:>10.3f} {t['ratio']:>7.3f}")
+        print(f"median ratio {res['ratio_median']:.3f} (rounds {res['ratio_min']:.3f} to {res['ratio_max']:.3f})")
+
+
+def main(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--pair", nargs=2, action="append", metavar=("METHOD", "PEER_COMMAND"), required=True)
+    p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--frames", type=int, default=200)
+    p.add_argument("--scene", default="builtin:sphere")
+    p.add_argument("--shadesim", default=os.path.join(ROOT, "build", "sim", "shadesim"))
+    p.add_argument("--peer-pattern", default=DEFAULT_PATTERN)
+    p.add_argument("--json-out")
+    a = p.parse_args(argv)
+    try:
+        if a.rounds < 1 or a.frames < 1:
+            raise BenchError("--rounds and --frames must be at least 1")
+        if not os.access(a.shadesim, os.X_OK):
+            raise BenchError(f"{a.shadesim}: no shadesim binary (--shadesim)")
+        try:
+            if re.compile(a.peer_pattern).groups < 1:
+                raise BenchError(f"--peer-pattern '{a.peer_pattern}' has no group for the time")
+        except re.error as e:
+            raise BenchError(f"--peer-pattern '{a.peer_pattern}': {e}")
+        results = measure(a)
+    except BenchError as e:
+        print(f"bench_peer: {e}", file=sys.stderr)
+        return 2
+    report(a, results)
+    if a.json_out:
+        with open(a.json_out + ".tmp", "w", encoding="utf-8") as f:
+            json.dump({"scene": a.scene, "frames": a.frames, "rounds": a.rounds, "pairs": results}, f, indent=1)
+        os.replace(a.json_out + ".tmp", a.json_out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
