@@ -164,8 +164,8 @@ inline void requireCoord(int64_t v, const SpanParams& p, const char* what) {
 // sliver's tip): on builtin:sphere 676 of the 2,086 triangles drawn began with such a row and
 // 676 ended with one. The unit would spend a cycle forming each. First rows: the edges' DDA
 // stepped as the walker steps them (raster/span_walk.h), so the state at the new first row is
-// the walker's; last rows: each active edge's bound there from its first row's, one 64-bit
-// division per edge. An edge active only in trimmed rows becomes an unused slot.
+// the walker's; last rows: each active edge's bound there from its first row's, one division
+// per edge. An edge active only in trimmed rows becomes an unused slot.
 void trimEmptyRows(SpanLaneTri& t, const SpanParams& p) {
   std::array<SpanDdaState, 3> e;
   for (size_t s = 0; s < 3; ++s) e[s] = {t.edge[s].q, t.edge[s].r};
@@ -176,22 +176,13 @@ void trimEmptyRows(SpanLaneTri& t, const SpanParams& p) {
   int64_t r1 = t.row_last;
   for (; r1 > r0; --r1) {
     // n DDA steps from the edge's first row in one: N grows by n (k D + m), so
-    // q = q0 + n k + ceil((n m - r0) / D); n m fits 64 bits at the registry's widths
-    // (CoordBits + RemBits <= 43), else the 128-bit division.
+    // q = q0 + n k + ceil((n m - r0) / D) (ceilDiv: a 64-bit division where it fits).
     std::array<SpanDdaState, 3> at{};
     for (size_t s = 0; s < 3; ++s) {
       const SpanEdge& g = t.edge[s];
       if (r1 < g.row_first || r1 > g.row_last) continue;
       const int64_t n = r1 - g.row_first;
-      int64_t nm = 0;
-      int64_t c = 0;
-      if (!__builtin_mul_overflow(n, g.m, &nm)) {
-        const int64_t v = nm - g.r;  // >= -r > -2^60: -v cannot overflow
-        c = v > 0 ? (v - 1) / g.div + 1 : -(-v / g.div);
-      } else {
-        c = ceilDiv(static_cast<i128>(n) * g.m - g.r, g.div);
-      }
-      at[s].q = g.q + n * g.k + c;
+      at[s].q = g.q + n * g.k + ceilDiv(static_cast<i128>(n) * g.m - g.r, g.div);
     }
     if (span_detail::laneRowBounds(t, r1, at.data(), lo, hi)) break;
   }

@@ -138,7 +138,7 @@ nlohmann::json toJson(const TriangleSetCycles& s) {
                      {"span_cycles", m.span_cycles},
                      {"no_overhead_bound", m.span_cycles},
                      {"cycles_over_bound", m.overBound()},
-                     {"fragments_per_cycle", m.cycles ? static_cast<double>(m.fragments) / static_cast<double>(m.cycles) : 0.0},
+                     {"fragments_per_cycle", m.fragmentsPerCycle()},
                      {"speedup_vs_serial", m.cycles ? serial / static_cast<double>(m.cycles) : 0.0},
                      {"lane_utilisation", m.utilisation()}});
   nlohmann::json classical = nlohmann::json::array();
@@ -172,7 +172,7 @@ std::string renderSpanCyclesTable(const std::vector<TriangleSetCycles>& sets) {
                        "cyc/bound", "x serial", "lane use");
     for (const ModeCycles& m : s.modes)
       out += fmt::format("{:<16} {:>12} {:>10.3f} {:>12} {:>12.3f} {:>8.2f}x {:>8.1f}%\n", m.mode, m.cycles,
-                         m.cycles ? static_cast<double>(m.fragments) / m.cycles : 0.0, m.span_cycles, m.overBound(),
+                         m.fragmentsPerCycle(), m.span_cycles, m.overBound(),
                          m.cycles ? static_cast<double>(serial.cycles) / m.cycles : 0.0, 100 * m.utilisation());
   }
   out += "(lane use: fragments per lane in the lane groups shown)\n\n";

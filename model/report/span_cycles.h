@@ -38,6 +38,7 @@ struct ModeCycles {
     return span_cycles ? static_cast<double>(fragments) / (static_cast<double>(span_cycles) * lanes) : 0.0;
   }
   double overBound() const { return span_cycles ? static_cast<double>(cycles) / static_cast<double>(span_cycles) : 0.0; }
+  double fragmentsPerCycle() const { return cycles ? static_cast<double>(fragments) / static_cast<double>(cycles) : 0.0; }
 };
 
 struct TriangleSetCycles {

@@ -46,14 +46,14 @@ void RtlSpanEngine::beginFrame() {
   if (!stream_dut_) return;
   stream_dut_->reset();
   stream_model_.reset();
-  stream_queue_.clear();
+  stream_offered_.reset();
   stream_descs_ = 0;
 }
 
 void RtlSpanEngine::streamTick() {
   SpanIn in;
-  in.desc_valid = !stream_queue_.empty();
-  in.desc = in.desc_valid ? &stream_queue_.front() : nullptr;
+  in.desc_valid = stream_offered_.has_value();
+  in.desc = in.desc_valid ? &*stream_offered_ : nullptr;
   in.out_ready = true;
   stream_model_.tick(in, stream_expected_);
   stream_dut_->tick(in, stream_out_);
@@ -63,14 +63,14 @@ void RtlSpanEngine::streamTick() {
         "accepted: {}",
         mode_, stream_model_.cycle() - 1, stream_descs_, diff));
   if (in.desc_valid && stream_expected_.desc_ready) {
-    stream_queue_.pop_front();
+    stream_offered_.reset();
     ++stream_descs_;
   }
 }
 
 void RtlSpanEngine::endFrame() {
   if (!stream_dut_) return;
-  while (!stream_queue_.empty() || !stream_model_.idle()) streamTick();
+  while (stream_offered_ || !stream_model_.idle()) streamTick();
   const uint64_t want = streamOrNull()->end();
   if (stream_model_.cycle() != want)
     throw std::runtime_error(fmt::format("span unit ({}): the frame's {} descriptors took {} cycles back to back on the "
@@ -136,8 +136,8 @@ SpanWalk RtlSpanEngine::run(const SpanDesc& d, std::vector<SpanFragment>& out) {
     // The descriptor's share of the frame's stream, and the stream instance up to its acceptance.
     run.cycles = walkSpanUnit(params(), d, [](int32_t, int32_t, const int64_t*) {}, span_detail::NoRuns{},
                               streamOrNull()).cycles;
-    stream_queue_.push_back(d);
-    while (!stream_queue_.empty()) streamTick();
+    stream_offered_ = d;
+    while (stream_offered_) streamTick();
   }
   return run;
 }

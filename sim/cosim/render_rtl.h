@@ -2,7 +2,6 @@
 // scene rendered with the RTL in the loop can be compared pixel for pixel with the model's.
 #pragma once
 
-#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -36,7 +35,7 @@ class RtlSpanEngine final : public SpanEngine {
   void endFrame() override;
 
  private:
-  // The full-rate unit's stream instance: one cycle, offering the oldest descriptor not yet taken.
+  // The full-rate unit's stream instance: one cycle, offering the descriptor not yet taken.
   void streamTick();
 
   std::string mode_, fail_dir_;
@@ -46,7 +45,7 @@ class RtlSpanEngine final : public SpanEngine {
   std::unique_ptr<SpanDut> stream_dut_;  // the full-rate unit only
   SpanUnitModel stream_model_;
   SpanOut stream_out_, stream_expected_;
-  std::deque<SpanDesc> stream_queue_;
+  std::optional<SpanDesc> stream_offered_;  // run() offers each descriptor until it is taken
   uint64_t stream_descs_ = 0;  // descriptors of the frame accepted by the stream instance
 };
 
