@@ -6,6 +6,10 @@
 //           ones is then shown LanesPerTri columns per cycle. Lane l = j*LanesPerTri + i shows
 //           column x = xg + i, valid iff ne_j && lo_j <= x <= hi_j, its pixel and attribute
 //           mapped by j's (flip, ox, oy, aoff).
+//           Interleave 1 (NumTri 4): a descriptor with desc_interleave_i set maps walker row w to
+//           screen row NumTri*w (+ oy, or oy - when flipped): its lane-triangles take interleaved
+//           rows of the triangle instead of the 4-way split (setup chooses per triangle). With
+//           Interleave 0 the input is ignored.
 // Why:      all lanes read one walker plane I = irow + didx*(x - xref): one multiply per
 //           attribute at a row start, then steps of LanesPerTri*didx, and lane i adds i*didx
 //           (shifts and adds, i < 8), so every mode gives at each pixel exactly the plane's value.
@@ -66,7 +70,8 @@ module shd_span_unit #(
   parameter integer RemBits     = 27,
   parameter integer PixBits     = 12,
   parameter integer TagBits     = 32,
-  parameter integer RowAhead    = 0
+  parameter integer RowAhead    = 0,
+  parameter integer Interleave  = 0
 ) (
   input  wire                                  clk_i,
   input  wire                                  rst_ni,
@@ -80,6 +85,7 @@ module shd_span_unit #(
   input  wire [NumAttr*AttrBits-1:0]           desc_iref_i,
   input  wire [NumAttr*AttrBits-1:0]           desc_didx_i,
   input  wire [NumAttr*AttrBits-1:0]           desc_didy_i,
+  input  wire                                  desc_interleave_i,
   input  wire [NumTri*CoordBits-1:0]           lt_row_first_i,
   input  wire [NumTri*CoordBits-1:0]           lt_row_last_i,
   input  wire [NumTri*CoordBits-1:0]           lt_clip_x0_i,
@@ -117,7 +123,9 @@ module shd_span_unit #(
   localparam integer PXW   = (PixBits >= C + 2) ? PixBits + 1 : C + 2;
   localparam integer MW    = A + C + 1;                  // didx*(xg - xref), natural width
   // A descriptor as one word, in the order the walker loads it (the full-rate unit's queue).
-  localparam integer DW    = TagBits + 3*C + 3*AV + NumTri*(6*C + 1 + AV) + NE*(1 + 4*C + 3*R);
+  localparam integer DW    = TagBits + 3*C + 3*AV + 1 + NumTri*(6*C + 1 + AV) + NE*(1 + 4*C + 3*R);
+  // Interleaving descriptors: walker row w is screen row NumTri*w + oy, a shift by LOG2T.
+  localparam integer LOG2T = (NumTri >= 4) ? 2 : 0;
 
   // The most negative / positive C+1-bit and C-bit values: empty min/max reductions give them.
   localparam [C:0]   EXT_MIN    = {1'b1, {C{1'b0}}};
@@ -133,6 +141,7 @@ module shd_span_unit #(
   reg  [C-1:0]           xref_q;
   reg  [AV-1:0]          didx_q;
   reg  [AV-1:0]          didy_q;
+  reg                    ilv_q;     // the descriptor interleaves rows (0 unless Interleave)
   reg  [NumTri*C-1:0]    lt_row_first_q;
   reg  [NumTri*C-1:0]    lt_row_last_q;
   reg  [NumTri*C-1:0]    lt_clip_x0_q;
@@ -178,6 +187,7 @@ module shd_span_unit #(
   wire [NumTri*C-1:0]    em_ox;
   wire [NumTri*C-1:0]    em_oy;
   wire [NumTri-1:0]      em_flip;
+  wire                   em_ilv;
   wire [NumTri*AV-1:0]   em_aoff;
 
   // ---------------------------------------------------------------- control, shared
@@ -192,6 +202,9 @@ module shd_span_unit #(
   wire          span_done;  // the lane group shown is its row's last
   wire          span_adv = !out_valid_o || out_ready_i;  // the lane group shown leaves (or is empty)
 
+  // The interleave bit counts only in a unit built for it: 0 otherwise (synthesis drops it).
+  wire ilv_in = (Interleave != 0) && desc_interleave_i;
+
   // Taking a descriptor loads the descriptor registers and starts the walker at row_first with
   // iref and every edge's (q0, r0); f_step steps the walker. The ports are concatenated here,
   // in the clocked block, and not in a wire: a simulator then reads them only when a descriptor
@@ -201,14 +214,14 @@ module shd_span_unit #(
   always @(posedge clk_i) begin
     if (f_load) begin
       if (f_from_q)
-        {tag_q, row_last_q, xref_q, didx_q, didy_q, lt_row_first_q, lt_row_last_q, lt_clip_x0_q,
+        {tag_q, row_last_q, xref_q, didx_q, didy_q, ilv_q, lt_row_first_q, lt_row_last_q, lt_clip_x0_q,
          lt_clip_x1_q, lt_ox_q, lt_oy_q, lt_flip_q, lt_aoff_q, e_right_q, e_row_first_q,
          e_row_last_q, e_k_q, e_div_q, e_m_q, w_q, irow_q, quo_q, rem_q} <= q_word;
       else
-        {tag_q, row_last_q, xref_q, didx_q, didy_q, lt_row_first_q, lt_row_last_q, lt_clip_x0_q,
+        {tag_q, row_last_q, xref_q, didx_q, didy_q, ilv_q, lt_row_first_q, lt_row_last_q, lt_clip_x0_q,
          lt_clip_x1_q, lt_ox_q, lt_oy_q, lt_flip_q, lt_aoff_q, e_right_q, e_row_first_q,
          e_row_last_q, e_k_q, e_div_q, e_m_q, w_q, irow_q, quo_q, rem_q} <=
-        {desc_tag_i, desc_row_last_i, desc_xref_i, desc_didx_i, desc_didy_i, lt_row_first_i,
+        {desc_tag_i, desc_row_last_i, desc_xref_i, desc_didx_i, desc_didy_i, ilv_in, lt_row_first_i,
          lt_row_last_i, lt_clip_x0_i, lt_clip_x1_i, lt_ox_i, lt_oy_i, lt_flip_i, lt_aoff_i,
          e_right_i, e_row_first_i, e_row_last_i, e_k_i, e_div_i, e_m_i, desc_row_first_i,
          desc_iref_i, e_q_i, e_r_i};
@@ -422,11 +435,12 @@ module shd_span_unit #(
                                 && ($signed({lo_l[C-1], lo_l}) <= x_i)
                                 && (x_i <= $signed({hi_l[C-1], hi_l}));
 
-        // flip: (ox - x, oy - wspan); else (x + ox, wspan + oy); exact, low PixBits kept.
+        // flip: (ox - x, oy - y); else (x + ox, y + oy), y = wspan, or NumTri*wspan for an
+        // interleaving descriptor; the low PixBits kept (exact below them).
         wire [PXW-1:0] x_p  = {{(PXW-C-1){x_i[C]}}, x_i};
         wire [PXW-1:0] ox_p = {{(PXW-C){ox_l[C-1]}}, ox_l};
         wire [PXW-1:0] oy_p = {{(PXW-C){oy_l[C-1]}}, oy_l};
-        wire [PXW-1:0] w_p  = {{(PXW-C){wspan_q[C-1]}}, wspan_q};
+        wire [PXW-1:0] w_p  = {{(PXW-C){wspan_q[C-1]}}, wspan_q} << (em_ilv ? LOG2T : 0);
         wire [PXW-1:0] px   = flip ? ox_p - x_p : x_p + ox_p;
         wire [PXW-1:0] py   = flip ? oy_p - w_p : w_p + oy_p;
         assign out_x_o[LN*PixBits +: PixBits] = px[PixBits-1:0];
@@ -522,12 +536,13 @@ module shd_span_unit #(
       assign em_ox        = lt_ox_q;
       assign em_oy        = lt_oy_q;
       assign em_flip      = lt_flip_q;
+      assign em_ilv       = ilv_q;
       assign em_aoff      = lt_aoff_q;
     end else begin : g_ahead
       // The full-rate unit: F (the walker) forms a row per busy cycle into B or straight into
       // E; E shows its row's lane groups; Q holds the next descriptor.
-      // A row: {ne, lo, hi, xe, xg0, wspan, icur0, map}, map = {tag, didx, ox, oy, flip, aoff}.
-      localparam integer MAPW = TagBits + AV + NumTri*(2*C + 1 + AV);
+      // A row: {ne, lo, hi, xe, xg0, wspan, icur0, map}, map = {tag, didx, ilv, ox, oy, flip, aoff}.
+      localparam integer MAPW = TagBits + AV + 1 + NumTri*(2*C + 1 + AV);
       localparam integer RW   = NumTri*(1 + 2*C) + 3*C + AV + MAPW;
       reg             f_busy_q, q_valid_q, b_valid_q, e_valid_q;
       reg             f_held_q;  // F stalled in the last cycle: its row has pixels, B is full
@@ -573,7 +588,7 @@ module shd_span_unit #(
 
       always @(posedge clk_i) begin
         if (accept && !f_takes)
-          qd_q <= {desc_tag_i, desc_row_last_i, desc_xref_i, desc_didx_i, desc_didy_i,
+          qd_q <= {desc_tag_i, desc_row_last_i, desc_xref_i, desc_didx_i, desc_didy_i, ilv_in,
                    lt_row_first_i, lt_row_last_i, lt_clip_x0_i, lt_clip_x1_i, lt_ox_i, lt_oy_i,
                    lt_flip_i, lt_aoff_i, e_right_i, e_row_first_i, e_row_last_i, e_k_i, e_div_i,
                    e_m_i, desc_row_first_i, desc_iref_i, e_q_i, e_r_i};
@@ -583,16 +598,16 @@ module shd_span_unit #(
         // F's row, concatenated here and not in a wire (a simulator then builds it only when
         // it is loaded; the hardware is the same).
         if (f_puts)
-          b_q <= {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q, lt_ox_q, lt_oy_q, lt_flip_q,
-                  lt_aoff_q};
+          b_q <= {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q, ilv_q, lt_ox_q, lt_oy_q,
+                  lt_flip_q, lt_aoff_q};
       end
 
       always @(posedge clk_i) begin
         if (e_load) begin
           if (take_b) {ne_q, lo_q, hi_q, xe_q, xg_q, wspan_q, icur_q, em_q} <= b_q;
           else        {ne_q, lo_q, hi_q, xe_q, xg_q, wspan_q, icur_q, em_q} <=
-                      {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q, lt_ox_q, lt_oy_q,
-                       lt_flip_q, lt_aoff_q};
+                      {ne_d, lo_d, hi_d, xe_r, xg_row, w_q, icur_row, tag_q, didx_q, ilv_q, lt_ox_q,
+                       lt_oy_q, lt_flip_q, lt_aoff_q};
         end else if (e_step) begin
           xg_q   <= xg_next[C-1:0];
           icur_q <= icur_step;
@@ -606,7 +621,7 @@ module shd_span_unit #(
       assign form_en      = f_busy_q && !f_skip;
       assign show         = e_valid_q;
       assign desc_ready_o = !q_valid_q;
-      assign {em_tag, em_didx, em_ox, em_oy, em_flip, em_aoff} = em_q;
+      assign {em_tag, em_didx, em_ilv, em_ox, em_oy, em_flip, em_aoff} = em_q;
     end
   endgenerate
 

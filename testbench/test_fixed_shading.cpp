@@ -393,12 +393,13 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   EXPECT_GT(stops, 500u);
 }
 
-// fixed_simd::colourRun against the flat/Gouraud run loop, pixel by pixel: runs of 1 to 40
-// pixels from every start offset, over depth buffers holding codes above, below and equal to
-// the run's (and 0), with colour codes below 0, within [0, 255 2^frac] and above (the clamp),
-// for fraction bits 1 to 23. The pixels that fail the z-test keep their depth, tag and colour.
-TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
-  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR set): the scalar path runs";
+// The colour-run kernels (fixed_simd::colourRunAvx512, colourRunAvx2) against the flat/Gouraud
+// run loop, pixel by pixel: runs of 1 to 40 pixels from every start offset, over depth buffers
+// holding codes above, below and equal to the run's (and 0), with colour codes below 0, within
+// [0, 255 2^frac] and above (the clamp), for fraction bits 1 to 23. The pixels that fail the z-test keep their depth, tag and colour,
+// and no other byte changes (the AVX2 kernel's blends: the room to the row's end is the
+// buffer's, the run's own or none, at random).
+static void checkColourKernel(const char* name, fixed_simd::ColourKernel kernel) {
   std::mt19937_64 rng(22);
   uint64_t fragments = 0, passed = 0, clamped = 0;
   for (int t = 0; t < 20000; ++t) {
@@ -437,18 +438,25 @@ TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
       }
       ++passed;
     }
+    r.room = std::array<size_t, 3>{kRunBuffer - r.px.p, r.px.count, 0}[rng() % 3];
     const fixed_simd::Target target{depth.data(), tri.data(), 9, kRunWidth};
     uint64_t got_passed = 0;
-    const uint64_t fresh = fixed_simd::colourRun(r, target, rgb.data(), got_passed);
-    ASSERT_EQ(depth, want_depth) << "run " << t;
-    ASSERT_EQ(tri, want_tri) << "run " << t;
+    const uint64_t fresh = kernel(r, target, rgb.data(), got_passed);
+    ASSERT_EQ(depth, want_depth) << name << " run " << t;
+    ASSERT_EQ(tri, want_tri) << name << " run " << t;
     for (size_t i = 0; i < rgb.size(); ++i)
-      ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << "run " << t << " frac " << r.frac << " byte " << i;
-    ASSERT_EQ(fresh, want_fresh) << "run " << t;
-    ASSERT_EQ(got_passed, want_passed) << "run " << t;
+      ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << name << " run " << t << " frac " << r.frac << " byte " << i;
+    ASSERT_EQ(fresh, want_fresh) << name << " run " << t;
+    ASSERT_EQ(got_passed, want_passed) << name << " run " << t;
     fragments += r.px.count;
   }
   EXPECT_GT(passed, fragments / 4);
   EXPECT_LT(passed, fragments * 3 / 4);
   EXPECT_GT(clamped, passed / 10);
+}
+
+TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
+  if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
+  if (fixed_simd::cpuHasAvx512()) checkColourKernel("AVX-512", fixed_simd::colourRunAvx512);
+  if (fixed_simd::cpuHasAvx2()) checkColourKernel("AVX2", fixed_simd::colourRunAvx2);
 }

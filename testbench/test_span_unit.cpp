@@ -710,14 +710,19 @@ Streamed streamThrough(const SpanParams& p, const std::vector<SpanDesc>& descs, 
 // descriptor alone: the same fragments in the same order, the same rows and lane groups, never
 // more cycles; and the walker equal to its cycle model, cycles included.
 TEST(SpanUnitModel, FullRateUnitGivesThePapersFragments) {
-  // The registry holds each lane mode as both units: <mode>full is <mode> with RowAhead 1.
+  // The registry holds each lane mode as both units: <mode>full is <mode> with RowAhead 1, and
+  // with Interleave 1 where it has four lane-triangles (BalancedSierpinski... below; given the
+  // paper's descriptors here, which do not interleave).
   for (const std::string& m : spanModes()) {
     if (spanParams(m).RowAhead) {
       EXPECT_EQ(m.substr(m.size() - 4), "full");
     }
   }
   for (const std::string& m : paperSpanModes()) {
-    ASSERT_EQ(spanParams(m + "full").toJson(), fullRate(m).toJson()) << m;
+    SpanParams registered = spanParams(m + "full");
+    EXPECT_EQ(registered.Interleave, registered.NumTri == 4 ? 1 : 0) << m;
+    registered.Interleave = 0;
+    ASSERT_EQ(registered.toJson(), fullRate(m).toJson()) << m;
     const SpanParams paper_p = spanParams(m), full_p = fullRate(m);
     SpanUnitModel paper(paper_p), full(full_p);
     SpanRun a, b;
@@ -783,4 +788,72 @@ TEST(SpanUnitModel, FullRateStreamKeepsItsTiming) {
                 static_cast<double>(fast.cycles) / static_cast<double>(paper_cycles), static_cast<unsigned long long>(groups),
                 static_cast<double>(fast.cycles) / static_cast<double>(groups));
   }
+}
+
+// The balanced Sierpinski unit (sierpinskifull, Interleave 1): setup chooses per triangle between
+// the 4-way split and the row interleave. On generator triangles of every size class: both
+// occur; the choice never takes more cycles than the split (each descriptor alone, the cycle
+// model's count); an interleaving descriptor's lane j shows only the screen rows 4 w + j, and
+// its fragments are the serial unit's, pixel for pixel and code for code, as a set (each lane
+// in row order, the rows' lane groups in x order: the unit's order, checked against the walker
+// in EveryModeEqualsSerialOnGeneratorTriangles).
+TEST(SpanUnitModel, BalancedSierpinskiNeverTakesMoreCyclesThanTheSplit) {
+  const SpanParams bal = spanParams("sierpinskifull");
+  ASSERT_EQ(bal.Interleave, 1);
+  SpanParams split = bal;
+  split.Interleave = 0;
+  RasterConfig cb, cs, c1;  // 512 x 512
+  cb.unit = bal;
+  cs.unit = split;
+  c1.unit = spanParams("serial");
+  SpanUnitModel ub(bal), us(split), u1(c1.unit);
+  TriangleGenerator gen(41);
+  SpanRun rb, rs, r1;
+  uint64_t interleaved = 0, drawn = 0, cyc_b = 0, cyc_s = 0;
+  for (int n = 0; n < 30000; ++n) {
+    const GenTriangle t = gen.next();
+    const auto v = toSetupVertices(t, bal.NumAttr);
+    const SetupResult sb = setupTriangle(v, t.id, cb), ss = setupTriangle(v, t.id, cs), s1 = setupTriangle(v, t.id, c1);
+    ASSERT_EQ(sb.desc.has_value(), ss.desc.has_value()) << describe(t);
+    if (!sb.desc) continue;
+    ASSERT_FALSE(ss.desc->interleave);
+    ++drawn;
+    runSpanUnit(ub, *sb.desc, rb);
+    runSpanUnit(us, *ss.desc, rs);
+    runSpanUnit(u1, *s1.desc, r1);
+    ASSERT_LE(rb.cycles, rs.cycles) << describe(t);
+    cyc_b += rb.cycles;
+    cyc_s += rs.cycles;
+    if (!sb.desc->interleave) {
+      ASSERT_EQ(rb.cycles, rs.cycles) << describe(t);
+      continue;
+    }
+    ++interleaved;
+    ASSERT_LT(rb.cycles, rs.cycles) << "interleaved on a tie, " << describe(t);
+    const std::vector<SpanFragment> a = sorted(rb.fragments), b = sorted(r1.fragments);
+    ASSERT_EQ(a.size(), b.size()) << describe(t);
+    for (size_t i = 0; i < a.size(); ++i)
+      ASSERT_TRUE(sameFragment(a[i], b[i])) << "fragment " << i << ", " << describe(t);
+    // Lane j's fragments lie on the rows 4 w + j: in the model's outputs, cycle by cycle.
+    SpanUnitModel m(bal);
+    SpanIn in;
+    in.desc_valid = true;
+    in.desc = &*sb.desc;
+    SpanOut o;
+    do {
+      m.tick(in, o);
+      in.desc_valid = false;
+      for (size_t j = 0; j < o.lane.size(); ++j) {
+        if (o.lane[j].valid) {
+          ASSERT_EQ(o.lane[j].y % 4, static_cast<int32_t>(j)) << describe(t);
+        }
+      }
+    } while (!m.idle());
+  }
+  EXPECT_GT(interleaved, drawn / 20);
+  EXPECT_LT(interleaved, drawn);
+  std::printf("%llu of %llu triangles interleaved; each alone %llu cycles against the split's %llu (%.3fx)\n",
+              static_cast<unsigned long long>(interleaved), static_cast<unsigned long long>(drawn),
+              static_cast<unsigned long long>(cyc_b), static_cast<unsigned long long>(cyc_s),
+              static_cast<double>(cyc_b) / static_cast<double>(cyc_s));
 }

@@ -4,6 +4,7 @@
 
 #include "test_util.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <set>
 #include <fstream>
@@ -148,6 +149,14 @@ TEST(VectorFile, CheckedInSpanFilesCoverTheDirectedPhasesAndTheControlCorners) {
     EXPECT_GT(idle_gap, 10u) << mode;   // the unit idle with nothing offered
     if (v.params.NumTri > 1) {
       EXPECT_GT(empty_stalled, 0u) << mode;  // a lane group without a valid lane, out_ready low
+    }
+    // A unit that may interleave rows gets descriptors of both assignments.
+    const auto interleaved = std::count_if(v.descs.begin(), v.descs.end(), [](const SpanDesc& d) { return d.interleave; });
+    if (v.params.Interleave) {
+      EXPECT_GT(interleaved, 10) << mode;
+      EXPECT_LT(interleaved, static_cast<long>(v.descs.size()) - 10) << mode;
+    } else {
+      EXPECT_EQ(interleaved, 0) << mode;
     }
   }
 }

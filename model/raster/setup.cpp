@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -30,17 +32,19 @@ int64_t snapHalfEven(double v, int frac) {
 
 bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }
 
-int64_t floorDiv(i128 a, i128 b) {  // b > 0
-  if (fitsI64(a) && fitsI64(b)) {  // the common case, without the slow 128-bit division
-    const int64_t a64 = static_cast<int64_t>(a), b64 = static_cast<int64_t>(b);
-    const int64_t q = a64 / b64;
-    return q - static_cast<int64_t>(((a64 % b64) != 0) & (a64 < 0));  // without a branch, as roundHalfEvenFrom
-  }
+__attribute__((noinline)) int64_t floorDivWide(i128 a, i128 b) {
   i128 q = a / b;
   if ((a % b) != 0 && a < 0) --q;
   return static_cast<int64_t>(q);
 }
-int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
+// b > 0. Inlined: the common case is one 64-bit division, the 128-bit one out of line.
+[[gnu::always_inline]] inline int64_t floorDiv(i128 a, i128 b) {
+  if (!fitsI64(a) || !fitsI64(b)) return floorDivWide(a, b);
+  const int64_t a64 = static_cast<int64_t>(a), b64 = static_cast<int64_t>(b);
+  const int64_t q = a64 / b64;
+  return q - static_cast<int64_t>(((a64 % b64) != 0) & (a64 < 0));  // without a branch, as roundHalfEvenFrom
+}
+[[gnu::always_inline]] inline int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
 
 // round-half-even(num / den) from the truncated quotient q and remainder r of num / den
 // (|r| < den, den > 0): floor first, then up when the remainder is above half, or exactly half
@@ -211,16 +215,23 @@ void trimEmptyRows(SpanLaneTri& t, const SpanParams& p) {
   t.row_last = static_cast<int32_t>(r1);
 }
 
-// Appends the lane-triangle of g to `lanes` (built in place). False when no pixel centre row
-// and column of its bounding box lies in the viewport (then it has no rows).
+// Appends the lane-triangle of g to `lanes` (built in place). g is given in a frame whose pixel
+// (x, y) is screen pixel (x + ox, y + oy), or (ox - x, oy - y) when flipped; the walker row w is
+// the frame's row stride w + phase (stride 1, phase 0 but for interleaved rows). False when no
+// pixel centre row and column of its bounding box lies in the viewport (then it has no rows).
 bool buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, bool flip, int64_t ox, int64_t oy,
-                  const RasterConfig& cfg) {
+                  const RasterConfig& cfg, int64_t stride = 1, int64_t phase = 0) {
   const int S = cfg.subpixel_bits;
   const SpanParams& p = cfg.unit;
   SpanLaneTri& t = lanes.emplace_back();
   t.flip = flip;
   t.ox = static_cast<int32_t>(ox);
-  t.oy = static_cast<int32_t>(oy);
+  t.oy = static_cast<int32_t>(oy + phase);
+  // The walker rows of the frame rows [a, b].
+  auto walkerRows = [&](int64_t a, int64_t b) -> std::pair<int64_t, int64_t> {
+    if (stride == 1) return {a, b};
+    return {ceilDiv(a - phase, stride), floorDiv(b - phase, stride)};
+  };
   // Rows: pixel centres within the vertical extent, then the horizontal edge, then the viewport.
   auto [r0, r1] = centreRows(*std::min_element(g.yu.begin(), g.yu.end()), *std::max_element(g.yu.begin(), g.yu.end()), S);
   for (const EdgeFunction& e : g.e) {
@@ -243,6 +254,9 @@ bool buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
   // Columns the same way: a triangle wholly left or right of the viewport has no pixel in it.
   const auto [c0, c1] = centreRows(*std::min_element(g.xu.begin(), g.xu.end()), *std::max_element(g.xu.begin(), g.xu.end()), S);
   if (r0 > r1 || c1 < t.clip_x0 || c0 > t.clip_x1) return false;  // no rows: row_first > row_last
+  const int64_t f0 = r0, f1 = r1;  // frame rows
+  std::tie(r0, r1) = walkerRows(r0, r1);
+  if (r0 > r1) return true;  // interleaved: none of the rows is this lane-triangle's
   requireCoord(r0, p, "lane-triangle first row");
   requireCoord(r1, p, "lane-triangle last row");
   t.row_first = static_cast<int32_t>(r0);
@@ -253,24 +267,26 @@ bool buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
     if (e.A == 0) continue;
     const size_t a = static_cast<size_t>(s), b = static_cast<size_t>((s + 1) % 3);
     auto [ea, eb] = centreRows(std::min(g.yu[a], g.yu[b]), std::max(g.yu[a], g.yu[b]), S);
-    ea = std::max(ea, r0);
-    eb = std::min(eb, r1);
+    std::tie(ea, eb) = walkerRows(std::max(ea, f0), std::min(eb, f1));
     SpanEdge& d = t.edge[slot++];
     if (ea > eb) continue;  // never active: stays an unused slot
     d.row_first = static_cast<int32_t>(ea);
     d.row_last = static_cast<int32_t>(eb);
     d.right = e.A < 0;
     const int64_t D = e.A < 0 ? -e.A : e.A;
-    const i128 N = -(static_cast<i128>(e.B) * ea + e.C);  // x >= N/D (left), x <= -N/D (right)
+    // In the walker frame: E = A x + B (stride w + phase) + C (stride 1: the frame's own).
+    const i128 B = stride == 1 ? e.B : static_cast<i128>(e.B) * stride;
+    const i128 C = stride == 1 ? e.C : e.C + static_cast<i128>(e.B) * phase;
+    const i128 N = -(B * ea + C);  // x >= N/D (left), x <= -N/D (right)
     const int64_t q = ceilDiv(N, D);
     d.q = static_cast<int32_t>(q);
     d.r = static_cast<int64_t>(static_cast<i128>(q) * D - N);
     d.div = D;
     if (eb > ea) {  // the DDA steps: -B = k D + m
-      const int64_t k = floorDiv(-static_cast<i128>(e.B), D);
+      const int64_t k = floorDiv(-B, D);
       requireCoord(k, p, "edge DDA step k");
       d.k = static_cast<int32_t>(k);
-      d.m = static_cast<int64_t>(-static_cast<i128>(e.B) - static_cast<i128>(k) * D);
+      d.m = static_cast<int64_t>(-B - static_cast<i128>(k) * D);
     }
     // While active the bound lies within the edge's horizontal extent (+-1): it fits.
     requireCoord(q, p, "edge DDA quotient");
@@ -279,6 +295,39 @@ bool buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
   }
   trimEmptyRows(t, p);
   return true;
+}
+
+// The cycles the unit takes for a descriptor of these lane-triangles alone, out_ready always 1:
+// the paper's unit an IDLE cycle, a ROW cycle per walker row and the lane groups; the full-rate
+// unit as SpanStream counts them. What setup compares to choose the lanes' assignment.
+uint64_t laneCycles(const InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const SpanParams& p) {
+  int64_t w0 = 0, w1 = -1;
+  bool any = false;
+  std::array<SpanDdaState, kMaxLaneTri * 3> e{};
+  for (size_t j = 0; j < lanes.size(); ++j) {
+    const SpanLaneTri& t = lanes[j];
+    for (size_t s = 0; s < 3; ++s) e[j * 3 + s] = {t.edge[s].q, t.edge[s].r};
+    if (t.row_first > t.row_last) continue;
+    w0 = any ? std::min<int64_t>(w0, t.row_first) : t.row_first;
+    w1 = any ? std::max<int64_t>(w1, t.row_last) : t.row_last;
+    any = true;
+  }
+  const int T = static_cast<int>(lanes.size()), L = p.LanesPerTri;
+  std::array<int64_t, kMaxLaneTri> lo{}, hi{};
+  std::array<bool, kMaxLaneTri> ne{};
+  SpanStream stream;
+  uint64_t paper = 1;
+  for (int64_t w = w0; w <= w1; ++w) {
+    int64_t xs = 0, xe = 0;
+    uint64_t groups = 0;
+    if (span_detail::unionRowBounds(lanes.data(), T, w, e.data(), lo.data(), hi.data(), ne.data(), xs, xe)) {
+      groups = static_cast<uint64_t>((xe - span_detail::firstGroup(p, xs)) / L + 1);
+    }
+    stream.row(groups);
+    paper += 1 + groups;
+    for (int j = 0; j < T; ++j) span_detail::stepEdges(lanes[static_cast<size_t>(j)], w, &e[static_cast<size_t>(j) * 3], p.CoordBits);
+  }
+  return p.RowAhead ? stream.end() : paper;
 }
 
 }  // namespace
@@ -422,6 +471,19 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
     boxed = buildLaneTri(lanes, translated(g1, t1x, t1y, S), false, t1x, t1y, cfg) || boxed;
     boxed = buildLaneTri(lanes, translated(g2, t2x, t2y, S), false, t2x, t2y, cfg) || boxed;
     boxed = buildLaneTri(lanes, reflected(g3, ox, oy, S), true, ox, oy, cfg) || boxed;
+    if (p.Interleave && boxed) {
+      // Rows interleaved instead: lane-triangle j takes the screen rows NumTri w + j. The
+      // split's four sub-triangles share the walker, so its cycles follow the widest of them
+      // and, on a triangle the viewport clips, the lanes whose sub-triangle is off screen idle;
+      // four adjacent rows of a triangle instead leave together, but span more columns than one
+      // when the edges slope. The one with fewer cycles is kept (the split on a tie).
+      InlineVec<SpanLaneTri, kMaxLaneTri> rows;
+      for (int j = 0; j < p.NumTri; ++j) buildLaneTri(rows, whole, false, 0, 0, cfg, p.NumTri, j);
+      if (laneCycles(rows, p) < laneCycles(lanes, p)) {
+        lanes = rows;
+        d.interleave = true;
+      }
+    }
   }
   int64_t row_first = 0, row_last = -1;
   bool any = false;
@@ -441,13 +503,16 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   d.row_last = static_cast<int32_t>(row_last);
   d.xref = static_cast<int32_t>(pl.xref);
   auto wrap = [&](i128 x) { return span_detail::wrapTo(static_cast<uint64_t>(x), p.AttrBits); };  // mod 2^AttrBits
+  // The walker plane I_w(x, w) is the screen plane at (x, ystride w).
+  const int64_t ystride = d.interleave ? p.NumTri : 1;
   for (int k = 0; k < K; ++k) {
-    d.iref.push_back(wrap(pl.at(k, d.xref, d.row_first)));
+    d.iref.push_back(wrap(pl.at(k, d.xref, ystride * d.row_first)));
     d.didx.push_back(wrap(pl.didx[static_cast<size_t>(k)]));
-    d.didy.push_back(wrap(pl.didy[static_cast<size_t>(k)]));
+    d.didy.push_back(wrap(static_cast<i128>(pl.didy[static_cast<size_t>(k)]) * ystride));
   }
   for (SpanLaneTri& l : lanes) {
-    // Lane attribute = I_w + aoff, or aoff - I_w when flipped, with I_w the walker (screen) plane.
+    // Lane attribute = I_w + aoff, or aoff - I_w when flipped, with I_w the walker plane: the
+    // lane's pixel (x + ox, ystride w + oy) has the value I_w(x, w) + didx ox + didy oy.
     for (int k = 0; k < K; ++k) {
       const i128 dx = pl.didx[static_cast<size_t>(k)], dy = pl.didy[static_cast<size_t>(k)];
       l.aoff.push_back(l.flip ? wrap(static_cast<i128>(pl.at(k, 0, 0)) + pl.at(k, l.ox, l.oy))

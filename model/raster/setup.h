@@ -27,6 +27,12 @@
 //   without a pixel at either end; a triangle whose box holds centres but that covers none (a
 //   sliver passing between them) is dropped as well ("no pixel centre inside it").
 //
+// Lane-triangles (NumTri 4): the triangle split at its edge midpoints (raster/span_unit.h). With
+//   Interleave 1 setup also builds the row interleave (lane-triangle j: the whole triangle on
+//   the screen rows 4 w + j) and keeps the one the unit takes fewer cycles for, alone (the
+//   split on a tie): the interleave wins where the split leaves lanes idle (a sub-triangle off
+//   screen or without pixels) or walks the widest sub-triangle's rows for all four.
+//
 // Attribute planes (the corrected 4.1 of docs/paper-corrections.md: the plane gradient with det as denominator)
 //   Vertex attribute k is quantised to a code a_i = round(value * 2^F_k) (F_k = attr_frac_bits).
 //   The gradients per pixel are the exact rationals

@@ -28,6 +28,8 @@ void SpanParams::validate() const {
   need(PixBits >= 1 && PixBits < CoordBits, "PixBits", PixBits, "must be in 1..CoordBits-1");
   need(TagBits >= 1 && TagBits <= 32, "TagBits", TagBits, "must be in 1..32");
   need(RowAhead == 0 || RowAhead == 1, "RowAhead", RowAhead, "must be 0 or 1");
+  need(Interleave == 0 || (Interleave == 1 && NumTri == 4), "Interleave", Interleave,
+       "must be 0, or 1 with NumTri 4 (rows interleaved over the four lane-triangles)");
 }
 
 namespace {
@@ -38,7 +40,8 @@ constexpr ParamMember<SpanParams> kSpanMembers[] = {
     {"AlignLanes", &SpanParams::AlignLanes}, {"NumAttr", &SpanParams::NumAttr},
     {"AttrBits", &SpanParams::AttrBits},     {"CoordBits", &SpanParams::CoordBits},
     {"RemBits", &SpanParams::RemBits},       {"PixBits", &SpanParams::PixBits},
-    {"TagBits", &SpanParams::TagBits},       {"RowAhead", &SpanParams::RowAhead, true}};
+    {"TagBits", &SpanParams::TagBits},       {"RowAhead", &SpanParams::RowAhead, true},
+    {"Interleave", &SpanParams::Interleave, true}};
 
 }  // namespace
 
@@ -115,25 +118,11 @@ void SpanUnitModel::tick(const SpanIn& in, SpanOut& out) {
 
 bool SpanUnitModel::formRow(RowRec& r) const {
   const SpanDesc& d = slot_[f_slot_];
-  const int L = p_.LanesPerTri;
-  bool any = false;
   int64_t xs = 0, xe = 0;
-  for (int j = 0; j < p_.NumTri; ++j) {
-    const size_t ju = static_cast<size_t>(j);
-    int64_t lo = 0, hi = 0;
-    const bool ne = laneRowBounds(d.tri[ju], w_, &e_[ju * 3], lo, hi);
-    r.lo[ju] = lo;
-    r.hi[ju] = hi;
-    r.ne[ju] = ne;
-    if (ne) {
-      xs = any ? std::min(xs, lo) : lo;
-      xe = any ? std::max(xe, hi) : hi;
-      any = true;
-    }
-  }
-  if (!any) return false;
+  if (!unionRowBounds(d.tri.data(), p_.NumTri, w_, e_.data(), r.lo.data(), r.hi.data(), r.ne.data(), xs, xe))
+    return false;
   r.xe = xe;
-  r.xg0 = p_.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+  r.xg0 = firstGroup(p_, xs);
   for (int a = 0; a < p_.NumAttr; ++a) {
     const size_t ai = static_cast<size_t>(a);
     r.icur0[ai] = wrapAttr(u(irow_[ai]) + u(d.didx[ai]) * u(r.xg0 - d.xref));

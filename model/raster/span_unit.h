@@ -23,11 +23,17 @@
 //                 (the paper's "cut points") every lane still covers exactly its own pixels.
 //   Any product of the two works (NumTri 4 with LanesPerTri 2: each sub-triangle in segments
 //   of two): setup splits by NumTri, the walker shows LanesPerTri columns per lane-triangle.
+//   Interleave = 1 (NumTri 4): a descriptor may instead interleave rows (its `interleave` bit):
+//   lane-triangle j is the whole triangle on the screen rows NumTri*w + j, so four adjacent
+//   rows leave together; the walker frame is the screen squeezed NumTri times vertically, and
+//   each lane-triangle's edges are exact in it (E = A x + NumTri B w + C + B j). Setup chooses,
+//   per triangle, the assignment with fewer cycles (raster/setup.h).
 //   Every lane reads the same walker attribute plane: I_w(x, w) = iref + didx*(x - xref)
 //   + didy*(w - row_first), exact integer (two's complement) arithmetic on attribute codes. A
-//   lane's fragment at walker (x, w) has
-//       flip = 0:  pixel (x + ox, w + oy),  attribute I_w(x, w) + aoff
-//       flip = 1:  pixel (ox - x, oy - w),  attribute aoff - I_w(x, w)
+//   lane's fragment at walker (x, w) has, with y = NumTri*w for a descriptor that interleaves
+//   rows and y = w otherwise,
+//       flip = 0:  pixel (x + ox, y + oy),  attribute I_w(x, w) + aoff
+//       flip = 1:  pixel (ox - x, oy - y),  attribute aoff - I_w(x, w)
 //   Because all of it is exact integer arithmetic on one plane, every mode produces, pixel by
 //   pixel, the code the plane equation gives there: bit-identical across modes by construction
 //   (and test_span_unit checks it).
@@ -139,6 +145,9 @@ struct SpanParams {
   // full-rate unit (rows formed ahead into a row register, the next descriptor queued). May be
   // left out of a configuration's "rtl" object: 0, the Verilog default.
   int RowAhead = 0;
+  // 0: every descriptor's lane-triangles share the walker's rows (the split); 1 (NumTri 4): a
+  // descriptor may interleave rows (SpanDesc::interleave). May be left out: 0.
+  int Interleave = 0;
 
   int lanes() const { return NumTri * LanesPerTri; }
   void validate() const;  // std::invalid_argument naming the parameter
@@ -181,6 +190,7 @@ struct SpanDesc {
   // otherwise walk until w wraps.
   int32_t row_first = 0, row_last = -1;
   int32_t xref = 0;                      // iref is the plane at (xref, row_first)
+  bool interleave = false;               // walker row w is screen row NumTri*w + oy (Interleave 1)
   AttrVec iref, didx, didy;                  // NumAttr each
   InlineVec<SpanLaneTri, kMaxLaneTri> tri;  // NumTri
 };

@@ -40,6 +40,29 @@ inline uint64_t u(int64_t v) { return static_cast<uint64_t>(v); }
   return t.row_first <= w && w <= t.row_last && lo <= hi;
 }
 
+// The first lane group's column of a row whose span starts at xs: xs, or with AlignLanes the
+// column below it that is a multiple of LanesPerTri (floor modulo).
+inline int64_t firstGroup(const SpanParams& p, int64_t xs) {
+  const int L = p.LanesPerTri;
+  return p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+}
+
+// The ROW cycle over every lane-triangle (T of them, edges e[3 j + s]): each one's [lo, hi]
+// and ne, and the union [xs, xe] of the non-empty ones; returns whether there is one.
+[[gnu::always_inline]] inline bool unionRowBounds(const SpanLaneTri* tri, int T, int64_t w, const SpanDdaState* e,
+                                                  int64_t* lo, int64_t* hi, bool* ne, int64_t& xs, int64_t& xe) {
+  bool any = false;
+  for (int j = 0; j < T; ++j) {
+    const size_t ju = static_cast<size_t>(j);
+    ne[ju] = laneRowBounds(tri[ju], w, &e[ju * 3], lo[ju], hi[ju]);
+    if (!ne[ju]) continue;
+    xs = any ? std::min(xs, lo[ju]) : lo[ju];
+    xe = any ? std::max(xe, hi[ju]) : hi[ju];
+    any = true;
+  }
+  return any;
+}
+
 // The ROW cycle's register update of one lane-triangle's edges: the DDA step of every edge
 // active at w that stays active at w + 1.
 inline void stepEdges(const SpanLaneTri& t, int64_t w, SpanDdaState* e, int coord_bits) {
@@ -59,13 +82,21 @@ inline void checkDescriptor(const SpanParams& p, const SpanDesc& d) {
     throw std::invalid_argument("span descriptor does not match the unit's NumTri/NumAttr");
   if (d.row_first > d.row_last)  // the RTL would walk until w wraps
     throw std::invalid_argument("span descriptor without rows: setup drops such triangles");
+  if (d.interleave && !p.Interleave)
+    throw std::invalid_argument("span descriptor interleaves rows; the unit's Interleave is 0");
+}
+
+// The screen row (before the PixBits mask) of lane-triangle t's pixels in walker row w.
+inline int64_t laneRowY(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t w) {
+  const int64_t y = d.interleave ? w * p.NumTri : w;
+  return t.flip ? t.oy - y : y + t.oy;
 }
 
 // The lane fragment at walker column x of row wspan, attribute base icur + i*didx (lane i).
 inline void laneFragment(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, int64_t x, int64_t wspan,
                          const int64_t* icur, int i, int32_t& px_out, int32_t& py_out, int64_t* attr) {
   const int64_t px = t.flip ? t.ox - x : x + t.ox;
-  const int64_t py = t.flip ? t.oy - wspan : wspan + t.oy;
+  const int64_t py = laneRowY(p, d, t, wspan);
   const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
   px_out = static_cast<int32_t>(px & pix_mask);
   py_out = static_cast<int32_t>(py & pix_mask);
@@ -93,7 +124,7 @@ inline void singleRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri&
     off[ai] = u(t.aoff[ai]);
   }
   const int64_t pix_mask = (int64_t{1} << p.PixBits) - 1;
-  const int32_t py = static_cast<int32_t>((t.flip ? t.oy - w : w + t.oy) & pix_mask);
+  const int32_t py = static_cast<int32_t>(laneRowY(p, d, t, w) & pix_mask);
   // The loop instantiated per output map (flip is constant over the triangle).
   auto row = [&](auto flip) {
     constexpr bool kFlip = decltype(flip)::value;
@@ -123,7 +154,7 @@ inline bool runRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t,
   const int K = KC > 0 ? KC : p.NumAttr, bits = AB > 0 ? AB : p.AttrBits;
   const int64_t pix_lim = int64_t{1} << p.PixBits;
   const int64_t px_lo = t.flip ? t.ox - lo : lo + t.ox, px_hi = t.flip ? t.ox - hi : hi + t.ox;
-  const int64_t py = t.flip ? t.oy - w : w + t.oy;
+  const int64_t py = laneRowY(p, d, t, w);
   if (px_lo < 0 || px_lo >= pix_lim || px_hi < 0 || px_hi >= pix_lim || py < 0 || py >= pix_lim) return false;
   const int64_t n1 = hi - lo;
   std::array<int64_t, kMaxAttr> a0, da;  // the first K are set
@@ -200,7 +231,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
     const SpanLaneTri& t = d.tri[0];
     int64_t lo = 0, hi = 0;
     if (!laneRowBounds(t, w, e.data(), lo, hi)) return;
-    const int64_t xg0 = p.AlignLanes ? lo - (((lo % L) + L) % L) : lo;
+    const int64_t xg0 = firstGroup(p, lo);
     groups = static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);  // no division in serial
     walk.span_cycles += groups;
     bool ran = false;
@@ -214,19 +245,9 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   std::array<bool, kMaxLaneTri> ne{};
   std::array<int64_t, kMaxAttr> attr;
   auto laneTrianglesRow = [&](int64_t w) {
-    bool any = false;
     int64_t xs = 0, xe = 0;
-    for (int j = 0; j < T; ++j) {
-      const size_t ju = static_cast<size_t>(j);
-      ne[ju] = laneRowBounds(d.tri[ju], w, &e[ju * 3], lo[ju], hi[ju]);
-      if (ne[ju]) {
-        xs = any ? std::min(xs, lo[ju]) : lo[ju];
-        xe = any ? std::max(xe, hi[ju]) : hi[ju];
-        any = true;
-      }
-    }
-    if (!any) return;
-    int64_t xg = p.AlignLanes ? xs - (((xs % L) + L) % L) : xs;
+    if (!unionRowBounds(d.tri.data(), T, w, e.data(), lo.data(), hi.data(), ne.data(), xs, xe)) return;
+    int64_t xg = firstGroup(p, xs);
     // The first K set here (zeroed per row here, not per descriptor: that costs more than a
     // row of one lane-triangle).
     std::array<int64_t, kMaxAttr> icur{};

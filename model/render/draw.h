@@ -18,6 +18,7 @@
 
 #include "raster/setup.h"
 #include "raster/span_walk.h"
+#include "render/fixed_simd.h"
 #include "render/normalize.h"
 #include "render/pipeline.h"
 #include "render/render.h"
@@ -185,6 +186,9 @@ class Frame {
   // Runs of a row to the vector kernels (fixed_simd.h): left to right, with depth codes that
   // fit int32_t (AttrBits <= 32).
   const bool vector_runs;
+  // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
+  // (fixed_simd::colourKernel); null: the scalar loop.
+  const fixed_simd::ColourKernel colour_kernel;
   ObjectShading obj;
 
   // The unit drawing method m, made on first use (render/methods.cpp); the units in use.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <cstring>
 #include <stdexcept>
 
 #include "render/normalize.h"
@@ -10,6 +11,7 @@
 #include <immintrin.h>
 #define SHD_HAVE_AVX512_KERNEL 1
 #define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd,avx512vl,avx512bw")))
+#define SHD_AVX2 __attribute__((target("avx2")))
 #endif
 
 namespace shd::fixed_simd {
@@ -23,12 +25,22 @@ namespace shd::fixed_simd {
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 
-bool available() {
+bool cpuHasAvx512() {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
                           __builtin_cpu_supports("avx512cd") && __builtin_cpu_supports("avx512vl") &&
-                          __builtin_cpu_supports("avx512bw") && std::getenv("SHD_SCALAR") == nullptr;
+                          __builtin_cpu_supports("avx512bw");
   return yes;
 }
+bool cpuHasAvx2() {
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
+}
+static bool scalarForced() {
+  static const bool yes = std::getenv("SHD_SCALAR") != nullptr;
+  return yes;
+}
+bool available() { return cpuHasAvx512() && !scalarForced(); }
+bool availableAvx2() { return cpuHasAvx2() && !scalarForced(); }
 
 namespace {
 
@@ -151,7 +163,32 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
 }
 
 // Lanes 0 .. 7 as 32-bit values.
-SHD_AVX512 inline __m256i lanes8() { return _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0); }
+// AVX2 helpers, inlined into the AVX2 and the AVX-512 kernels (a subset of either's target).
+SHD_AVX2 inline __m256i lanes8() { return _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0); }
+
+// Within each 128-bit half: pixels' bytes r g b (of 32-bit lanes r | g << 8 | b << 16) packed
+// into the first 12 bytes, the last 4 zero.
+SHD_AVX2 inline __m256i packRgb(__m256i x) {
+  return _mm256_shuffle_epi8(x, _mm256_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1,  //
+                                                 0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1));
+}
+
+// Fragments k .. k + 7 of a colour run: unorm8FromCode of each channel's code (clamped to
+// [0, 255 2^frac], rounded half up to an integer), packed by packRgb.
+SHD_AVX2 inline __m256i colourBytes8(const ColourRun& r, size_t k) {
+  const __m128i frac = _mm_cvtsi32_si128(r.frac);
+  const __m256i top = _mm256_set1_epi32(255 << r.frac), half = _mm256_set1_epi32(1 << (r.frac - 1));
+  __m256i px = _mm256_setzero_si256();
+  for (int ch = 0; ch < 3; ++ch) {
+    const __m256i code = _mm256_add_epi32(
+        _mm256_set1_epi32(static_cast<int32_t>(static_cast<uint32_t>(r.c[ch]) + static_cast<uint32_t>(k) * static_cast<uint32_t>(r.dc[ch]))),
+        _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(r.dc[ch])));
+    const __m256i u8 = _mm256_srl_epi32(
+        _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), top), half), frac);
+    px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * ch));
+  }
+  return packRgb(px);
+}
 
 // The z-test of fragments k .. k + 7 of a run (those below px.count): their depth codes
 // against the buffer's, and where they pass the codes and the tag written. Returns the passing
@@ -223,29 +260,60 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   return std::min(k, r.px.count);
 }
 
-SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
-  const __m128i frac = _mm_cvtsi32_si128(r.frac);
-  const __m256i top = _mm256_set1_epi32(255 << r.frac), half = _mm256_set1_epi32(1 << (r.frac - 1));
-  // Within each 128-bit half: pixels' bytes r g b (of 32-bit lanes r | g << 8 | b << 16) packed
-  // into the first 12 bytes.
-  const __m256i pack = _mm256_setr_epi8(0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1,  //
-                                        0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1);
+// colourRun in AVX2: zTest8 and the colour of colourRunAvx512 below with vector masks for the
+// mask registers; the depth and tag through masked 32-bit stores, the colour bytes as below.
+SHD_AVX2 uint64_t colourRunAvx2(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  const __m256i lanes = lanes8();
+  const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
+  const __m256i tag = _mm256_set1_epi32(t.tag), zero = _mm256_setzero_si256();
+  const uint32_t dz = r.px.dz;
+  uint64_t covered = 0;
+  for (size_t k = 0; k < r.px.count; k += 8) {
+    const int n = static_cast<int>(std::min<size_t>(8, r.px.count - k));
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
+    const __m256i zk = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * dz)),
+                                        _mm256_mullo_epi32(lanes, _mm256_set1_epi32(static_cast<int32_t>(dz))));
+    int32_t* const depth = t.depth + r.px.p + k;
+    __builtin_prefetch(depth + 2 * t.width);
+    __builtin_prefetch(depth + 2 * t.width + 7);
+    const __m256i old = _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
+    const __m256i pass_v = _mm256_and_si256(valid, _mm256_cmpgt_epi32(zk, old));
+    const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
+    if (pass == 0) continue;
+    passed += static_cast<uint64_t>(__builtin_popcount(pass));
+    const unsigned fresh = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, zero))));
+    covered += static_cast<uint64_t>(__builtin_popcount(pass & fresh));
+    _mm256_maskstore_epi32(depth, pass_v, zk);
+    _mm256_maskstore_epi32(t.tri + r.px.p + k, pass_v, tag);
+    // The 8 pixels' 24 bytes, in order.
+    alignas(32) uint8_t bytes[32];
+    _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(r, k), join));
+    uint8_t* const out = rgb + 3 * (r.px.p + k);
+    if (pass == 0xFF) {
+      std::memcpy(out, bytes, 24);
+    } else if (k + 11 <= r.room) {  // 32 bytes = 10 2/3 pixels, all in the row
+      // The passing pixels' bytes (their lanes' all-ones packed like the colours), the rest as read.
+      const __m256i mask = _mm256_permutevar8x32_epi32(packRgb(pass_v), join);
+      const __m256i was = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(out));
+      const __m256i now = _mm256_load_si256(reinterpret_cast<const __m256i*>(bytes));
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, now, mask));
+    } else {
+      for (unsigned m = pass; m != 0; m &= m - 1) {
+        const int i = __builtin_ctz(m);
+        std::memcpy(out + 3 * i, bytes + 3 * i, 3);
+      }
+    }
+  }
+  return covered;
+}
+
+SHD_AVX512 uint64_t colourRunAvx512(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
   uint64_t covered = 0;
   for (size_t k = 0; k < r.px.count; k += 8) {
     const __mmask8 pass = zTest8(t, r.px, k, covered);
     passed += static_cast<uint64_t>(__builtin_popcount(pass));
     if (pass == 0) continue;
-    __m256i px = _mm256_setzero_si256();
-    for (int ch = 0; ch < 3; ++ch) {
-      // unorm8FromCode: the code clamped to [0, 255 2^frac], rounded half up to an integer.
-      const __m256i code = _mm256_add_epi32(
-          _mm256_set1_epi32(static_cast<int32_t>(static_cast<uint32_t>(r.c[ch]) + static_cast<uint32_t>(k) * static_cast<uint32_t>(r.dc[ch]))),
-          _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(r.dc[ch])));
-      const __m256i u8 = _mm256_srl_epi32(
-          _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), top), half), frac);
-      px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * ch));
-    }
-    const __m256i bytes = _mm256_shuffle_epi8(px, pack);
+    const __m256i bytes = colourBytes8(r, k);
     // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
     const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
     uint8_t* const out = rgb + 3 * (r.px.p + k);
@@ -255,11 +323,18 @@ SHD_AVX512 uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb,
   return covered;
 }
 
+ColourKernel colourKernel() {
+  return available() ? colourRunAvx512 : availableAvx2() ? colourRunAvx2 : nullptr;
+}
+
 #pragma GCC diagnostic pop
 
 #else
 
+bool cpuHasAvx512() { return false; }
+bool cpuHasAvx2() { return false; }
 bool available() { return false; }
+bool availableAvx2() { return false; }
 uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
                  int64_t* const[3]) {
   return allGroups(n);
@@ -267,9 +342,13 @@ uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64
 size_t bufferRun(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRun: built without the vector kernel");
 }
-uint64_t colourRun(const ColourRun&, const Target&, uint8_t*, uint64_t&) {
-  throw std::logic_error("fixed_simd::colourRun: built without the vector kernel");
+uint64_t colourRunAvx512(const ColourRun&, const Target&, uint8_t*, uint64_t&) {
+  throw std::logic_error("fixed_simd::colourRunAvx512: built without the vector kernels");
 }
+uint64_t colourRunAvx2(const ColourRun&, const Target&, uint8_t*, uint64_t&) {
+  throw std::logic_error("fixed_simd::colourRunAvx2: built without the vector kernels");
+}
+ColourKernel colourKernel() { return nullptr; }
 
 #endif
 

@@ -1,5 +1,5 @@
 // Fixed-point fragment work 8 fragments at a time, in AVX-512 (F, DQ, CD, VL, BW) where the
-// CPU has it: the z-test and writes of the runs of a row (flat and Gouraud colours; phong-fixed's
+// CPU has it (flat and Gouraud runs also in AVX2 where it has that alone): the z-test and writes of the runs of a row (flat and Gouraud colours; phong-fixed's
 // inputs into a batch), and phong-fixed's datapath, the same integer operations as
 // FixedPointShader::shade() (fixed_shading.h, normalize.h), lane by lane, so the same colours.
 // The datapath covers the common case, one directional light and a lobe of N.H from a table
@@ -24,6 +24,11 @@ namespace shd::fixed_simd {
 // The CPU runs the vector kernel (AVX-512 F, DQ, CD, VL and BW), and SHD_SCALAR is not set in the
 // environment (which forces the scalar path, for comparisons).
 bool available();
+// The CPU runs the AVX2 colour-run kernel (colourRunAvx2, without AVX-512), and SHD_SCALAR is not set.
+bool availableAvx2();
+// The CPU alone (SHD_SCALAR not consulted): what the kernels below need.
+bool cpuHasAvx512();
+bool cpuHasAvx2();
 
 // The constants of the one light and the lobe table.
 struct NhParams {
@@ -88,13 +93,21 @@ struct ColourRun {
   RunPixels px;
   std::array<int32_t, 3> c{}, dc{};
   int frac = 12;
+  size_t room = 0;  // pixels from the run's first to the end of its row (the AVX2 kernel's blends)
 };
 
 // The run's z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
 // and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch]. Returns the
 // passing pixels whose depth was 0 (not covered before); adds the passing pixels to passed.
-// With the vector kernel only.
-uint64_t colourRun(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed);
+// Two kernels, each for a CPU with its instructions: AVX-512 and AVX2, the same operations on
+// 8 lanes. AVX2 has no byte-masked store: a group's colour bytes are blended into the 32 bytes
+// there (the bytes of other pixels written back as read) where those lie within the run's row
+// (room), else written pixel by pixel, so no pixel of another row is touched.
+uint64_t colourRunAvx512(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed);
+uint64_t colourRunAvx2(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed);
+// The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else null.
+using ColourKernel = uint64_t (*)(const ColourRun&, const Target&, uint8_t*, uint64_t&);
+ColourKernel colourKernel();
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
 // the z-test (the fragment's code above the buffer's), and where it passes the code and the

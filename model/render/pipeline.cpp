@@ -1,6 +1,7 @@
 #include "render/pipeline.h"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -27,7 +28,41 @@ Poly clipPolygon(const Poly& in, Dist dist) {
 
 }  // namespace
 
+void Framebuffer::markDrawn(double xmin, double ymin, double xmax, double ymax) {
+  // A pixel (x, y) whose centre lies in the box: x in [xmin - 0.5, xmax - 0.5], so within
+  // [floor(xmin) - 1, ceil(xmax)], which [trunc(xmin) - 2, trunc(xmax) + 1] holds (trunc is
+  // within 1 of floor and of ceil; the coordinates lie in the guard band); clamped to the frame.
+  auto lo = [](double v, int n) { return std::clamp(static_cast<int>(v) - 2, 0, n - 1); };
+  auto hi = [](double v, int n) { return std::clamp(static_cast<int>(v) + 1, 0, n - 1); };
+  drawn_x0 = std::min(drawn_x0, lo(xmin, width));
+  drawn_y0 = std::min(drawn_y0, lo(ymin, height));
+  drawn_x1 = std::max(drawn_x1, hi(xmax, width));
+  drawn_y1 = std::max(drawn_y1, hi(ymax, height));
+}
+
 void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) {
+  const size_t n = static_cast<size_t>(W) * H, n_lsb = exact ? 3 * n : 0;
+  const bool same = fb.width == W && fb.height == H && fb.rgb.size() == 3 * n && fb.tri.size() == n &&
+                    fb.depth.size() == n && fb.lsb.size() == n_lsb && fb.spec_lsb.size() == n_lsb;
+  const int x0 = fb.drawn_x0, y0 = fb.drawn_y0, x1 = fb.drawn_x1, y1 = fb.drawn_y1;
+  fb.drawn_x0 = fb.drawn_y0 = INT_MAX;  // nothing drawn
+  fb.drawn_x1 = fb.drawn_y1 = INT_MIN;
+  if (same) {
+    // The same frame again (a benchmark, an animation): the buffers are clear outside the
+    // rectangle drawn since the last clear.
+    const size_t w = x0 <= x1 ? static_cast<size_t>(x1 - x0 + 1) : 0;
+    for (int y = y0; w > 0 && y <= y1; ++y) {
+      const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x0);
+      std::memset(fb.rgb.data() + 3 * p, 0, 3 * w);
+      std::memset(fb.tri.data() + p, 0xFF, w * sizeof(int32_t));
+      std::memset(fb.depth.data() + p, 0, w * sizeof(int32_t));
+      if (exact) {
+        std::fill_n(fb.lsb.data() + 3 * p, 3 * w, 0.0);
+        std::fill_n(fb.spec_lsb.data() + 3 * p, 3 * w, 0.0);
+      }
+    }
+    return;
+  }
   fb.width = W;
   fb.height = H;
   // Depth last: every fragment reads it, so it is the buffer to find in the cache.

@@ -75,7 +75,9 @@ struct Projection {
   Vec3 vertexCam(const PVertex& v) const { return pixelCam(v.x - 0.5, v.y - 0.5, v.w); }
 };
 
-// The buffers of a W x H frame, cleared; lsb and spec_lsb only for an exact method.
+// The buffers of a W x H frame, cleared; lsb and spec_lsb only for an exact method. When fb
+// already holds a frame of that size and kind, only its drawn rectangle is cleared (the rest
+// is clear): the renderer marks every triangle it draws (Framebuffer::markDrawn).
 void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact);
 
 // Object -> camera space and the projection of the vertices in front of the near plane (their

@@ -170,6 +170,8 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
   triangles_.push_back(info);
   ++f_.st.drawn;
+  f_.fb.markDrawn(std::min({sv[0].x, sv[1].x, sv[2].x}), std::min({sv[0].y, sv[1].y, sv[2].y}),
+                  std::max({sv[0].x, sv[1].x, sv[2].x}), std::max({sv[0].y, sv[1].y, sv[2].y}));
   part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
 }
 

@@ -32,6 +32,7 @@
 #pragma once
 
 #include <array>
+#include <climits>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -202,6 +203,11 @@ struct Framebuffer {
   std::vector<double> lsb;     // reference only: the exact colour in LSBs (3 per pixel)
   std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
   bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
+  // The pixels drawn since the buffers were last cleared lie in this rectangle (x0 > x1: none):
+  // the next clear of a frame of the same size and kind clears it alone (clearFramebuffer).
+  int drawn_x0 = INT_MAX, drawn_y0 = INT_MAX, drawn_x1 = INT_MIN, drawn_y1 = INT_MIN;
+  // Adds the pixels whose centres lie within [xmin, xmax] x [ymin, ymax] (screen pixels).
+  void markDrawn(double xmin, double ymin, double xmax, double ymax);
 };
 
 // A frame as an image (its rgb), the mask of its covered pixels, and the reference method's

@@ -27,7 +27,8 @@ nlohmann::json toJson(const SpanDesc& d) {
                     {"edges", edges}});
   }
   return {{"tag", d.tag},   {"row_first", d.row_first}, {"row_last", d.row_last}, {"xref", d.xref},
-          {"iref", d.iref}, {"didx", d.didx},           {"didy", d.didy},         {"tri", tris}};
+          {"iref", d.iref}, {"didx", d.didx},           {"didy", d.didy},         {"interleave", d.interleave},
+          {"tri", tris}};
 }
 
 ReadyDraw::ReadyDraw(double p) {

@@ -92,6 +92,7 @@ class SpanDutImpl final : public SpanDut {
       put(h_.dut().desc_didx_i, a * AB, AB, static_cast<uint64_t>(d.didx[ai]));
       put(h_.dut().desc_didy_i, a * AB, AB, static_cast<uint64_t>(d.didy[ai]));
     }
+    h_.dut().desc_interleave_i = d.interleave ? 1 : 0;
     for (int j = 0; j < kP.NumTri; ++j) {
       const SpanLaneTri& t = d.tri[static_cast<size_t>(j)];
       put(h_.dut().lt_row_first_i, j * CB, CB, static_cast<uint64_t>(t.row_first));

@@ -61,6 +61,7 @@ class SpanRtlImpl final : public SpanRtl {
     dut_.desc_iref_i(desc_iref_i);
     dut_.desc_didx_i(desc_didx_i);
     dut_.desc_didy_i(desc_didy_i);
+    dut_.desc_interleave_i(desc_interleave_i);
     dut_.lt_row_first_i(lt_row_first_i);
     dut_.lt_row_last_i(lt_row_last_i);
     dut_.lt_clip_x0_i(lt_clip_x0_i);
@@ -105,6 +106,7 @@ class SpanRtlImpl final : public SpanRtl {
     attrs(desc_iref_i, d.iref);
     attrs(desc_didx_i, d.didx);
     attrs(desc_didy_i, d.didy);
+    write(desc_interleave_i, [&](auto& v) { put(v, 0, 1, d.interleave ? 1 : 0); });
     // One field per lane-triangle j (width CB, or 1 for flip; K*AB for aoff).
     auto perTri = [&](auto& sig, int width, auto field) {
       write(sig, [&](auto& v) {
@@ -181,6 +183,7 @@ class SpanRtlImpl final : public SpanRtl {
   SHD_SPAN_SIGNAL(desc_iref_i)
   SHD_SPAN_SIGNAL(desc_didx_i)
   SHD_SPAN_SIGNAL(desc_didy_i)
+  SHD_SPAN_SIGNAL(desc_interleave_i)
   SHD_SPAN_SIGNAL(lt_row_first_i)
   SHD_SPAN_SIGNAL(lt_row_last_i)
   SHD_SPAN_SIGNAL(lt_clip_x0_i)

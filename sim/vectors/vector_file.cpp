@@ -21,7 +21,7 @@ const char* const kHeaderKeys[] = {"unit", "config", "params", "prom", "latency"
 
 const char* const kSpecParamOrder = "Degree CosFracBits ShinBits CoefIntBits CoefFracBits DiffFracBits HornerFracBits "
                                     "SpecFracBits LightBits PipeStages Kind TableBits Segments";
-const char* const kSpanParamOrder = "NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits RowAhead";
+const char* const kSpanParamOrder = "NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits RowAhead Interleave";
 
 std::vector<int> specParamList(const SpecUnitParams& p) {
   return {p.Degree,       p.CosFracBits,    p.ShinBits,     p.CoefIntBits, p.CoefFracBits,
@@ -30,7 +30,7 @@ std::vector<int> specParamList(const SpecUnitParams& p) {
 }
 
 std::vector<int> spanParamList(const SpanParams& p) {
-  return {p.NumTri, p.LanesPerTri, p.AlignLanes, p.NumAttr, p.AttrBits, p.CoordBits, p.RemBits, p.PixBits, p.TagBits, p.RowAhead};
+  return {p.NumTri, p.LanesPerTri, p.AlignLanes, p.NumAttr, p.AttrBits, p.CoordBits, p.RemBits, p.PixBits, p.TagBits, p.RowAhead, p.Interleave};
 }
 
 uint64_t lowBits(int64_t v, int bits) {
@@ -295,7 +295,7 @@ std::string renderSpanVectors(const SpanVectors& v) {
   t += fmt::format(
       "# parameter order: {}\n"
       "# Records (hex, port widths, signed values in two's complement; see sim/vectors/vector_file.h):\n"
-      "# D tag row_first row_last xref {{iref didx didy}}*NumAttr {{row_first row_last clip_x0 clip_x1 ox oy flip\n"
+      "# D tag row_first row_last xref {{iref didx didy}}*NumAttr interleave {{row_first row_last clip_x0 clip_x1 ox oy flip\n"
       "#   {{aoff}}*NumAttr {{right row_first row_last q r div k m}}*3}}*NumTri: the descriptor ports from the next C on\n"
       "# C desc_valid out_ready  exp_desc_ready exp_out_valid exp_tag exp_lane_valid {{x y {{attr}}*NumAttr}}*valid lanes:\n"
       "#   one clock cycle after reset (rst_ni low for two cycles, desc_valid 0, out_ready 1), inputs and the outputs\n"
@@ -322,6 +322,7 @@ std::string renderSpanVectors(const SpanVectors& v) {
       t += fmt::format("D {} {} {} {}", hx(d.tag, p.TagBits), hx(d.row_first, CB), hx(d.row_last, CB), hx(d.xref, CB));
       for (size_t a = 0; a < static_cast<size_t>(K); ++a)
         t += fmt::format(" {} {} {}", hx(d.iref[a], AB), hx(d.didx[a], AB), hx(d.didy[a], AB));
+      t += fmt::format(" {:x}", d.interleave ? 1 : 0);
       for (const SpanLaneTri& lt : d.tri) {
         check(lt.aoff.size() == static_cast<size_t>(K), fmt::format("descriptor {}: aoff has not NumAttr entries", d.tag));
         t += fmt::format("  {} {} {} {} {} {} {:x}", hx(lt.row_first, CB), hx(lt.row_last, CB), hx(lt.clip_x0, CB),
@@ -394,6 +395,8 @@ SpanVectors loadSpanVectors(const std::string& path) {
         d.didx.push_back(f.next(AB, true, fmt::format("didx[{}]", a)));
         d.didy.push_back(f.next(AB, true, fmt::format("didy[{}]", a)));
       }
+      d.interleave = f.next(1, false, "interleave") != 0;
+      if (d.interleave && !p.Interleave) throw r.error(line.no, "interleave is 1 and the unit's Interleave is 0");
       for (int j = 0; j < p.NumTri; ++j) {
         SpanLaneTri lt;
         const std::string n = fmt::format("lane-triangle {} ", j);

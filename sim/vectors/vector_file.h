@@ -30,8 +30,9 @@
 //   cycle; inputs of cycles without valid are driven too: the unit must ignore them).
 //
 // span (rtl/shd_span_unit.v): params = NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits
-//   RemBits PixBits TagBits RowAhead. Two records, each one line starting with its letter:
-//     D tag row_first row_last xref  {iref didx didy} per attribute
+//   RemBits PixBits TagBits RowAhead Interleave. Two records, each one line starting with its
+//   letter:
+//     D tag row_first row_last xref  {iref didx didy} per attribute  interleave
 //       {row_first row_last clip_x0 clip_x1 ox oy flip  {aoff} per attribute
 //        {right row_first row_last q r div k m} per edge (3)} per lane-triangle
 //       the descriptor ports (desc_*, lt_*, e_*) from the next C record on. A D record comes

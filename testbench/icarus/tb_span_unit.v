@@ -30,7 +30,8 @@ module tb_span_unit #(
   parameter integer RemBits     = 27,
   parameter integer PixBits     = 12,
   parameter integer TagBits     = 32,
-  parameter integer RowAhead    = 0
+  parameter integer RowAhead    = 0,
+  parameter integer Interleave  = 0
 ) ();
 
   localparam integer L         = NumTri * LanesPerTri;
@@ -52,6 +53,7 @@ module tb_span_unit #(
   reg  [K*A-1:0]             desc_iref_i      = {(K*A){1'b0}};
   reg  [K*A-1:0]             desc_didx_i      = {(K*A){1'b0}};
   reg  [K*A-1:0]             desc_didy_i      = {(K*A){1'b0}};
+  reg                        desc_interleave_i = 1'b0;
   reg  [NumTri*C-1:0]        lt_row_first_i   = {(NumTri*C){1'b0}};
   reg  [NumTri*C-1:0]        lt_row_last_i    = {(NumTri*C){1'b0}};
   reg  [NumTri*C-1:0]        lt_clip_x0_i     = {(NumTri*C){1'b0}};
@@ -79,12 +81,13 @@ module tb_span_unit #(
   shd_span_unit #(
     .NumTri(NumTri), .LanesPerTri(LanesPerTri), .AlignLanes(AlignLanes), .NumAttr(NumAttr),
     .AttrBits(AttrBits), .CoordBits(CoordBits), .RemBits(RemBits), .PixBits(PixBits), .TagBits(TagBits),
-    .RowAhead(RowAhead)
+    .RowAhead(RowAhead), .Interleave(Interleave)
   ) dut (
     .clk_i(clk_i), .rst_ni(rst_ni),
     .desc_valid_i(desc_valid_i), .desc_ready_o(desc_ready_o), .desc_tag_i(desc_tag_i),
     .desc_row_first_i(desc_row_first_i), .desc_row_last_i(desc_row_last_i), .desc_xref_i(desc_xref_i),
     .desc_iref_i(desc_iref_i), .desc_didx_i(desc_didx_i), .desc_didy_i(desc_didy_i),
+    .desc_interleave_i(desc_interleave_i),
     .lt_row_first_i(lt_row_first_i), .lt_row_last_i(lt_row_last_i), .lt_clip_x0_i(lt_clip_x0_i),
     .lt_clip_x1_i(lt_clip_x1_i), .lt_ox_i(lt_ox_i), .lt_oy_i(lt_oy_i), .lt_flip_i(lt_flip_i),
     .lt_aoff_i(lt_aoff_i), .e_right_i(e_right_i), .e_row_first_i(e_row_first_i),
@@ -102,7 +105,7 @@ module tb_span_unit #(
   reg     cycle_bad, params_seen, pending, have_desc, done, dumping;
   reg [63:0] v, exp_mask, exp_tag, exp_dr, exp_ov;
   reg [8*40-1:0] signal;
-  integer hp [0:10];
+  integer hp [0:11];
 
   // The file is read character by character ($fgetc): ch is the next unread one (-1 at the end),
   // so a record's fields are taken from its own line only.
@@ -176,6 +179,7 @@ module tb_span_unit #(
         next_field(A, "didx");             desc_didx_i[a*A +: A] = v[A-1:0];
         next_field(A, "didy");             desc_didy_i[a*A +: A] = v[A-1:0];
       end
+      next_field(1, "interleave");         desc_interleave_i = v[0];
       for (j = 0; j < NumTri; j = j + 1) begin
         next_field(C, "lt row_first");     lt_row_first_i[j*C +: C] = v[C-1:0];
         next_field(C, "lt row_last");      lt_row_last_i[j*C +: C]  = v[C-1:0];
@@ -266,16 +270,17 @@ module tb_span_unit #(
         // A header or comment line: the rest of it at once.
         line = 0;
         n = $fgets(line, fd);
-        for (a = 0; a < 11; a = a + 1) hp[a] = 32'bx;
-        if ($sscanf(line, " params %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4], hp[5],
-                    hp[6], hp[7], hp[8], hp[9], hp[10]) >= 1) begin
+        for (a = 0; a < 12; a = a + 1) hp[a] = 32'bx;
+        if ($sscanf(line, " params %d %d %d %d %d %d %d %d %d %d %d %d", hp[0], hp[1], hp[2], hp[3], hp[4], hp[5],
+                    hp[6], hp[7], hp[8], hp[9], hp[10], hp[11]) >= 1) begin
           if (hp[0] !== NumTri || hp[1] !== LanesPerTri || hp[2] !== AlignLanes || hp[3] !== NumAttr ||
               hp[4] !== AttrBits || hp[5] !== CoordBits || hp[6] !== RemBits || hp[7] !== PixBits ||
-              hp[8] !== TagBits || hp[9] !== RowAhead || hp[10] !== 32'bx) begin
+              hp[8] !== TagBits || hp[9] !== RowAhead || hp[10] !== Interleave ||
+              hp[11] !== 32'bx) begin
             if (line[7:0] == "\n") line = line >> 8;
             $display("tb_span_unit: error: %0s, line %0d: '#%0s' differs from the parameters compiled in:", path, lineno, line);
-            $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits RowAhead)",
-                     NumTri, LanesPerTri, AlignLanes, NumAttr, AttrBits, CoordBits, RemBits, PixBits, TagBits, RowAhead);
+            $display("  # params %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d %0d (NumTri LanesPerTri AlignLanes NumAttr AttrBits CoordBits RemBits PixBits TagBits RowAhead Interleave)",
+                     NumTri, LanesPerTri, AlignLanes, NumAttr, AttrBits, CoordBits, RemBits, PixBits, TagBits, RowAhead, Interleave);
             $fatal(1);
           end
           params_seen = 1'b1;

@@ -3,7 +3,7 @@
 //
 // Both interpolate colour codes (flat's constant) and write them as they are: per fragment the
 // z-test and the codes straight to unorm8 (what combine() gives them); per run of a row the
-// same in a loop of its own, or in AVX-512 (fixed_simd::colourRun).
+// same in a loop of its own, or in AVX-512 or AVX2 (fixed_simd::colourKernel).
 #include <algorithm>
 #include <type_traits>
 
@@ -44,12 +44,12 @@ struct ColourRunLoop {
   int W;
   uint64_t& covered;
   uint64_t& rejected;
-  bool vector_runs;
+  fixed_simd::ColourKernel kernel;  // null: the loop below for every run
   const fixed_simd::Target& target;
   uint8_t* rgb;
 
   void operator()(const RowRun& r) const {
-    if (vector_runs && r.dx == 1) {
+    if (kernel != nullptr && r.dx == 1) {
       vectorRun(r);
       return;
     }
@@ -85,7 +85,7 @@ struct ColourRunLoop {
     rejected += static_cast<uint64_t>(count) - passed;
   }
 
-  // A left-to-right run in AVX-512 (fixed_simd::colourRun).
+  // A left-to-right run in AVX-512 or AVX2 (fixed_simd::colourKernel).
   void vectorRun(const RowRun& r) const {
     fixed_simd::ColourRun run;
     run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0),
@@ -95,8 +95,9 @@ struct ColourRunLoop {
       run.dc[k] = static_cast<int32_t>(r.da[k]);
     }
     run.frac = kColourFrac;
+    run.room = static_cast<size_t>(W - r.x0);
     uint64_t passed = 0;
-    covered += fixed_simd::colourRun(run, target, rgb, passed);
+    covered += kernel(run, target, rgb, passed);
     rejected += run.px.count - passed;
   }
 };
@@ -108,7 +109,8 @@ void drawColourRuns(Frame& f, const SpanTriangle& t) {
   const PixelWriter write = f.writer(t.tag);
   const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
   ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected};
-  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, f.vector_runs, target, fb.rgb.data()};
+  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected,
+                    f.colour_kernel, target, fb.rgb.data()};
   f.walk(t, fragment, run);
 }
 
