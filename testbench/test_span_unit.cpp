@@ -208,19 +208,27 @@ void checkModesAgainstSerial(uint64_t seed, long count, bool check_walkers) {
       }
       for (size_t i = 0; i < got->size(); ++i) {
         const SpanFragment& f = (*got)[i];
-        ASSERT_TRUE(f.x >= 0 && f.x < c.width && f.y >= 0 && f.y < c.height)
-            << mode << " fragment (" << f.x << ", " << f.y << ") outside the viewport, " << describe(t);
+        // Each check tested plainly first: GoogleTest's assertion objects, made for each of some
+        // 10^8 fragments, took a third of the run.
+        if (!(f.x >= 0 && f.x < c.width && f.y >= 0 && f.y < c.height)) {
+          FAIL() << mode << " fragment (" << f.x << ", " << f.y << ") outside the viewport, " << describe(t);
+        }
         const size_t p = static_cast<size_t>(f.y) * c.width + f.x;
-        ASSERT_NE(seen[p], visit) << mode << " pixel (" << f.x << ", " << f.y << ") twice, " << describe(t);
+        if (seen[p] == visit) {
+          FAIL() << mode << " pixel (" << f.x << ", " << f.y << ") twice, " << describe(t);
+        }
         seen[p] = visit;
         if (mi == 0) {
           drawn[p] = static_cast<uint64_t>(n) + 1;
           serial_at[p] = static_cast<uint32_t>(i);
         } else {
-          ASSERT_EQ(drawn[p], static_cast<uint64_t>(n) + 1)
-              << mode << " pixel (" << f.x << ", " << f.y << ") that serial does not draw, seed " << seed << " "
-              << describe(t);
-          ASSERT_EQ(f.attr, serial[serial_at[p]].attr) << mode << " seed " << seed << " " << describe(t);
+          if (drawn[p] != static_cast<uint64_t>(n) + 1) {
+            FAIL() << mode << " pixel (" << f.x << ", " << f.y << ") that serial does not draw, seed " << seed << " "
+                   << describe(t);
+          }
+          if (f.attr != serial[serial_at[p]].attr) {
+            ASSERT_EQ(f.attr, serial[serial_at[p]].attr) << mode << " seed " << seed << " " << describe(t);
+          }
         }
       }
       frags += mi == 0 ? static_cast<long>(serial.size()) : 0;

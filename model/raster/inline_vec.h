@@ -97,8 +97,14 @@ class InlineVec {
   const_iterator begin() const { return a_; }
   const_iterator end() const { return a_ + n_; }
 
+  // A loop, not std::equal: for integers that becomes a call of memcmp, which for the few
+  // elements held here costs more than the comparison (the mode-equality tests compare every
+  // fragment's attributes).
   friend bool operator==(const InlineVec& a, const InlineVec& b) {
-    return a.n_ == b.n_ && std::equal(a.begin(), a.end(), b.begin());
+    if (a.n_ != b.n_) return false;
+    for (size_t i = 0; i < a.n_; ++i)
+      if (!(a.a_[i] == b.a_[i])) return false;
+    return true;
   }
   friend bool operator!=(const InlineVec& a, const InlineVec& b) { return !(a == b); }
 
