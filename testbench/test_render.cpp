@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <random>
@@ -723,5 +724,122 @@ TEST(Render, AFrameOverAnotherEqualsItRenderedAfresh) {
       EXPECT_EQ(reused.fb.lsb, fresh.fb.lsb) << toString(m);
       EXPECT_EQ(reused.fb.spec_lsb, fresh.fb.spec_lsb) << toString(m);
     }
+  }
+}
+
+// Two threads (RenderOptions::threads, render.cpp): the same bytes and counts as one, for every
+// method that allows it, on every built-in scene (builtin:materials: several objects, each its
+// material), with the materials' own lobes and with the specular unit's quadratic lobe (at the
+// vertices of gouraud, per polygon in flat, per pixel in phong-fixed), in the paper's serial
+// unit and the full-rate Sierpinski unit, and again frame over frame into the same buffers.
+TEST(Render, TwoThreadsEqualOneThread) {
+  const SpecUnitConfig cubic_config = specConfig("cubic");
+  ModelSpecEngine cubic(buildPromTable(PromRequest::fromContent(cubic_config.prom), cubic_config.rtl));
+  int compared = 0;
+  for (const char* name : {"builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials"}) {
+    const Scene s = loadScene(name);
+    for (Method m : allMethods()) {
+      if (!traits(m).two_threads) continue;
+      for (const char* brdf : {"", "quadratic"}) {
+        for (const char* mode : {"serial", "sierpinskifull"}) {
+          const std::string what = fmt::format("{} {} brdf '{}' {}", name, toString(m), brdf, mode);
+          ModelEngines one(mode), two(mode);
+          one.view.cubic = two.view.cubic = &cubic;  // builtin:materials has a cubic material
+          RenderOptions o;
+          o.method = m;
+          o.brdf = brdf;
+          const RenderResult a = render(s, o, one.span, one.view);
+          o.threads = 2;
+          RenderResult b = render(s, o, two.span, two.view);
+          render(s, o, two.span, two.view, b);  // over the frame before
+          EXPECT_GT(a.stats.pixels_covered, 0u) << what;
+          EXPECT_EQ(a.fb.rgb, b.fb.rgb) << what;
+          EXPECT_EQ(a.fb.depth, b.fb.depth) << what;
+          EXPECT_EQ(a.fb.tri, b.fb.tri) << what;
+          ASSERT_EQ(a.triangles.size(), b.triangles.size()) << what;
+          for (size_t i = 0; i < a.triangles.size(); ++i) {
+            ASSERT_EQ(a.triangles[i].object, b.triangles[i].object) << what;
+            ASSERT_EQ(a.triangles[i].mesh_triangle, b.triangles[i].mesh_triangle) << what;
+          }
+          RenderStats sa = a.stats, sb = b.stats;  // every count: 8-byte fields, no padding
+          sa.ms = sb.ms = 0;
+          EXPECT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << what << ": the counts differ";
+          if (std::string(brdf) == "quadratic") {
+            EXPECT_GT(sa.spec_evaluations, 0u) << what;
+          }
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_EQ(compared, 4 * 3 * 2 * 2);
+}
+
+// What cannot run on two threads is refused, naming why; an error on either thread reaches the
+// caller as on one thread, and nothing is left running.
+TEST(Render, TwoThreadsRefuseWhatTheyCannotDrawAndPassErrorsOn) {
+  const Scene sphere = loadScene("builtin:sphere");
+  ModelEngines e("serial");
+  RenderOptions o;
+  o.threads = 2;
+  o.method = Method::Phong;
+  try {
+    render(sphere, o, e.span, e.view);
+    FAIL() << "phong on two threads";
+  } catch (const std::invalid_argument& x) {
+    EXPECT_NE(std::string(x.what()).find("phong runs on one thread (two: flat, gouraud, phong-fixed)"),
+              std::string::npos)
+        << x.what();
+  }
+  o.method = Method::Gouraud;
+  o.threads = 3;
+  EXPECT_THROW(render(sphere, o, e.span, e.view), std::invalid_argument);
+  // A span engine that is not the model's walk (the RTL's, here a stand-in).
+  struct NotTheWalker final : SpanEngine {
+    ModelSpanEngine inner{spanParams("serial")};
+    const SpanParams& params() const override { return inner.params(); }
+    SpanWalk run(const SpanDesc& d, std::vector<SpanFragment>& out) override { return inner.run(d, out); }
+  } rtl;
+  o.threads = 2;
+  EXPECT_THROW(render(sphere, o, rtl, e.view), std::invalid_argument);
+  // The front end's error: a projection beyond the clipper's range (as in
+  // RenderPipeline.ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle).
+  Scene plane = loadScene("builtin:plane");
+  plane.camera.px_per_unit = 1e6;
+  plane.camera.z_near = 1e-6;
+  plane.camera.eye = {0.01, 0.1, 0.01};
+  plane.camera.target = {0.01, 0.1, 1};
+  try {
+    render(plane, o, e.span, e.view);
+    FAIL() << "rendered";
+  } catch (const std::range_error& x) {
+    EXPECT_NE(std::string(x.what()).find("builtin:plane: object 'plane' triangle "), std::string::npos) << x.what();
+  }
+  // The back end's error: a specular unit that fails on its 10th batch (phong-fixed's per-pixel
+  // requests, batched per triangle: the unit is not the model).
+  struct Failing final : SpecEngine {
+    SpecEngine& inner;
+    int batches = 0;
+    explicit Failing(SpecEngine& i) : inner(i) {}
+    const PromTable& table() const override { return inner.table(); }
+    uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
+      if (++batches == 10) throw std::runtime_error("the unit failed");
+      return inner.evaluate(in, out);
+    }
+  } failing(*e.quad);
+  SpecEngines view;
+  view.quadratic = &failing;
+  o.method = Method::PhongFixed;
+  o.brdf = "quadratic";
+  for (int threads : {1, 2}) {
+    o.threads = threads;
+    failing.batches = 0;
+    try {
+      render(sphere, o, e.span, view);
+      FAIL() << threads << " threads: rendered";
+    } catch (const std::runtime_error& x) {
+      EXPECT_STREQ(x.what(), "the unit failed") << threads << " threads";
+    }
+    EXPECT_EQ(failing.batches, 10) << threads << " threads";
   }
 }

@@ -375,9 +375,19 @@ int RasterConfig::attrFracBits(int k) const {
 }
 
 SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg) {
+  SetupResult res;
+  setupTriangle(v, tag, cfg, res);
+  return res;
+}
+
+void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg, SetupResult& res) {
   const SpanParams& p = cfg.unit;
   const int S = cfg.subpixel_bits, K = p.NumAttr;
-  SetupResult res;
+  res.desc.reset();
+  res.dropped.clear();
+  res.tri = SnappedTriangle{};
+  res.edges = {};
+  res.plane = AttributePlane{};
   SnappedTriangle& t = res.tri;
   // Snap to the subpixel grid; the guard band bounds every width downstream.
   const double guard = static_cast<double>(int64_t{1} << (p.CoordBits - 3));
@@ -411,7 +421,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   t.det = (t.X[1] - t.X[0]) * (t.Y[2] - t.Y[0]) - (t.X[2] - t.X[0]) * (t.Y[1] - t.Y[0]);
   if (t.det == 0) {
     res.dropped = "zero area";
-    return res;
+    return;
   }
   if (t.det < 0) {  // one orientation downstream: inside is E >= 0
     std::swap(t.X[1], t.X[2]);
@@ -496,7 +506,7 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
   if (!any) {
     res.desc.reset();
     res.dropped = boxed ? "no pixel centre inside it in the viewport" : "no pixel centre of its bounding box in the viewport";
-    return res;
+    return;
   }
   d.tag = tag;
   d.row_first = static_cast<int32_t>(row_first);
@@ -519,7 +529,6 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
                               : wrap(dx * l.ox + dy * l.oy));
     }
   }
-  return res;
 }
 
 std::vector<SpanFragment> rasterizeReference(const SetupResult& s, const RasterConfig& cfg) {

@@ -127,6 +127,9 @@ struct SetupResult {
 // std::invalid_argument (a clear message naming the vertex or attribute) for NaN/infinite
 // coordinates, vertices outside the guard band, or attributes that cannot fit AttrBits.
 SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg);
+// The same into res, whatever it held (a result reused in place: the renderer's two-thread
+// frame sets up each triangle in the slot its other thread draws it from, without a copy).
+void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg, SetupResult& res);
 
 // The reference the span unit is tested against: every pixel of the viewport whose centre
 // passes the three biased edge functions (direct evaluation, no DDA), with the plane's value,

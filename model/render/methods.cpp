@@ -34,18 +34,18 @@ constexpr Attributes C = Attributes::Colour, N = Attributes::Normal;
 // modified-gouraud and adaptive draw their parts with the gouraud and phong units (their own
 // attributes are never set up).
 constexpr MethodTraits kMethodTable[] = {
-    // method                  name                 attr vertex pixel  exact  unit
-    {Method::Flat,             "flat",              C, false, false, false, makeFlatUnit},
-    {Method::Gouraud,          "gouraud",           C, true,  false, false, makeGouraudUnit},
-    {Method::GouraudClassical, "gouraud-classical", C, true,  false, false, makeGouraudClassicalUnit},
-    {Method::Phong,            "phong",             N, false, true,  false, makePhongUnit},
-    {Method::PhongIncremental, "phong-incremental", N, false, true,  false, makePhongIncrementalUnit},
-    {Method::PhongFixed,       "phong-fixed",       N, false, true,  false, makePhongFixedUnit},
-    {Method::NormalBisection,  "normal-bisection",  N, false, true,  false, makeNormalBisectionUnit},
-    {Method::Biquadratic,      "biquadratic",       C, true,  false, false, makeBiquadraticUnit},
-    {Method::ModifiedGouraud,  "modified-gouraud",  C, true,  false, false, makeModifiedGouraudUnit},
-    {Method::Adaptive,         "adaptive",          N, true,  false, false, makeAdaptiveUnit},
-    {Method::Reference,        "reference",         N, false, false, true,  makeReferenceUnit},
+    // method                  name                 attr vertex pixel  exact  2 thr. unit
+    {Method::Flat,             "flat",              C, false, false, false, true,  makeFlatUnit},
+    {Method::Gouraud,          "gouraud",           C, true,  false, false, true,  makeGouraudUnit},
+    {Method::GouraudClassical, "gouraud-classical", C, true,  false, false, false, makeGouraudClassicalUnit},
+    {Method::Phong,            "phong",             N, false, true,  false, false, makePhongUnit},
+    {Method::PhongIncremental, "phong-incremental", N, false, true,  false, false, makePhongIncrementalUnit},
+    {Method::PhongFixed,       "phong-fixed",       N, false, true,  false, true,  makePhongFixedUnit},
+    {Method::NormalBisection,  "normal-bisection",  N, false, true,  false, false, makeNormalBisectionUnit},
+    {Method::Biquadratic,      "biquadratic",       C, true,  false, false, false, makeBiquadraticUnit},
+    {Method::ModifiedGouraud,  "modified-gouraud",  C, true,  false, false, false, makeModifiedGouraudUnit},
+    {Method::Adaptive,         "adaptive",          N, true,  false, false, false, makeAdaptiveUnit},
+    {Method::Reference,        "reference",         N, false, false, true,  false, makeReferenceUnit},
 };
 constexpr size_t kMethodCount = std::size(kMethodTable);
 
@@ -77,6 +77,13 @@ std::vector<Method> allMethods() {
   std::vector<Method> v;
   for (const MethodTraits& t : kMethodTable) v.push_back(t.method);
   return v;
+}
+
+std::string twoThreadMethods() {
+  std::string s;
+  for (const MethodTraits& t : kMethodTable)
+    if (t.two_threads) s += (s.empty() ? "" : ", ") + std::string(t.name);
+  return s;
 }
 
 }  // namespace shd

@@ -33,6 +33,10 @@ struct MethodTraits {
   // Exact: the lobes themselves (a device lobe's Blinn lobe, no specular unit) and the
   // framebuffer's lsb and spec_lsb.
   bool exact;
+  // A frame may run on two threads (RenderOptions::threads): the lobe is evaluated on one side
+  // alone, the front (vertex or polygon colours) or the back (per pixel), so the two threads
+  // share no specular unit and no object state (render.cpp).
+  bool two_threads;
   std::unique_ptr<MethodUnit> (*make)(Frame&);
 };
 

@@ -6,9 +6,14 @@
 #include "render/render.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
 #include <stdexcept>
+#include <thread>
+
+#include <immintrin.h>
 
 #include <fmt/format.h>
 
@@ -35,15 +40,109 @@ DeviceCoding codingFor(SpecEngine* e, const Material& m) {
   return c;
 }
 
+// The object's material, lobe and specular unit (Frame::obj).
+void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_t oi) {
+  const SceneObject& obj = scene.objects[oi];
+  const Material& mat = scene.materials.at(static_cast<size_t>(obj.material));
+  ObjectShading& o = f.obj;
+  o.index = static_cast<int>(oi);
+  o.material = &mat;
+  o.lobe = parseLobe(f.opt.brdf.empty() ? mat.brdf : f.opt.brdf);
+  o.spec = engines.forLobe(o.lobe);
+  if (isDeviceLobe(o.lobe) && o.spec == nullptr && !traits(f.opt.method).exact)
+    throw std::invalid_argument(fmt::format("object '{}': brdf {} needs the specular unit", obj.name, toString(o.lobe)));
+  o.coding = codingFor(o.spec, mat);
+  o.shader.emplace(f.ctx, mat, o.lobe, &o.coding);
+  o.direct = o.spec != nullptr ? o.spec->model() : nullptr;
+}
+
+// A screen triangle of a two-thread frame, or a mark between objects, on its way from the
+// front end (SceneDrawer on the calling thread: culling, vertex colours, clipping, setup) to the
+// back end (drawBackEnd: the method's unit walks, z-tests, shades and writes it).
+struct DrawJob {
+  enum class Kind : uint8_t { Triangle, BeginObject, EndObject, End };
+  Kind kind = Kind::End;
+  Method method = Method::Gouraud;  // Triangle: of the unit that draws it
+  bool colour_attrs = true;         // Triangle: set up with colour attributes (else normals)
+  uint32_t tag = 0;                 // Triangle
+  size_t object = 0;                // BeginObject
+  std::array<PVertex, 3> v;         // Triangle: as set up
+  SetupResult setup;                // Triangle
+};
+
+// The jobs in order through a ring of slots, one thread writing and one reading. Each side
+// makes its progress visible to the other every kBatch jobs and before it waits, so neither
+// waits for a count the other has not yet shown. Both wait by spinning (a frame is about a
+// millisecond: a sleep and wake-up costs more than the wait), yielding after a while. The
+// reader's failure stops the writer (failed()), the writer's the reader (abort()).
+class DrawQueue {
+ public:
+  DrawQueue() : slots_(kSlots) {}
+  // The writer: the next slot, filled in place, then push()ed.
+  DrawJob& slot() {
+    if (head_ - done_seen_ == kSlots) {
+      written_.store(head_, std::memory_order_release);
+      for (unsigned spin = 0; head_ - (done_seen_ = done_.load(std::memory_order_acquire)) == kSlots; ++spin) {
+        if (failed_.load(std::memory_order_acquire)) throw BackEndFailed{};
+        pause(spin);
+      }
+    }
+    return slots_[head_ % kSlots];
+  }
+  void push() {
+    if (++head_ % kBatch == 0 || slots_[(head_ - 1) % kSlots].kind == DrawJob::Kind::End)
+      written_.store(head_, std::memory_order_release);
+  }
+  // The reader: the next job (null when the writer aborted), released once done with.
+  const DrawJob* next() {
+    if (tail_ == written_seen_) {
+      done_.store(tail_, std::memory_order_release);
+      for (unsigned spin = 0; tail_ == (written_seen_ = written_.load(std::memory_order_acquire)); ++spin) {
+        if (aborted_.load(std::memory_order_acquire)) return nullptr;
+        pause(spin);
+      }
+    }
+    return &slots_[tail_ % kSlots];
+  }
+  void release() {
+    if (++tail_ % kBatch == 0) done_.store(tail_, std::memory_order_release);
+  }
+  void fail(std::exception_ptr e) {
+    error_ = std::move(e);
+    failed_.store(true, std::memory_order_release);
+  }
+  void abort() { aborted_.store(true, std::memory_order_release); }
+  // After the reader has ended (joined): its exception, if it failed.
+  std::exception_ptr error() const { return error_; }
+  // Thrown by slot() when the reader has failed.
+  struct BackEndFailed {};
+
+ private:
+  static constexpr size_t kSlots = 256, kBatch = 16;
+  static void pause(unsigned spin) {
+    if (spin < 4096) _mm_pause();
+    else std::this_thread::yield();
+  }
+  std::vector<DrawJob> slots_;
+  size_t head_ = 0, done_seen_ = 0;     // the writer's
+  size_t tail_ = 0, written_seen_ = 0;  // the reader's
+  alignas(64) std::atomic<size_t> written_{0};
+  alignas(64) std::atomic<size_t> done_{0};
+  std::atomic<bool> failed_{false}, aborted_{false};
+  std::exception_ptr error_;
+};
+
 // The objects of a frame, drawn by the unit of the frame's method, with the buffers of the
 // per-triangle work reused across the frame (no allocation per triangle once they have grown).
 class SceneDrawer {
  public:
-  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, std::vector<ScreenTriangleInfo>& triangles);
+  // queue: a two-thread frame's, to which the screen triangles go (else they are drawn here).
+  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, std::vector<ScreenTriangleInfo>& triangles,
+              DrawQueue* queue = nullptr);
   void drawObject(size_t oi);
+  const RasterConfig& rasterConfig(bool colour_attrs) const { return colour_attrs ? rc_colour_ : rc_unit_; }
 
  private:
-  void lightObject(size_t oi);
   void lightVertices(const std::array<uint32_t, 3>& tri);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   void drawPart(const Part& part, uint32_t ti);
@@ -61,17 +160,20 @@ class SceneDrawer {
   Poly poly_;                         // a clipped triangle
   Fan fan_;                           // the polygon to draw
   Parts parts_;                       // its screen triangles
+  DrawQueue* const queue_;
+  SetupResult setup_;                 // of the triangle being drawn here (no queue)
 };
 
 SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines,
-                         std::vector<ScreenTriangleInfo>& triangles)
+                         std::vector<ScreenTriangleInfo>& triangles, DrawQueue* queue)
     : f_(f),
       scene_(scene),
       engines_(engines),
       triangles_(triangles),
       basis_(cameraBasis(scene.camera)),
       unit_(f.unit(f.opt.method)),
-      vertex_colours_(traits(f.opt.method).vertex_colours) {
+      vertex_colours_(traits(f.opt.method).vertex_colours),
+      queue_(queue) {
   RasterConfig rc;
   rc.width = f.W;
   rc.height = f.H;
@@ -86,26 +188,19 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
   rc_unit_.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
 }
 
-// The object's material, lobe and specular unit (Frame::obj).
-void SceneDrawer::lightObject(size_t oi) {
-  const SceneObject& obj = scene_.objects[oi];
-  const Material& mat = scene_.materials.at(static_cast<size_t>(obj.material));
-  ObjectShading& o = f_.obj;
-  o.index = static_cast<int>(oi);
-  o.material = &mat;
-  o.lobe = parseLobe(f_.opt.brdf.empty() ? mat.brdf : f_.opt.brdf);
-  o.spec = engines_.forLobe(o.lobe);
-  if (isDeviceLobe(o.lobe) && o.spec == nullptr && !traits(f_.opt.method).exact)
-    throw std::invalid_argument(fmt::format("object '{}': brdf {} needs the specular unit", obj.name, toString(o.lobe)));
-  o.coding = codingFor(o.spec, mat);
-  o.shader.emplace(f_.ctx, mat, o.lobe, &o.coding);
-  o.direct = o.spec != nullptr ? o.spec->model() : nullptr;
+// A mark for the back end of a two-thread frame.
+void pushMark(DrawQueue& q, DrawJob::Kind kind, size_t oi) {
+  DrawJob& j = q.slot();
+  j.kind = kind;
+  j.object = oi;
+  q.push();
 }
 
 void SceneDrawer::drawObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
-  lightObject(oi);
+  lightObject(f_, scene_, engines_, oi);
   for (const auto& u : f_.units()) u.second->beginObject();
+  if (queue_ != nullptr) pushMark(*queue_, DrawJob::Kind::BeginObject, oi);
   transformVertices(obj, basis_, scene_.camera, f_.proj, verts_);
   lit_.assign(verts_.size(), 0);
   size_t ti = 0;
@@ -115,6 +210,7 @@ void SceneDrawer::drawObject(size_t oi) {
     throw std::range_error(fmt::format("{}: object '{}' triangle {}: {}", scene_.name, obj.name, ti, e.what()));
   }
   for (const auto& u : f_.units()) u.second->endObject();
+  if (queue_ != nullptr) pushMark(*queue_, DrawJob::Kind::EndObject, oi);
 }
 
 // Gouraud vertex colours: computed when a triangle that is not culled first needs them.
@@ -162,7 +258,9 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
     }
   }
   const uint32_t tag = static_cast<uint32_t>(triangles_.size());
-  const SetupResult s = setupTriangle(sv, tag, rc);
+  DrawJob* job = queue_ != nullptr ? &queue_->slot() : nullptr;
+  SetupResult& s = job != nullptr ? job->setup : setup_;
+  setupTriangle(sv, tag, rc, s);
   if (!s.desc) return;  // no pixel centre inside (drawMeshTriangle counts the triangle culled)
   ScreenTriangleInfo info;
   info.object = f_.obj.index;
@@ -172,11 +270,106 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   ++f_.st.drawn;
   f_.fb.markDrawn(std::min({sv[0].x, sv[1].x, sv[2].x}), std::min({sv[0].y, sv[1].y, sv[2].y}),
                   std::max({sv[0].x, sv[1].x, sv[2].x}), std::max({sv[0].y, sv[1].y, sv[2].y}));
-  part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
+  if (job == nullptr) {
+    part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
+    return;
+  }
+  job->kind = DrawJob::Kind::Triangle;
+  job->method = part.method;
+  job->colour_attrs = colour_attrs;
+  job->tag = tag;
+  for (size_t i = 0; i < 3; ++i) job->v[i] = *part.v[i];
+  queue_->push();
+}
+
+// The back end of a two-thread frame: its jobs, in order, drawn by the units of its own frame
+// f (the statistics its own), until the end mark; false when the front end aborted.
+bool drawBackEnd(DrawQueue& q, Frame& f, const Scene& scene, const SpecEngines& engines, const SceneDrawer& front) {
+  for (;;) {
+    const DrawJob* j = q.next();
+    if (j == nullptr) return false;
+    switch (j->kind) {
+      case DrawJob::Kind::End:
+        q.release();
+        return true;
+      case DrawJob::Kind::BeginObject:
+        lightObject(f, scene, engines, j->object);
+        for (const auto& u : f.units()) u.second->beginObject();
+        break;
+      case DrawJob::Kind::EndObject:
+        for (const auto& u : f.units()) u.second->endObject();
+        break;
+      case DrawJob::Kind::Triangle:
+        f.unit(j->method)
+            .draw(SpanTriangle{{&j->v[0], &j->v[1], &j->v[2]}, j->method, j->setup, front.rasterConfig(j->colour_attrs),
+                               j->tag});
+        break;
+    }
+    q.release();
+  }
+}
+
+
+// The frame on two threads: this one the front end (SceneDrawer with a queue), another the back
+// end (drawBackEnd with a frame of its own, on the same buffers and span engine). Every pixel
+// is written by the back end alone, in the order of one thread; each side counts in its own
+// RenderStats, summed after. The objects' specular-unit codings are made here first, so that
+// the two sides' lightObject only read the units' memo of zero codes (SpecEngine::zeroCode).
+void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
+                      RenderResult& res) {
+  for (size_t oi = 0; oi < scene.objects.size(); ++oi) lightObject(front, scene, engines, oi);
+  RenderStats back_stats;
+  Frame back(scene, front.opt, span, res.fb, back_stats);
+  back.unit(front.opt.method);  // made before the first object's beginObject, as the front's
+  DrawQueue q;
+  SceneDrawer drawer(front, scene, engines, res.triangles, &q);
+  std::thread worker([&] {
+    try {
+      drawBackEnd(q, back, scene, engines, drawer);
+    } catch (...) {
+      q.fail(std::current_exception());
+    }
+  });
+  try {
+    for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+    q.slot().kind = DrawJob::Kind::End;
+    q.push();
+  } catch (const DrawQueue::BackEndFailed&) {
+    // the back end's exception, below
+  } catch (...) {
+    q.abort();
+    worker.join();
+    throw;
+  }
+  worker.join();
+  if (q.error()) std::rethrow_exception(q.error());
+  res.stats += back_stats;
 }
 
 }  // namespace
 
+
+RenderStats& RenderStats::operator+=(const RenderStats& o) {
+  triangles += o.triangles;
+  culled_back += o.culled_back;
+  culled_outside += o.culled_outside;
+  culled_no_pixel += o.culled_no_pixel;
+  clipped += o.clipped;
+  drawn += o.drawn;
+  fragments += o.fragments;
+  pixels_covered += o.pixels_covered;
+  span_cycles += o.span_cycles;
+  spec_cycles += o.spec_cycles;
+  spec_evaluations += o.spec_evaluations;
+  spec_at_zero += o.spec_at_zero;
+  depth_rejected += o.depth_rejected;
+  divisions += o.divisions;
+  split_parts += o.split_parts;
+  normalisations += o.normalisations;
+  adaptive_gouraud += o.adaptive_gouraud;
+  adaptive_phong += o.adaptive_phong;
+  return *this;
+}
 
 int64_t SpecEngine::zeroCode(uint32_t shin) {
   constexpr int64_t kUnknown = -2;
@@ -249,11 +442,22 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   }
   res.stats = RenderStats{};
   res.triangles.clear();
+  if (opt.threads != 1 && opt.threads != 2)
+    throw std::invalid_argument(fmt::format("render: threads {}: 1 or 2", opt.threads));
+  if (opt.threads == 2 && !traits(opt.method).two_threads)
+    throw std::invalid_argument(fmt::format("render: {} runs on one thread (two: {})", toString(opt.method),
+                                            twoThreadMethods()));
+  if (opt.threads == 2 && span.walker() == nullptr)
+    throw std::invalid_argument("render: two threads need the model's span unit, not the RTL's");
   clearFramebuffer(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);
   Frame frame(scene, opt, span, res.fb, res.stats);
-  SceneDrawer drawer(frame, scene, engines, res.triangles);
   span.beginFrame();
-  for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+  if (opt.threads == 1) {
+    SceneDrawer drawer(frame, scene, engines, res.triangles);
+    for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+  } else {
+    renderTwoThreads(scene, span, engines, frame, res);
+  }
   span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }

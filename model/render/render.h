@@ -66,6 +66,8 @@ enum class Method {
 Method parseMethod(const std::string& s);  // std::invalid_argument naming the choices
 const char* toString(Method m);
 std::vector<Method> allMethods();
+// The methods a frame may draw on two threads (RenderOptions::threads), named in a list.
+std::string twoThreadMethods();
 
 // The span unit: the fragments of one descriptor, appended to `out` in the unit's output order,
 // and the cycles they took, the consumer always ready. A frame's descriptors go to the unit back
@@ -164,6 +166,11 @@ struct RenderOptions {
   // datapath at these widths, fragment by fragment (render/fixed_widths.h), the span unit
   // interpolating the normal at their NormalFracBits. PhongWidths{} gives the same images.
   std::optional<PhongWidths> phong_widths;
+  // 1, or 2: the frame on two threads, the same bytes and counts as on one (render.cpp): this
+  // thread culls, clips and sets up the triangles, another walks, shades and writes them, in
+  // order. For the methods whose traits allow it (MethodTraits::two_threads) with the model's
+  // span unit (SpanEngine::walker); otherwise std::invalid_argument.
+  int threads = 1;
 };
 
 struct RenderStats {
@@ -193,6 +200,8 @@ struct RenderStats {
   uint64_t normalisations = 0;  // normal-bisection: exact normalisations (nodes)
   uint64_t adaptive_gouraud = 0, adaptive_phong = 0;  // adaptive: the choices
   double ms = 0;
+  // Adds o's counts (not ms): the two threads' halves of a frame.
+  RenderStats& operator+=(const RenderStats& o);
 };
 
 struct Framebuffer {

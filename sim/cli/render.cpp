@@ -40,6 +40,7 @@ class RenderCmd final : public Command {
   LobeConfigs lobes_;
   bool rtl_ = false, quiet_ = false;
   int bench_ = 0;
+  int threads_ = 1;
   double heat_scale_ = 8, highlight_lsb_ = 32;
 
   void say(const std::string& m) const {
@@ -83,6 +84,11 @@ void RenderCmd::add(CLI::App& app) {
                  "the highlight: pixels whose reference specular part exceeds this many LSBs")
       ->check(realIn(0, 255));
   app.add_option("--bench", bench_, "render this many frames and report the median time")->check(countIn(0, 10000));
+  app.add_option("--threads", threads_,
+                 fmt::format("1, or 2: the model's frames on two threads, one culling, clipping and setting up the "
+                             "triangles, the other drawing them in order: the same image and counts ({} only)",
+                             twoThreadMethods()))
+      ->check(countIn(1, 2));
   app.add_flag("--quiet", quiet_, "no progress lines");
 }
 
@@ -105,7 +111,9 @@ RtlCheck RenderCmd::renderRtl(const Scene& sc, const RenderOptions& ro, const Sp
                               const RenderResult& res, const fs::path& tmp) const {
   say("the same frame with the verilated span and specular units");
   Engines hw = makeEngines(sc, ro, span, lobes_, true, tmp, failDir());
-  const RenderResult hres = render(sc, ro, *hw.span, hw.view);
+  RenderOptions one = ro;  // the verilated units on this thread alone
+  one.threads = 1;
+  const RenderResult hres = render(sc, one, *hw.span, hw.view);
   fs::remove_all(tmp);
   return checkRtlFrame(sc, res, hres);
 }
@@ -141,6 +149,9 @@ int RenderCmd::run(const CLI::App& app) {
   RenderOptions ro;
   ro.method = parseMethod(method_);
   ro.brdf = brdf_;
+  ro.threads = threads_;
+  if (threads_ == 2 && !traits(ro.method).two_threads)
+    throw ArgError(fmt::format("--threads 2: --method {} draws on one thread (two: {})", method_, twoThreadMethods()));
   // A lobe configuration no object evaluates with the specular unit would be silently unused.
   const std::vector<Lobe> lobes = deviceLobesUsed(sc, ro);
   for (const auto& [option, lobe] : {std::pair{"--quadratic-config", Lobe::Quadratic}, {"--cubic-config", Lobe::Cubic}})

@@ -42,6 +42,7 @@ Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConf
 RenderResult renderReference(const Scene& sc, const RenderOptions& ro) {
   RenderOptions rref = ro;
   rref.method = Method::Reference;
+  rref.threads = 1;  // the reference draws on one thread
   ModelSpanEngine serial(SpanParams{});
   return render(sc, rref, serial, SpecEngines{});
 }
