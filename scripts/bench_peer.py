@@ -2,7 +2,8 @@
 """bench_peer.py: the model's time per frame against a peer renderer's, measured side by side.
 
   scripts/bench_peer.py --pair METHOD 'PEER COMMAND' [--pair ...] [--rounds R] [--frames N]
-                        [--scene SCENE] [--shadesim BIN] [--peer-pattern REGEX] [--json-out FILE]
+                        [--threads 1,2] [--scene SCENE] [--shadesim BIN] [--peer-pattern REGEX]
+                        [--json-out FILE]
 
 Each --pair names a shadesim method (`shadesim render --method`) and a shell command that prints
 the peer's time per frame in milliseconds. Every round runs, for every pair, shadesim
@@ -10,6 +11,9 @@ the peer's time per frame in milliseconds. Every round runs, for every pair, sha
 order shadesim, peer on odd rounds and peer, shadesim on even ones, so that a machine drifting
 during the run weighs on both alike. Only ratios taken this way mean anything: never compare with
 a figure from another run, day or machine.
+
+--threads: the thread counts of shadesim's frames (`render --threads`), comma-separated; each
+pair runs once per count in every round, beside its own peer run (default 1).
 
 --peer-pattern: a regular expression whose first group is the peer's ms per frame, searched in
 its output; the last match counts (default: a number followed by "ms").
@@ -44,10 +48,10 @@ def run(cmd, shell=False):
     return p.stdout
 
 
-def shadesim_ms(a, method, work):
+def shadesim_ms(a, method, threads, work):
     js = os.path.join(work, "render.json")
     run([a.shadesim, "render", "--scene", a.scene, "--method", method, "--bench", str(a.frames), "--quiet",
-         "-o", os.path.join(work, "render.png"), "--json", js])
+         "--threads", str(threads), "-o", os.path.join(work, "render.png"), "--json", js])
     with open(js, encoding="utf-8") as f:
         return float(json.load(f)["ms"])
 
@@ -62,17 +66,19 @@ def peer_ms(a, cmd):
 
 
 def measure(a):
-    results = [{"method": m, "peer": c, "rounds": []} for m, c in a.pair]
+    results = [{"method": m, "threads": n, "peer": c, "rounds": []} for m, c in a.pair for n in a.threads]
     with tempfile.TemporaryDirectory(prefix="bench_peer_") as work:
         for r in range(a.rounds):
             for res in results:
                 order = ("shadesim", "peer") if r % 2 == 0 else ("peer", "shadesim")
                 t = {}
                 for who in order:
-                    t[who] = shadesim_ms(a, res["method"], work) if who == "shadesim" else peer_ms(a, res["peer"])
+                    t[who] = (shadesim_ms(a, res["method"], res["threads"], work) if who == "shadesim"
+                              else peer_ms(a, res["peer"]))
                 t["ratio"] = t["shadesim"] / t["peer"]
                 res["rounds"].append(t)
-                print(f"bench_peer: round {r + 1}/{a.rounds} {res['method']}: shadesim {t['shadesim']:.3f} ms, "
+                print(f"bench_peer: round {r + 1}/{a.rounds} {res['method']} ({res['threads']} thread(s)): "
+                      f"shadesim {t['shadesim']:.3f} ms, "
                       f"peer {t['peer']:.3f} ms, ratio {t['ratio']:.3f}", file=sys.stderr, flush=True)
     for res in results:
         ratios = [t["ratio"] for t in res["rounds"]]
@@ -85,7 +91,7 @@ def report(a, results):
     env = " SHD_SCALAR=1" if os.environ.get("SHD_SCALAR") else ""
     print(f"{a.scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds; ratio = shadesim / peer")
     for res in results:
-        print(f"\n{res['method']} against: {res['peer']}")
+        print(f"\n{res['method']}, {res['threads']} thread(s), against: {res['peer']}")
         print(f"{'round':>5} {'shadesim ms':>12} {'peer ms':>10} {'ratio':>7}")
         for i, t in enumerate(res["rounds"]):
             print(f"{i + 1:>5} {t['shadesim']:>12.3f} {t['peer']:>10.3f} {t['ratio']:>7.3f}")
@@ -97,6 +103,7 @@ def main(argv):
     p.add_argument("--pair", nargs=2, action="append", metavar=("METHOD", "PEER_COMMAND"), required=True)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--frames", type=int, default=200)
+    p.add_argument("--threads", default="1")
     p.add_argument("--scene", default="builtin:sphere")
     p.add_argument("--shadesim", default=os.path.join(ROOT, "build", "sim", "shadesim"))
     p.add_argument("--peer-pattern", default=DEFAULT_PATTERN)
@@ -105,6 +112,13 @@ def main(argv):
     try:
         if a.rounds < 1 or a.frames < 1:
             raise BenchError("--rounds and --frames must be at least 1")
+        given = a.threads
+        try:
+            a.threads = [int(n) for n in given.split(",")]
+        except ValueError:
+            a.threads = []
+        if not a.threads or any(n not in (1, 2) for n in a.threads) or len(set(a.threads)) != len(a.threads):
+            raise BenchError(f"--threads '{given}': distinct thread counts, 1 or 2, comma-separated")
         if not os.access(a.shadesim, os.X_OK):
             raise BenchError(f"{a.shadesim}: no shadesim binary (--shadesim)")
         try:
