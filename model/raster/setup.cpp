@@ -383,11 +383,13 @@ SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, con
 void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg, SetupResult& res) {
   const SpanParams& p = cfg.unit;
   const int S = cfg.subpixel_bits, K = p.NumAttr;
+  // What res held and is not overwritten below (every other field is).
   res.desc.reset();
   res.dropped.clear();
-  res.tri = SnappedTriangle{};
-  res.edges = {};
-  res.plane = AttributePlane{};
+  res.tri.swapped = false;
+  res.plane.iref.clear();
+  res.plane.didx.clear();
+  res.plane.didy.clear();
   SnappedTriangle& t = res.tri;
   // Snap to the subpixel grid; the guard band bounds every width downstream.
   const double guard = static_cast<double>(int64_t{1} << (p.CoordBits - 3));
@@ -421,6 +423,8 @@ void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const Rast
   t.det = (t.X[1] - t.X[0]) * (t.Y[2] - t.Y[0]) - (t.X[2] - t.X[0]) * (t.Y[1] - t.Y[0]);
   if (t.det == 0) {
     res.dropped = "zero area";
+    res.edges = {};
+    res.plane.xref = res.plane.yref = 0;
     return;
   }
   if (t.det < 0) {  // one orientation downstream: inside is E >= 0
