@@ -12,6 +12,7 @@
 #include <condition_variable>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -126,13 +127,16 @@ class DrawQueue {
     if (spin < 1024) _mm_pause();
     else std::this_thread::yield();
   }
+  // Each side's own fields in cache lines of their own: a line written by one thread and read
+  // by the other moves between the cores at every write (on builtin:sphere's two-thread gouraud
+  // frame the writer's load of head_, beside the reader's tail_, took a tenth of its time).
   std::vector<DrawJob> slots_;
-  size_t head_ = 0, done_seen_ = 0;     // the writer's
-  size_t tail_ = 0, written_seen_ = 0;  // the reader's
+  std::exception_ptr error_;
+  alignas(64) size_t head_ = 0, done_seen_ = 0;     // the writer's
+  alignas(64) size_t tail_ = 0, written_seen_ = 0;  // the reader's
   alignas(64) std::atomic<size_t> written_{0};
   alignas(64) std::atomic<size_t> done_{0};
-  std::atomic<bool> failed_{false}, aborted_{false};
-  std::exception_ptr error_;
+  alignas(64) std::atomic<bool> failed_{false}, aborted_{false};
 };
 
 // The thread that draws the back ends of two-thread frames: made with the first and kept for
@@ -266,6 +270,12 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
   rc_unit_.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
 }
 
+// The screen triangle v added to the framebuffer's drawn rectangle.
+void markDrawn(Framebuffer& fb, const std::array<const PVertex*, 3>& v) {
+  fb.markDrawn(std::min({v[0]->x, v[1]->x, v[2]->x}), std::min({v[0]->y, v[1]->y, v[2]->y}),
+               std::max({v[0]->x, v[1]->x, v[2]->x}), std::max({v[0]->y, v[1]->y, v[2]->y}));
+}
+
 // A mark for the back end of a two-thread frame.
 void pushMark(DrawQueue& q, DrawJob::Kind kind, size_t oi) {
   DrawJob& j = q.slot();
@@ -346,8 +356,7 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
   triangles_.push_back(info);
   ++f_.st.drawn;
-  f_.fb.markDrawn(std::min({sv[0].x, sv[1].x, sv[2].x}), std::min({sv[0].y, sv[1].y, sv[2].y}),
-                  std::max({sv[0].x, sv[1].x, sv[2].x}), std::max({sv[0].y, sv[1].y, sv[2].y}));
+  markDrawn(f_.fb, part.v);
   if (job == nullptr) {
     part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
     return;
@@ -360,9 +369,20 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   queue_->push();
 }
 
-// The back end of a two-thread frame: its jobs, in order, drawn by the units of its own frame
-// f (the statistics its own), until the end mark; false when the front end aborted.
-bool drawBackEnd(DrawQueue& q, Frame& f, const Scene& scene, const SpecEngines& engines, const SceneDrawer& front) {
+// The back end of a two-thread frame: its own frame (its own counts) and the front end's
+// raster configurations, copied: in lines of their own, apart from what the front end writes.
+struct alignas(64) BackEnd {
+  RenderStats stats;
+  const RasterConfig rc_colour, rc_unit;
+  Frame f;
+  BackEnd(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Framebuffer& fb, const SceneDrawer& front)
+      : rc_colour(front.rasterConfig(true)), rc_unit(front.rasterConfig(false)), f(scene, opt, span, fb, stats) {}
+};
+
+// The back end's jobs, in order, drawn by the units of its frame, until the end mark; false
+// when the front end aborted.
+bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines& engines) {
+  Frame& f = b.f;
   for (;;) {
     const DrawJob* j = q.next();
     if (j == nullptr) return false;
@@ -377,11 +397,11 @@ bool drawBackEnd(DrawQueue& q, Frame& f, const Scene& scene, const SpecEngines& 
       case DrawJob::Kind::EndObject:
         for (const auto& u : f.units()) u.second->endObject();
         break;
-      case DrawJob::Kind::Triangle:
-        f.unit(j->method)
-            .draw(SpanTriangle{{&j->v[0], &j->v[1], &j->v[2]}, j->method, j->setup, front.rasterConfig(j->colour_attrs),
-                               j->tag});
+      case DrawJob::Kind::Triangle: {
+        const std::array<const PVertex*, 3> v = {&j->v[0], &j->v[1], &j->v[2]};
+        f.unit(j->method).draw(SpanTriangle{v, j->method, j->setup, j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag});
         break;
+      }
     }
     q.release();
   }
@@ -396,14 +416,13 @@ bool drawBackEnd(DrawQueue& q, Frame& f, const Scene& scene, const SpecEngines& 
 void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
                       RenderResult& res) {
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) lightObject(front, scene, engines, oi);
-  RenderStats back_stats;
-  Frame back(scene, front.opt, span, res.fb, back_stats);
-  back.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   DrawQueue q;
   SceneDrawer drawer(front, scene, engines, res.triangles, &q);
+  const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res.fb, drawer);
+  back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   const std::function<void()> back_end = [&] {
     try {
-      drawBackEnd(q, back, scene, engines, drawer);
+      drawBackEnd(q, *back, scene, engines);
     } catch (...) {
       q.fail(std::current_exception());
     }
@@ -424,7 +443,7 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
   }
   worker.wait();
   if (q.error()) std::rethrow_exception(q.error());
-  res.stats += back_stats;
+  res.stats += back->stats;
 }
 
 }  // namespace
