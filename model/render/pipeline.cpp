@@ -40,29 +40,16 @@ void Framebuffer::markDrawn(double xmin, double ymin, double xmax, double ymax) 
   drawn_y1 = std::max(drawn_y1, hi(ymax, height));
 }
 
-void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) {
+ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact) {
   const size_t n = static_cast<size_t>(W) * H, n_lsb = exact ? 3 * n : 0;
   const bool same = fb.width == W && fb.height == H && fb.rgb.size() == 3 * n && fb.tri.size() == n &&
                     fb.depth.size() == n && fb.lsb.size() == n_lsb && fb.spec_lsb.size() == n_lsb;
-  const int x0 = fb.drawn_x0, y0 = fb.drawn_y0, x1 = fb.drawn_x1, y1 = fb.drawn_y1;
+  const ClearRect r{fb.drawn_x0, fb.drawn_y0, fb.drawn_x1, fb.drawn_y1, exact};
   fb.drawn_x0 = fb.drawn_y0 = INT_MAX;  // nothing drawn
   fb.drawn_x1 = fb.drawn_y1 = INT_MIN;
-  if (same) {
-    // The same frame again (a benchmark, an animation): the buffers are clear outside the
-    // rectangle drawn since the last clear.
-    const size_t w = x0 <= x1 ? static_cast<size_t>(x1 - x0 + 1) : 0;
-    for (int y = y0; w > 0 && y <= y1; ++y) {
-      const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(x0);
-      std::memset(fb.rgb.data() + 3 * p, 0, 3 * w);
-      std::memset(fb.tri.data() + p, 0xFF, w * sizeof(int32_t));
-      std::memset(fb.depth.data() + p, 0, w * sizeof(int32_t));
-      if (exact) {
-        std::fill_n(fb.lsb.data() + 3 * p, 3 * w, 0.0);
-        std::fill_n(fb.spec_lsb.data() + 3 * p, 3 * w, 0.0);
-      }
-    }
-    return;
-  }
+  // The same frame again (a benchmark, an animation): the buffers are clear outside the
+  // rectangle drawn since the last clear.
+  if (same) return r;
   fb.width = W;
   fb.height = H;
   // Depth last: every fragment reads it, so it is the buffer to find in the cache.
@@ -77,7 +64,25 @@ void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) {
     fb.lsb.clear();
     fb.spec_lsb.clear();
   }
+  return ClearRect{1, 1, 0, 0, exact};  // nothing left to clear
 }
+
+void clearRect(Framebuffer& fb, const ClearRect& r) {
+  const size_t W = static_cast<size_t>(fb.width);
+  const size_t w = r.x0 <= r.x1 ? static_cast<size_t>(r.x1 - r.x0 + 1) : 0;
+  for (int y = r.y0; w > 0 && y <= r.y1; ++y) {
+    const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(r.x0);
+    std::memset(fb.rgb.data() + 3 * p, 0, 3 * w);
+    std::memset(fb.tri.data() + p, 0xFF, w * sizeof(int32_t));
+    std::memset(fb.depth.data() + p, 0, w * sizeof(int32_t));
+    if (r.exact) {
+      std::fill_n(fb.lsb.data() + 3 * p, 3 * w, 0.0);
+      std::fill_n(fb.spec_lsb.data() + 3 * p, 3 * w, 0.0);
+    }
+  }
+}
+
+void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) { clearRect(fb, prepareClear(fb, W, H, exact)); }
 
 void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                        std::vector<PVertex>& verts) {

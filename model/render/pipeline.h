@@ -79,6 +79,15 @@ struct Projection {
 // already holds a frame of that size and kind, only its drawn rectangle is cleared (the rest
 // is clear): the renderer marks every triangle it draws (Framebuffer::markDrawn).
 void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact);
+// The same in two steps: prepareClear sizes the buffers (a new size or kind cleared whole) and
+// marks nothing drawn, and returns what is left to clear, the rectangle drawn before (x0 > x1:
+// nothing), which clearRect clears (a two-thread frame's back end, render.cpp).
+struct ClearRect {
+  int x0, y0, x1, y1;
+  bool exact;
+};
+ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact);
+void clearRect(Framebuffer& fb, const ClearRect& r);
 
 // Object -> camera space and the projection of the vertices in front of the near plane (their
 // colours are left to the method, render.cpp).

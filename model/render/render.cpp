@@ -410,11 +410,12 @@ bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
 
 // The frame on two threads: this one the front end (SceneDrawer with a queue), another the back
 // end (drawBackEnd with a frame of its own, on the same buffers and span engine). Every pixel
-// is written by the back end alone, in the order of one thread; each side counts in its own
+// is written by the back end alone, in the order of one thread, after it has cleared what the
+// frame before drew (clear); each side counts in its own
 // RenderStats, summed after. The objects' specular-unit codings are made here first, so that
 // the two sides' lightObject only read the units' memo of zero codes (SpecEngine::zeroCode).
 void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
-                      RenderResult& res) {
+                      const ClearRect& clear, RenderResult& res) {
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) lightObject(front, scene, engines, oi);
   DrawQueue q;
   SceneDrawer drawer(front, scene, engines, res.triangles, &q);
@@ -422,6 +423,7 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
   back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   const std::function<void()> back_end = [&] {
     try {
+      clearRect(res.fb, clear);  // while the front end transforms and sets up the first triangles
       drawBackEnd(q, *back, scene, engines);
     } catch (...) {
       q.fail(std::current_exception());
@@ -549,14 +551,15 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                                             twoThreadMethods()));
   if (opt.threads == 2 && span.walker() == nullptr)
     throw std::invalid_argument("render: two threads need the model's span unit, not the RTL's");
-  clearFramebuffer(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);
+  const ClearRect clear = prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);
   Frame frame(scene, opt, span, res.fb, res.stats);
   span.beginFrame();
   if (opt.threads == 1) {
+    clearRect(res.fb, clear);
     SceneDrawer drawer(frame, scene, engines, res.triangles);
     for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
   } else {
-    renderTwoThreads(scene, span, engines, frame, res);
+    renderTwoThreads(scene, span, engines, frame, clear, res);
   }
   span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
