@@ -84,15 +84,32 @@ void clearRect(Framebuffer& fb, const ClearRect& r) {
 
 void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) { clearRect(fb, prepareClear(fb, W, H, exact)); }
 
+namespace {
+
+// Vertex i of obj in camera space and, in front of the near plane, projected (v as PVertex{}
+// leaves it: the colour is the method's).
+inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+                            const NormalTransform& to_world, size_t i, PVertex& v) {
+  v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
+  v.n = normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
+  if (v.cam.z >= cam.z_near) proj.project(v);
+}
+
+}  // namespace
+
 void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                        std::vector<PVertex>& verts) {
   verts.assign(obj.mesh.positions.size(), PVertex{});
   const NormalTransform to_world(obj.transform);
-  for (size_t i = 0; i < verts.size(); ++i) {
-    PVertex& v = verts[i];
-    v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
-    v.n = normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
-    if (v.cam.z >= cam.z_near) proj.project(v);
+  for (size_t i = 0; i < verts.size(); ++i) transformVertex(obj, basis, cam, proj, to_world, i, verts[i]);
+}
+
+void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+                          PVertex* verts, size_t begin, size_t end) {
+  const NormalTransform to_world(obj.transform);
+  for (size_t i = begin; i < end; ++i) {
+    verts[i] = PVertex{};
+    transformVertex(obj, basis, cam, proj, to_world, i, verts[i]);
   }
 }
 

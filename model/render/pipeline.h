@@ -93,6 +93,10 @@ void clearRect(Framebuffer& fb, const ClearRect& r);
 // colours are left to the method, render.cpp).
 void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                        std::vector<PVertex>& verts);
+// The same for the vertices [begin, end) of an array that holds them all (each one made anew):
+// parts of an object's vertices, on either thread of a two-thread frame (render.cpp).
+void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+                          PVertex* verts, size_t begin, size_t end);
 
 // Where a mesh triangle goes before it is clipped.
 struct TriangleView {

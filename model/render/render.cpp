@@ -60,6 +60,34 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
   o.direct = o.spec != nullptr ? o.spec->model() : nullptr;
 }
 
+// An object's vertices transformed by both threads of a two-thread frame: each claims chunks
+// (next) and counts those it has written (done); the front end, which claims too, waits until
+// all are done before its first triangle. The back end helps when it reaches the object's mark:
+// at once at the frame's start, where it has nothing else to do; later objects the front end
+// mostly transforms alone, the back end still busy with the object before.
+struct SharedTransform {
+  const SceneObject* obj = nullptr;
+  const CameraBasis* basis = nullptr;
+  const Camera* cam = nullptr;
+  const Projection* proj = nullptr;
+  PVertex* verts = nullptr;
+  size_t n = 0;
+  alignas(64) std::atomic<size_t> next{0};
+  alignas(64) std::atomic<size_t> done{0};
+
+  static constexpr size_t kChunk = 64;
+  void work() {
+    for (size_t b; (b = next.fetch_add(kChunk, std::memory_order_relaxed)) < n;) {
+      const size_t e = std::min(b + kChunk, n);
+      transformVertexRange(*obj, *basis, *cam, *proj, verts, b, e);
+      done.fetch_add(e - b, std::memory_order_release);
+    }
+  }
+  void waitAll() const {
+    while (done.load(std::memory_order_acquire) < n) _mm_pause();
+  }
+};
+
 // A screen triangle of a two-thread frame, or a mark between objects, on its way from the
 // front end (SceneDrawer on the calling thread: culling, vertex colours, clipping, setup) to the
 // back end (drawBackEnd: the method's unit walks, z-tests, shades and writes it).
@@ -70,6 +98,7 @@ struct DrawJob {
   bool colour_attrs = true;         // Triangle: set up with colour attributes (else normals)
   uint32_t tag = 0;                 // Triangle
   size_t object = 0;                // BeginObject
+  mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
   std::array<PVertex, 3> v;         // Triangle: as set up
   SetupResult setup;                // Triangle
 };
@@ -93,8 +122,9 @@ class DrawQueue {
     }
     return slots_[head_ % kSlots];
   }
-  void push() {
-    if (++head_ % kBatch == 0 || slots_[(head_ - 1) % kSlots].kind == DrawJob::Kind::End)
+  void push() {  // shown at once: every kBatch-th job and the marks but EndObject
+    const DrawJob::Kind k = slots_[head_ % kSlots].kind;
+    if (++head_ % kBatch == 0 || k == DrawJob::Kind::End || k == DrawJob::Kind::BeginObject)
       written_.store(head_, std::memory_order_release);
   }
   // The reader: the next job (null when the writer aborted), released once done with.
@@ -288,8 +318,26 @@ void SceneDrawer::drawObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   lightObject(f_, scene_, engines_, oi);
   for (const auto& u : f_.units()) u.second->beginObject();
-  if (queue_ != nullptr) pushMark(*queue_, DrawJob::Kind::BeginObject, oi);
-  transformVertices(obj, basis_, scene_.camera, f_.proj, verts_);
+  if (queue_ == nullptr) {
+    transformVertices(obj, basis_, scene_.camera, f_.proj, verts_);
+  } else {
+    verts_.resize(obj.mesh.positions.size());
+    DrawJob& j = queue_->slot();
+    j.kind = DrawJob::Kind::BeginObject;
+    j.object = oi;
+    SharedTransform& t = j.transform;
+    t.obj = &obj;
+    t.basis = &basis_;
+    t.cam = &scene_.camera;
+    t.proj = &f_.proj;
+    t.verts = verts_.data();
+    t.n = verts_.size();
+    t.next.store(0, std::memory_order_relaxed);
+    t.done.store(0, std::memory_order_relaxed);
+    queue_->push();  // shown to the back end at once (release)
+    t.work();
+    t.waitAll();
+  }
   lit_.assign(verts_.size(), 0);
   size_t ti = 0;
   try {
@@ -391,6 +439,7 @@ bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         q.release();
         return true;
       case DrawJob::Kind::BeginObject:
+        j->transform.work();
         lightObject(f, scene, engines, j->object);
         for (const auto& u : f.units()) u.second->beginObject();
         break;
