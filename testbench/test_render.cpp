@@ -739,7 +739,7 @@ TEST(Render, TwoThreadsEqualOneThread) {
   for (const char* name : {"builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials"}) {
     const Scene s = loadScene(name);
     for (Method m : allMethods()) {
-      if (!traits(m).two_threads) continue;
+      if (traits(m).two_threads == TwoThreads::No) continue;
       for (const char* brdf : {"", "quadratic"}) {
         for (const char* mode : {"serial", "sierpinskifull"}) {
           const std::string what = fmt::format("{} {} brdf '{}' {}", name, toString(m), brdf, mode);
@@ -773,6 +773,33 @@ TEST(Render, TwoThreadsEqualOneThread) {
     }
   }
   EXPECT_EQ(compared, 4 * 3 * 2 * 2);
+  // phong-fixed's walk done ahead and replayed to a consumer without runs: a specular unit that
+  // is not the model batches each triangle's requests, and that path takes fragments alone.
+  struct Batched final : SpecEngine {
+    SpecEngine& inner;
+    explicit Batched(SpecEngine& i) : inner(i) {}
+    const PromTable& table() const override { return inner.table(); }
+    uint64_t evaluate(const std::vector<SpecRequest>& in, std::vector<std::array<uint32_t, 3>>& out) override {
+      return inner.evaluate(in, out);
+    }
+  };
+  const Scene sphere = loadScene("builtin:sphere");
+  ModelEngines e("evenodd");
+  Batched batched(*e.quad);
+  SpecEngines view;
+  view.quadratic = &batched;
+  RenderOptions o;
+  o.method = Method::PhongFixed;
+  o.brdf = "quadratic";
+  const RenderResult a = render(sphere, o, e.span, view);
+  o.threads = 2;
+  const RenderResult b = render(sphere, o, e.span, view);
+  EXPECT_EQ(a.fb.rgb, b.fb.rgb);
+  EXPECT_EQ(a.fb.depth, b.fb.depth);
+  EXPECT_EQ(a.fb.tri, b.fb.tri);
+  EXPECT_EQ(a.stats.spec_evaluations, b.stats.spec_evaluations);
+  EXPECT_EQ(a.stats.span_cycles, b.stats.span_cycles);
+  EXPECT_GT(a.stats.spec_evaluations, 0u);
 }
 
 // What cannot run on two threads is refused, naming why; an error on either thread reaches the

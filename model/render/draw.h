@@ -26,6 +26,19 @@
 
 namespace shd {
 
+// A screen triangle's span walk done ahead, by a two-thread frame's front end (render.cpp), for
+// its back end's Frame::walk to replay: the fragments and runs in the walk's order, and the
+// walk's counts (the front end's). The renderer's 4 attributes.
+struct RecordedWalk {
+  struct Event {
+    bool run = false;  // a RowRun, or the one fragment at (x0, y) with attributes a0
+    int32_t x0 = 0, y = 0, dx = 1;
+    int64_t count = 1;
+    std::array<int64_t, 4> a0{}, da{};
+  };
+  std::vector<Event> events;
+};
+
 // A screen triangle set up for the span unit, with the method that draws it.
 struct SpanTriangle {
   std::array<const PVertex*, 3> v;  // as set up (the fan's, or a split's)
@@ -33,6 +46,7 @@ struct SpanTriangle {
   const SetupResult& setup;  // setup.desc: its span descriptor; setup.plane: its attribute planes
   const RasterConfig& raster;
   uint32_t tag;  // its id: the index in RenderResult::triangles, the framebuffer's tri
+  const RecordedWalk* walked = nullptr;  // its walk done ahead, or null: Frame::walk walks it
 };
 
 class MethodUnit;
@@ -211,6 +225,10 @@ class Frame {
   // RTL's stream) collected first. The span cycles and fragments counted.
   template <class Sink, class... Runs>
   void walk(const SpanTriangle& t, Sink& sink, Runs&... runs) {
+    if (t.walked != nullptr) {
+      replay(*t.walked, sink, runs...);
+      return;
+    }
     if (walker != nullptr) {
       SpanWalk wk;
       if constexpr (sizeof...(Runs) == 0)
@@ -239,6 +257,24 @@ class Frame {
       st.pixels_covered += write(p, attr[3], combine(colourAt(x, y), nullptr, 0));
     };
     walk(t, fragment);
+  }
+  // A walk done ahead, to the same consumers: with no run consumer, a run's fragments one by
+  // one, which is what the walk gives such a consumer (a run is a row's fragments in order).
+  template <class Sink, class... Runs>
+  static void replay(const RecordedWalk& w, Sink& sink, Runs&... runs) {
+    for (const RecordedWalk::Event& e : w.events) {
+      if (!e.run) {
+        sink(e.x0, e.y, static_cast<const int64_t*>(e.a0.data()));
+      } else if constexpr (sizeof...(Runs) > 0) {
+        (runs(RowRun{e.x0, e.y, e.dx, e.count, e.a0.data(), e.da.data()}), ...);
+      } else {
+        std::array<int64_t, 4> a = e.a0;
+        for (int64_t i = 0; i < e.count; ++i) {
+          sink(e.x0 + static_cast<int32_t>(i) * e.dx, e.y, static_cast<const int64_t*>(a.data()));
+          for (size_t k = 0; k < a.size(); ++k) a[k] += e.da[k];
+        }
+      }
+    }
   }
   // The fragments of t from the span engine, in its order, into frags (counted).
   void collect(const SpanTriangle& t);

@@ -25,6 +25,7 @@ std::unique_ptr<MethodUnit> makeReferenceUnit(Frame& f);           // reference.
 
 namespace {
 constexpr Attributes C = Attributes::Colour, N = Attributes::Normal;
+constexpr TwoThreads No = TwoThreads::No, Setup = TwoThreads::AfterSetup, Walk = TwoThreads::AfterWalk;
 }  // namespace
 
 // In Method's order. The walk of each unit: colour runs (flat, gouraud; AVX-512 where the CPU
@@ -34,18 +35,18 @@ constexpr Attributes C = Attributes::Colour, N = Attributes::Normal;
 // modified-gouraud and adaptive draw their parts with the gouraud and phong units (their own
 // attributes are never set up).
 constexpr MethodTraits kMethodTable[] = {
-    // method                  name                 attr vertex pixel  exact  2 thr. unit
-    {Method::Flat,             "flat",              C, false, false, false, true,  makeFlatUnit},
-    {Method::Gouraud,          "gouraud",           C, true,  false, false, true,  makeGouraudUnit},
-    {Method::GouraudClassical, "gouraud-classical", C, true,  false, false, false, makeGouraudClassicalUnit},
-    {Method::Phong,            "phong",             N, false, true,  false, false, makePhongUnit},
-    {Method::PhongIncremental, "phong-incremental", N, false, true,  false, false, makePhongIncrementalUnit},
-    {Method::PhongFixed,       "phong-fixed",       N, false, true,  false, true,  makePhongFixedUnit},
-    {Method::NormalBisection,  "normal-bisection",  N, false, true,  false, false, makeNormalBisectionUnit},
-    {Method::Biquadratic,      "biquadratic",       C, true,  false, false, false, makeBiquadraticUnit},
-    {Method::ModifiedGouraud,  "modified-gouraud",  C, true,  false, false, false, makeModifiedGouraudUnit},
-    {Method::Adaptive,         "adaptive",          N, true,  false, false, false, makeAdaptiveUnit},
-    {Method::Reference,        "reference",         N, false, false, true,  false, makeReferenceUnit},
+    // method                  name                 attr vertex pixel  exact  2 threads unit
+    {Method::Flat,             "flat",              C, false, false, false, Setup,  makeFlatUnit},
+    {Method::Gouraud,          "gouraud",           C, true,  false, false, Setup,  makeGouraudUnit},
+    {Method::GouraudClassical, "gouraud-classical", C, true,  false, false, No,     makeGouraudClassicalUnit},
+    {Method::Phong,            "phong",             N, false, true,  false, No,     makePhongUnit},
+    {Method::PhongIncremental, "phong-incremental", N, false, true,  false, No,     makePhongIncrementalUnit},
+    {Method::PhongFixed,       "phong-fixed",       N, false, true,  false, Walk,   makePhongFixedUnit},
+    {Method::NormalBisection,  "normal-bisection",  N, false, true,  false, No,     makeNormalBisectionUnit},
+    {Method::Biquadratic,      "biquadratic",       C, true,  false, false, No,     makeBiquadraticUnit},
+    {Method::ModifiedGouraud,  "modified-gouraud",  C, true,  false, false, No,     makeModifiedGouraudUnit},
+    {Method::Adaptive,         "adaptive",          N, true,  false, false, No,     makeAdaptiveUnit},
+    {Method::Reference,        "reference",         N, false, false, true,  No,     makeReferenceUnit},
 };
 constexpr size_t kMethodCount = std::size(kMethodTable);
 
@@ -82,7 +83,7 @@ std::vector<Method> allMethods() {
 std::string twoThreadMethods() {
   std::string s;
   for (const MethodTraits& t : kMethodTable)
-    if (t.two_threads) s += (s.empty() ? "" : ", ") + std::string(t.name);
+    if (t.two_threads != TwoThreads::No) s += (s.empty() ? "" : ", ") + std::string(t.name);
   return s;
 }
 

@@ -20,6 +20,13 @@ class MethodUnit;
 // bits) or the normal (camera space, 28 fraction bits).
 enum class Attributes { Colour, Normal };
 
+// Where a two-thread frame hands a screen triangle from its front end to its back end.
+enum class TwoThreads {
+  No,          // one thread only
+  AfterSetup,  // set up by the front end; walked, shaded and written by the back end
+  AfterWalk,   // set up and walked by the front end (the back end's shading is the longer half)
+};
+
 struct MethodTraits {
   Method method;
   const char* name;
@@ -33,10 +40,10 @@ struct MethodTraits {
   // Exact: the lobes themselves (a device lobe's Blinn lobe, no specular unit) and the
   // framebuffer's lsb and spec_lsb.
   bool exact;
-  // A frame may run on two threads (RenderOptions::threads): the lobe is evaluated on one side
-  // alone, the front (vertex or polygon colours) or the back (per pixel), so the two threads
-  // share no specular unit and no object state (render.cpp).
-  bool two_threads;
+  // Whether and where a frame may split between two threads (RenderOptions::threads,
+  // render.cpp): the lobe is evaluated on one side alone, the front (vertex or polygon colours)
+  // or the back (per pixel), so the two threads share no specular unit and no object state.
+  TwoThreads two_threads;
   std::unique_ptr<MethodUnit> (*make)(Frame&);
 };
 

@@ -101,6 +101,8 @@ struct DrawJob {
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
   std::array<PVertex, 3> v;         // Triangle: as set up
   SetupResult setup;                // Triangle
+  bool walked = false;              // Triangle: walked by the front end (TwoThreads::AfterWalk), into walk
+  RecordedWalk walk;
 };
 
 // The jobs in order through a ring of slots, one thread writing and one reading. Each side
@@ -111,6 +113,15 @@ struct DrawJob {
 class DrawQueue {
  public:
   DrawQueue() : slots_(kSlots) {}
+  // Empty again for the next frame (the slots and their memory kept).
+  void reset() {
+    head_ = done_seen_ = tail_ = written_seen_ = 0;
+    written_.store(0, std::memory_order_relaxed);
+    done_.store(0, std::memory_order_relaxed);
+    failed_.store(false, std::memory_order_relaxed);
+    aborted_.store(false, std::memory_order_relaxed);
+    error_ = nullptr;
+  }
   // The writer: the next slot, filled in place, then push()ed.
   DrawJob& slot() {
     if (head_ - done_seen_ == kSlots) {
@@ -182,6 +193,7 @@ class BackThread {
     return t;
   }
   std::mutex frame;  // held by a two-thread frame from start() to wait()
+  DrawQueue queue;   // the frame's (under `frame`): its slots' memory kept from frame to frame
   // Runs job (which must not throw) on the back thread; wait() returns once it has.
   void start(const std::function<void()>& job) {
     job_ = &job;
@@ -256,6 +268,7 @@ class SceneDrawer {
 
  private:
   void lightVertices(const std::array<uint32_t, 3>& tri);
+  void walkAhead(const SpanDesc& d, RecordedWalk& w);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   void drawPart(const Part& part, uint32_t ti);
 
@@ -414,7 +427,34 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   job->colour_attrs = colour_attrs;
   job->tag = tag;
   for (size_t i = 0; i < 3; ++i) job->v[i] = *part.v[i];
+  job->walked = traits(part.method).two_threads == TwoThreads::AfterWalk;
+  if (job->walked) walkAhead(*s.desc, job->walk);
   queue_->push();
+}
+
+// A descriptor walked here, on the front end, for the back end to replay (Frame::replay), and
+// counted as Frame::walk counts it: on this side, with the span engine's stream.
+void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w) {
+  w.events.clear();
+  auto fragment = [&w](int32_t x, int32_t y, const int64_t* attr) {
+    RecordedWalk::Event& e = w.events.emplace_back();
+    e.x0 = x;
+    e.y = y;
+    std::copy(attr, attr + e.a0.size(), e.a0.begin());
+  };
+  auto run = [&w](const RowRun& r) {
+    RecordedWalk::Event& e = w.events.emplace_back();
+    e.run = true;
+    e.x0 = r.x0;
+    e.y = r.y;
+    e.dx = r.dx;
+    e.count = r.count;
+    std::copy(r.a0, r.a0 + e.a0.size(), e.a0.begin());
+    std::copy(r.da, r.da + e.da.size(), e.da.begin());
+  };
+  const SpanWalk wk = walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull());
+  f_.st.span_cycles += wk.cycles;
+  f_.st.fragments += wk.fragments;
 }
 
 // The back end of a two-thread frame: its own frame (its own counts) and the front end's
@@ -448,7 +488,8 @@ bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         break;
       case DrawJob::Kind::Triangle: {
         const std::array<const PVertex*, 3> v = {&j->v[0], &j->v[1], &j->v[2]};
-        f.unit(j->method).draw(SpanTriangle{v, j->method, j->setup, j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag});
+        f.unit(j->method).draw(SpanTriangle{v, j->method, j->setup, j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
+                                            j->walked ? &j->walk : nullptr});
         break;
       }
     }
@@ -466,7 +507,10 @@ bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
 void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
                       const ClearRect& clear, RenderResult& res) {
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) lightObject(front, scene, engines, oi);
-  DrawQueue q;
+  BackThread& worker = BackThread::instance();
+  const std::lock_guard<std::mutex> one_frame(worker.frame);
+  DrawQueue& q = worker.queue;
+  q.reset();
   SceneDrawer drawer(front, scene, engines, res.triangles, &q);
   const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res.fb, drawer);
   back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
@@ -478,8 +522,6 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
       q.fail(std::current_exception());
     }
   };
-  BackThread& worker = BackThread::instance();
-  const std::lock_guard<std::mutex> one_frame(worker.frame);
   worker.start(back_end);
   try {
     for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
@@ -595,7 +637,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   res.triangles.clear();
   if (opt.threads != 1 && opt.threads != 2)
     throw std::invalid_argument(fmt::format("render: threads {}: 1 or 2", opt.threads));
-  if (opt.threads == 2 && !traits(opt.method).two_threads)
+  if (opt.threads == 2 && traits(opt.method).two_threads == TwoThreads::No)
     throw std::invalid_argument(fmt::format("render: {} runs on one thread (two: {})", toString(opt.method),
                                             twoThreadMethods()));
   if (opt.threads == 2 && span.walker() == nullptr)
