@@ -56,6 +56,18 @@ RenderResult renderPhongFixedQuadratic(const Scene& s, SpanEngine& span, SpecEng
   return render(s, o, span, view);
 }
 
+// The eye just above builtin:plane's 8 x 8 plane, looking along it: the near plane (1e-6 ahead)
+// cuts the triangles under the eye up to 4 units to the side, which project to 4e12 px, beyond
+// the clipper's range.
+Scene planeBeyondTheClipper() {
+  Scene s = loadScene("builtin:plane");
+  s.camera.px_per_unit = 1e6;
+  s.camera.z_near = 1e-6;
+  s.camera.eye = {0.01, 0.1, 0.01};
+  s.camera.target = {0.01, 0.1, 1};
+  return s;
+}
+
 double maxError(const Framebuffer& a, const Framebuffer& ref) {
   double worst = 0;
   for (size_t i = 0; i < a.rgb.size(); ++i)
@@ -526,13 +538,7 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
 
 // The renderer names the object and the triangle whose projection leaves the clipper's range.
 TEST(RenderPipeline, ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle) {
-  // The eye just above the 8 x 8 plane, looking along it: the near plane (1e-6 ahead) cuts
-  // the triangles under the eye up to 4 units to the side, which project to 4e12 px.
-  Scene s = loadScene("builtin:plane");
-  s.camera.px_per_unit = 1e6;
-  s.camera.z_near = 1e-6;
-  s.camera.eye = {0.01, 0.1, 0.01};
-  s.camera.target = {0.01, 0.1, 1};
+  const Scene s = planeBeyondTheClipper();
   try {
     renderModel(s, Method::Gouraud, "", "serial");
     FAIL() << "rendered";
@@ -829,15 +835,9 @@ TEST(Render, TwoThreadsRefuseWhatTheyCannotDrawAndPassErrorsOn) {
   } rtl;
   o.threads = 2;
   EXPECT_THROW(render(sphere, o, rtl, e.view), std::invalid_argument);
-  // The front end's error: a projection beyond the clipper's range (as in
-  // RenderPipeline.ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle).
-  Scene plane = loadScene("builtin:plane");
-  plane.camera.px_per_unit = 1e6;
-  plane.camera.z_near = 1e-6;
-  plane.camera.eye = {0.01, 0.1, 0.01};
-  plane.camera.target = {0.01, 0.1, 1};
+  // The front end's error: a projection beyond the clipper's range.
   try {
-    render(plane, o, e.span, e.view);
+    render(planeBeyondTheClipper(), o, e.span, e.view);
     FAIL() << "rendered";
   } catch (const std::range_error& x) {
     EXPECT_NE(std::string(x.what()).find("builtin:plane: object 'plane' triangle "), std::string::npos) << x.what();
