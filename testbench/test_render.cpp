@@ -835,6 +835,22 @@ TEST(Render, TwoThreadsRefuseWhatTheyCannotDrawAndPassErrorsOn) {
   } rtl;
   o.threads = 2;
   EXPECT_THROW(render(sphere, o, rtl, e.view), std::invalid_argument);
+  // An error before the back end began (a device lobe without its specular unit): the frame
+  // after it, into the same buffers, still equals a frame drawn afresh (the clear was not lost).
+  {
+    const Scene torus = loadScene("builtin:torus");
+    RenderOptions g;
+    g.threads = 2;
+    RenderResult reused = render(torus, g, e.span, e.view);
+    g.brdf = "quadratic";
+    EXPECT_THROW(render(sphere, g, e.span, SpecEngines{}, reused), std::invalid_argument);
+    g.brdf = "";
+    render(sphere, g, e.span, e.view, reused);
+    const RenderResult fresh = render(sphere, g, e.span, e.view);
+    EXPECT_EQ(reused.fb.rgb, fresh.fb.rgb);
+    EXPECT_EQ(reused.fb.depth, fresh.fb.depth);
+    EXPECT_EQ(reused.fb.tri, fresh.fb.tri);
+  }
   // The front end's error: a projection beyond the clipper's range.
   try {
     render(planeBeyondTheClipper(), o, e.span, e.view);

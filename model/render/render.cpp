@@ -504,8 +504,8 @@ bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
 // frame before drew (clear); each side counts in its own
 // RenderStats, summed after. The objects' specular-unit codings are made here first, so that
 // the two sides' lightObject only read the units' memo of zero codes (SpecEngine::zeroCode).
-void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
-                      const ClearRect& clear, RenderResult& res) {
+void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
+                    const ClearRect& clear, RenderResult& res, bool& cleared) {
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) lightObject(front, scene, engines, oi);
   BackThread& worker = BackThread::instance();
   const std::lock_guard<std::mutex> one_frame(worker.frame);
@@ -517,6 +517,7 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
   const std::function<void()> back_end = [&] {
     try {
       clearRect(res.fb, clear);  // while the front end transforms and sets up the first triangles
+      cleared = true;
       drawBackEnd(q, *back, scene, engines);
     } catch (...) {
       q.fail(std::current_exception());
@@ -537,6 +538,20 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
   worker.wait();
   if (q.error()) std::rethrow_exception(q.error());
   res.stats += back->stats;
+}
+
+// drawTwoThreads, and on an error before the back end cleared the buffers (an object's lobe
+// without its specular unit, say) the clear done here: the buffers are then as one thread
+// leaves them, clear outside the drawn rectangle, which the next frame's clear relies on.
+void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
+                      const ClearRect& clear, RenderResult& res) {
+  bool cleared = false;  // set by the back end; read here once it has ended, or if it never began
+  try {
+    drawTwoThreads(scene, span, engines, front, clear, res, cleared);
+  } catch (...) {
+    if (!cleared) clearRect(res.fb, clear);
+    throw;
+  }
 }
 
 }  // namespace
