@@ -42,7 +42,8 @@ struct MethodTraits {
   bool exact;
   // Whether and where a frame may split between two threads (RenderOptions::threads,
   // render.cpp): the lobe is evaluated on one side alone, the front (vertex or polygon colours)
-  // or the back (per pixel), so the two threads share no specular unit and no object state.
+  // or the back (per pixel), so the two threads share no specular unit and no object state; and
+  // the unit's draw() reads the setup alone, not SpanTriangle::v (the back end passes none).
   TwoThreads two_threads;
   std::unique_ptr<MethodUnit> (*make)(Frame&);
 };

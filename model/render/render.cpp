@@ -99,7 +99,6 @@ struct DrawJob {
   uint32_t tag = 0;                 // Triangle
   size_t object = 0;                // BeginObject
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
-  std::array<PVertex, 3> v;         // Triangle: as set up
   SetupResult setup;                // Triangle
   bool walked = false;              // Triangle: walked by the front end (TwoThreads::AfterWalk), into walk
   RecordedWalk walk;
@@ -426,7 +425,6 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   job->method = part.method;
   job->colour_attrs = colour_attrs;
   job->tag = tag;
-  for (size_t i = 0; i < 3; ++i) job->v[i] = *part.v[i];
   job->walked = traits(part.method).two_threads == TwoThreads::AfterWalk;
   if (job->walked) walkAhead(*s.desc, job->walk);
   queue_->push();
@@ -487,7 +485,8 @@ bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         for (const auto& u : f.units()) u.second->endObject();
         break;
       case DrawJob::Kind::Triangle: {
-        const std::array<const PVertex*, 3> v = {&j->v[0], &j->v[1], &j->v[2]};
+        // No vertices: the methods that split a frame draw from the setup alone (methods.h).
+        const std::array<const PVertex*, 3> v = {nullptr, nullptr, nullptr};
         f.unit(j->method).draw(SpanTriangle{v, j->method, j->setup, j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
                                             j->walked ? &j->walk : nullptr});
         break;
