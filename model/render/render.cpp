@@ -410,11 +410,10 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   SetupResult& s = job != nullptr ? job->setup : setup_;
   setupTriangle(sv, tag, rc, s);
   if (!s.desc) return;  // no pixel centre inside (drawMeshTriangle counts the triangle culled)
-  ScreenTriangleInfo info;
-  info.object = f_.obj.index;
+  ScreenTriangleInfo& info = triangles_.emplace_back();  // filled in place: a local copied in
+  info.object = f_.obj.index;                           // stalled on its own partial stores
   info.mesh_triangle = ti;
   for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
-  triangles_.push_back(info);
   ++f_.st.drawn;
   markDrawn(f_.fb, part.v);
   if (job == nullptr) {
