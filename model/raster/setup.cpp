@@ -374,24 +374,14 @@ int RasterConfig::attrFracBits(int k) const {
   return attr_frac_bits[static_cast<size_t>(k)];
 }
 
-SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg) {
-  SetupResult res;
-  setupTriangle(v, tag, cfg, res);
-  return res;
-}
+namespace {
 
-void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg, SetupResult& res) {
+// The vertices snapped to the subpixel grid and the attributes to their codes, half to even, in
+// t's X, Y and a; std::invalid_argument naming the triangle for what cannot be set up.
+void snapVertices(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg, SnappedTriangle& t) {
   const SpanParams& p = cfg.unit;
   const int S = cfg.subpixel_bits, K = p.NumAttr;
-  // What res held and is not overwritten below (every other field is).
-  res.desc.reset();
-  res.dropped.clear();
-  res.tri.swapped = false;
-  res.plane.iref.clear();
-  res.plane.didx.clear();
-  res.plane.didy.clear();
-  SnappedTriangle& t = res.tri;
-  // Snap to the subpixel grid; the guard band bounds every width downstream.
+  // The guard band bounds every width downstream.
   const double guard = static_cast<double>(int64_t{1} << (p.CoordBits - 3));
   for (size_t i = 0; i < 3; ++i) {
     if (!std::isfinite(v[i].x) || !std::isfinite(v[i].y))
@@ -420,6 +410,28 @@ void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const Rast
       t.a[static_cast<size_t>(k)][i] = snapHalfEven(val, F);
     }
   }
+}
+
+}  // namespace
+
+SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg) {
+  SetupResult res;
+  setupTriangle(v, tag, cfg, res);
+  return res;
+}
+
+void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg, SetupResult& res) {
+  const SpanParams& p = cfg.unit;
+  const int S = cfg.subpixel_bits, K = p.NumAttr;
+  // What res held and is not overwritten below (every other field is).
+  res.desc.reset();
+  res.dropped.clear();
+  res.tri.swapped = false;
+  res.plane.iref.clear();
+  res.plane.didx.clear();
+  res.plane.didy.clear();
+  SnappedTriangle& t = res.tri;
+  snapVertices(v, tag, cfg, t);
   t.det = (t.X[1] - t.X[0]) * (t.Y[2] - t.Y[0]) - (t.X[2] - t.X[0]) * (t.Y[1] - t.Y[0]);
   if (t.det == 0) {
     res.dropped = "zero area";
