@@ -464,17 +464,17 @@ struct alignas(64) BackEnd {
       : rc_colour(front.rasterConfig(true)), rc_unit(front.rasterConfig(false)), f(scene, opt, span, fb, stats) {}
 };
 
-// The back end's jobs, in order, drawn by the units of its frame, until the end mark; false
-// when the front end aborted.
-bool drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines& engines) {
+// The back end's jobs, in order, drawn by the units of its frame, until the end mark or the
+// front end's abort.
+void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines& engines) {
   Frame& f = b.f;
   for (;;) {
     const DrawJob* j = q.next();
-    if (j == nullptr) return false;
+    if (j == nullptr) return;
     switch (j->kind) {
       case DrawJob::Kind::End:
         q.release();
-        return true;
+        return;
       case DrawJob::Kind::BeginObject:
         j->transform.work();
         lightObject(f, scene, engines, j->object);
