@@ -702,7 +702,7 @@ TEST(Render, VectorPathsEqualTheScalarPaths) {
 }
 
 // A frame rendered into the result of an earlier one, whose clear then covers only the
-// rectangle drawn before (clearFramebuffer), equals the frame rendered afresh: every buffer,
+// rectangle drawn before (prepareClear, clearRect), equals the frame rendered afresh: every buffer,
 // byte for byte, for a colour method, phong-fixed and the exact reference (its LSB buffers).
 TEST(Render, AFrameOverAnotherEqualsItRenderedAfresh) {
   const Scene sphere = loadScene("builtin:sphere"), torus = loadScene("builtin:torus");

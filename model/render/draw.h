@@ -26,9 +26,9 @@
 
 namespace shd {
 
-// A screen triangle's span walk done ahead, by a two-thread frame's front end (render.cpp), for
-// its back end's Frame::walk to replay: the fragments and runs in the walk's order, and the
-// walk's counts (the front end's). The renderer's 4 attributes.
+// A screen triangle's span walk done ahead, by a two-thread frame's front end (render.cpp, which
+// counts its cycles and fragments), for its back end's Frame::walk to replay: the fragments and
+// runs in the walk's order. The renderer's 4 attributes.
 struct RecordedWalk {
   struct Event {
     bool run = false;  // a RowRun, or the one fragment at (x0, y) with attributes a0

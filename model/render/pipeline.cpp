@@ -82,8 +82,6 @@ void clearRect(Framebuffer& fb, const ClearRect& r) {
   }
 }
 
-void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact) { clearRect(fb, prepareClear(fb, W, H, exact)); }
-
 namespace {
 
 // Vertex i of obj in camera space and, in front of the near plane, projected (v as PVertex{}

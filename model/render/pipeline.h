@@ -75,13 +75,11 @@ struct Projection {
   Vec3 vertexCam(const PVertex& v) const { return pixelCam(v.x - 0.5, v.y - 0.5, v.w); }
 };
 
-// The buffers of a W x H frame, cleared; lsb and spec_lsb only for an exact method. When fb
-// already holds a frame of that size and kind, only its drawn rectangle is cleared (the rest
-// is clear): the renderer marks every triangle it draws (Framebuffer::markDrawn).
-void clearFramebuffer(Framebuffer& fb, int W, int H, bool exact);
-// The same in two steps: prepareClear sizes the buffers (a new size or kind cleared whole) and
-// marks nothing drawn, and returns what is left to clear, the rectangle drawn before (x0 > x1:
-// nothing), which clearRect clears (a two-thread frame's back end, render.cpp).
+// The buffers of a W x H frame, cleared, in two steps: prepareClear sizes them (a new size or
+// kind cleared whole; lsb and spec_lsb only for an exact method) and marks nothing drawn, and
+// returns what is left to clear: when fb already held a frame of that size and kind, the
+// rectangle that frame drew (Framebuffer::markDrawn; the rest is clear), which clearRect
+// clears (x0 > x1: nothing). A two-thread frame's back end runs clearRect (render.cpp).
 struct ClearRect {
   int x0, y0, x1, y1;
   bool exact;

@@ -213,7 +213,7 @@ struct Framebuffer {
   std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
   bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
   // The pixels drawn since the buffers were last cleared lie in this rectangle (x0 > x1: none):
-  // the next clear of a frame of the same size and kind clears it alone (clearFramebuffer).
+  // the next clear of a frame of the same size and kind clears it alone (prepareClear, clearRect).
   // (A cache line of their own: a two-thread frame's front end marks them per triangle while
   // its back end reads the buffers' addresses above.)
   alignas(64) int drawn_x0 = INT_MAX, drawn_y0 = INT_MAX, drawn_x1 = INT_MIN, drawn_y1 = INT_MIN;
