@@ -100,8 +100,7 @@ struct DrawJob {
   size_t object = 0;                // BeginObject
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
   SetupResult setup;                // Triangle
-  bool walked = false;              // Triangle: walked by the front end (TwoThreads::AfterWalk), into walk
-  RecordedWalk walk;
+  RecordedWalk walk;                // Triangle: the front end's walk, for a TwoThreads::AfterWalk method
 };
 
 // The jobs in order through a ring of slots, one thread writing and one reading. Each side
@@ -312,20 +311,6 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
   rc_unit_.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
 }
 
-// The screen triangle v added to the framebuffer's drawn rectangle.
-void markDrawn(Framebuffer& fb, const std::array<const PVertex*, 3>& v) {
-  fb.markDrawn(std::min({v[0]->x, v[1]->x, v[2]->x}), std::min({v[0]->y, v[1]->y, v[2]->y}),
-               std::max({v[0]->x, v[1]->x, v[2]->x}), std::max({v[0]->y, v[1]->y, v[2]->y}));
-}
-
-// A mark for the back end of a two-thread frame.
-void pushMark(DrawQueue& q, DrawJob::Kind kind, size_t oi) {
-  DrawJob& j = q.slot();
-  j.kind = kind;
-  j.object = oi;
-  q.push();
-}
-
 void SceneDrawer::drawObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   lightObject(f_, scene_, engines_, oi);
@@ -358,7 +343,12 @@ void SceneDrawer::drawObject(size_t oi) {
     throw std::range_error(fmt::format("{}: object '{}' triangle {}: {}", scene_.name, obj.name, ti, e.what()));
   }
   for (const auto& u : f_.units()) u.second->endObject();
-  if (queue_ != nullptr) pushMark(*queue_, DrawJob::Kind::EndObject, oi);
+  if (queue_ != nullptr) {
+    DrawJob& j = queue_->slot();
+    j.kind = DrawJob::Kind::EndObject;
+    j.object = oi;
+    queue_->push();
+  }
 }
 
 // Gouraud vertex colours: computed when a triangle that is not culled first needs them.
@@ -415,7 +405,8 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   info.mesh_triangle = ti;
   for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
   ++f_.st.drawn;
-  markDrawn(f_.fb, part.v);
+  f_.fb.markDrawn(std::min({sv[0].x, sv[1].x, sv[2].x}), std::min({sv[0].y, sv[1].y, sv[2].y}),
+                  std::max({sv[0].x, sv[1].x, sv[2].x}), std::max({sv[0].y, sv[1].y, sv[2].y}));
   if (job == nullptr) {
     part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
     return;
@@ -424,8 +415,7 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   job->method = part.method;
   job->colour_attrs = colour_attrs;
   job->tag = tag;
-  job->walked = traits(part.method).two_threads == TwoThreads::AfterWalk;
-  if (job->walked) walkAhead(*s.desc, job->walk);
+  if (traits(part.method).two_threads == TwoThreads::AfterWalk) walkAhead(*s.desc, job->walk);
   queue_->push();
 }
 
@@ -486,8 +476,9 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
       case DrawJob::Kind::Triangle: {
         // No vertices: the methods that split a frame draw from the setup alone (methods.h).
         const std::array<const PVertex*, 3> v = {nullptr, nullptr, nullptr};
+        const bool walked = traits(j->method).two_threads == TwoThreads::AfterWalk;
         f.unit(j->method).draw(SpanTriangle{v, j->method, j->setup, j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
-                                            j->walked ? &j->walk : nullptr});
+                                            walked ? &j->walk : nullptr});
         break;
       }
     }
