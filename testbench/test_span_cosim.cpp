@@ -10,6 +10,10 @@
 #include <fstream>
 #include <memory>
 #include <random>
+#include <stdexcept>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "raster/desc_stream.h"
 #include "cosim/replay.h"
@@ -158,6 +162,131 @@ INSTANTIATE_TEST_SUITE_P(Pairs, SpanCosimWrongModel,
                          testing::Values(WrongModelCase{"seg2", "evenodd", 8, 32},
                                          WrongModelCase{"seg2full", "evenoddfull", 8, 3}),
                          [](const testing::TestParamInfo<WrongModelCase>& i) { return std::string(i.param.rtl); });
+
+namespace {
+
+std::string fileText(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+}
+
+// The same run on one thread and on two (SpanCosimOptions::threads), each with a fail directory
+// of its own under `dir`.
+std::array<SpanCosimResult, 2> oneAndTwoThreads(const std::string& mode,
+                                                const std::function<std::function<bool(SpanDesc&)>()>& make_stream,
+                                                SpanCosimOptions o, const fs::path& dir) {
+  std::array<SpanCosimResult, 2> r;
+  for (int t = 1; t <= 2; ++t) {
+    o.threads = t;
+    o.fail_dir = (dir / std::to_string(t)).string();
+    fs::create_directories(o.fail_dir);
+    r[static_cast<size_t>(t - 1)] = runSpanCosim(mode, make_stream(), o);
+  }
+  return r;
+}
+
+}  // namespace
+
+// Two threads (the stimulus and the model ahead of the RTL) give one thread's result: every
+// mode's counts on a stream, and with a wrong model the first mismatch, the count of them up to
+// the limit and the saved case, byte for byte; also with one-pixel triangles back to back. A limit of one mismatch stops the checker while
+// the stimulus, 20,000 triangles from its end, waits for room in the ring.
+TEST(SpanCosim, TwoThreadsEqualOneThread) {
+  const fs::path dir = shd::testutil::freshTestDir("span_cosim");
+  for (const std::string& mode : rtlSpanConfigs()) {  // every mode of a full build
+    SpanCosimOptions o;
+    o.seed = 9;
+    const auto r = oneAndTwoThreads(mode, [&] { return stream(mode, 20261126, 3000); }, o, dir / mode);
+    EXPECT_GT(r[0].triangles, 2000u) << mode;
+    EXPECT_EQ(r[0].mismatches, 0u) << mode << ": " << (r[0].first ? r[0].first->what : "");
+    EXPECT_EQ(r[1].triangles, r[0].triangles) << mode;
+    EXPECT_EQ(r[1].fragments, r[0].fragments) << mode;
+    EXPECT_EQ(r[1].cycles, r[0].cycles) << mode;
+    EXPECT_EQ(r[1].mismatches, r[0].mismatches) << mode;
+  }
+  // One-pixel triangles back to back, the consumer always ready: a descriptor every few cycles,
+  // the most the stimulus can take ahead of the checker (SpanStimulus' ring of descriptors).
+  for (const std::string mode : {"serialfull", "seg8full", "sierpinskifull"}) {
+    SpanCosimOptions o;
+    o.ready_prob = 1;
+    o.desc_gap_prob = 0;
+    o.drain_every = 0;
+    const auto tiny = [&] {
+      RasterConfig cfg;
+      cfg.unit = spanParams(mode);
+      TriGenOptions g;
+      g.size_weight = {1, 0, 0, 0, 0};
+      auto s = std::make_shared<DescriptorStream>(77, 20000, cfg, g);
+      return std::function<bool(SpanDesc&)>([s](SpanDesc& d) { return s->next(d); });
+    };
+    const auto r = oneAndTwoThreads(mode, tiny, o, dir / (mode + "_tiny"));
+    EXPECT_GT(r[0].triangles, 5000u) << mode;
+    EXPECT_LT(r[0].cycles, 4 * r[0].triangles) << mode;
+    EXPECT_EQ(r[0].mismatches, 0u) << mode << ": " << (r[0].first ? r[0].first->what : "");
+    EXPECT_EQ(r[1].mismatches, 0u) << mode << ": " << (r[1].first ? r[1].first->what : "");
+    EXPECT_EQ(r[1].triangles, r[0].triangles) << mode;
+    EXPECT_EQ(r[1].fragments, r[0].fragments) << mode;
+    EXPECT_EQ(r[1].cycles, r[0].cycles) << mode;
+  }
+  for (const uint64_t limit : {uint64_t{16}, uint64_t{1}}) {
+    for (const WrongModelCase& w : {WrongModelCase{"seg2", "evenodd", 8, 32}, WrongModelCase{"seg2full", "evenoddfull", 8, 3}}) {
+      SpanCosimOptions o;
+      o.model_params = spanParams(w.model);
+      o.drain_every = w.drain_every;
+      o.max_mismatches = limit;
+      const auto r = oneAndTwoThreads(
+          w.rtl,
+          [&] {
+            return alikeFirst(w.rtl, w.model, w.alike, 5, 20000, std::make_shared<std::vector<uint32_t>>());
+          },
+          o, dir / fmt::format("{}_{}", w.rtl, limit));
+      ASSERT_TRUE(r[0].first.has_value()) << w.rtl;
+      ASSERT_TRUE(r[1].first.has_value()) << w.rtl;
+      EXPECT_EQ(r[0].mismatches, limit) << w.rtl;
+      EXPECT_EQ(r[1].mismatches, r[0].mismatches) << w.rtl;
+      EXPECT_EQ(r[1].first->cycle, r[0].first->cycle) << w.rtl;
+      EXPECT_EQ(r[1].first->tag, r[0].first->tag) << w.rtl;
+      EXPECT_EQ(r[1].first->what, r[0].first->what) << w.rtl;
+      EXPECT_EQ(r[1].cycles, r[0].cycles) << w.rtl;
+      EXPECT_EQ(r[1].triangles, r[0].triangles) << w.rtl;
+      EXPECT_EQ(r[1].fragments, r[0].fragments) << w.rtl;
+      ASSERT_TRUE(r[0].case_note.empty() && r[1].case_note.empty()) << r[0].case_note << r[1].case_note;
+      EXPECT_EQ(fileText(r[1].vector_path), fileText(r[0].vector_path)) << w.rtl;
+      EXPECT_GT(fileText(r[0].vector_path).size(), 100u);
+      nlohmann::json c0 = nlohmann::json::parse(fileText(r[0].case_path));
+      nlohmann::json c1 = nlohmann::json::parse(fileText(r[1].case_path));
+      c0.erase("vectors");
+      c1.erase("vectors");
+      EXPECT_EQ(c1, c0) << w.rtl;
+    }
+  }
+}
+
+// An error of the stream (the stimulus' thread) reaches the caller, as on one thread; so does a
+// thread count other than 1 or 2.
+TEST(SpanCosim, TwoThreadsPassTheStreamsErrorOn) {
+  for (int threads : {1, 2}) {
+    auto next = stream("serialfull", 3, 5000);
+    auto count = std::make_shared<int>(0);
+    SpanCosimOptions o;
+    o.threads = threads;
+    o.fail_dir = shd::testutil::freshTestDir("span_cosim").string();
+    try {
+      runSpanCosim("serialfull", [=](SpanDesc& d) {
+        if (++*count == 700) throw std::runtime_error("descriptor 700 is unreadable");
+        return next(d);
+      }, o);
+      ADD_FAILURE() << threads << " threads: no error";
+    } catch (const std::runtime_error& e) {
+      EXPECT_STREQ(e.what(), "descriptor 700 is unreadable") << threads << " threads";
+    }
+  }
+  for (int threads : {0, 3}) {
+    SpanCosimOptions o;
+    o.threads = threads;
+    EXPECT_THROW(runSpanCosim("serial", stream("serial", 3, 10), o), std::invalid_argument) << threads;
+  }
+}
 
 TEST(SpanCosim, AGeneratedVectorFileOfTheRealModelReplaysClean) {
   // The counterpart of the saved failing case: the correct model's expectations pass.

@@ -21,6 +21,7 @@
 
 #include <fmt/format.h>
 
+#include "io/spsc_ring.h"
 #include "render/draw.h"
 #include "render/methods.h"
 #include "render/pipeline.h"
@@ -103,80 +104,9 @@ struct DrawJob {
   RecordedWalk walk;                // Triangle: the front end's walk, for a TwoThreads::AfterWalk method
 };
 
-// The jobs in order through a ring of slots, one thread writing and one reading. Each side
-// makes its progress visible to the other every kBatch jobs and before it waits, so neither
-// waits for a count the other has not yet shown. Both wait by spinning (a frame is about a
-// millisecond: a sleep and wake-up costs more than the wait), yielding after a while. The
-// reader's failure stops the writer (failed()), the writer's the reader (abort()).
-class DrawQueue {
- public:
-  DrawQueue() : slots_(kSlots) {}
-  // Empty again for the next frame (the slots and their memory kept).
-  void reset() {
-    head_ = done_seen_ = tail_ = written_seen_ = 0;
-    written_.store(0, std::memory_order_relaxed);
-    done_.store(0, std::memory_order_relaxed);
-    failed_.store(false, std::memory_order_relaxed);
-    aborted_.store(false, std::memory_order_relaxed);
-    error_ = nullptr;
-  }
-  // The writer: the next slot, filled in place, then push()ed.
-  DrawJob& slot() {
-    if (head_ - done_seen_ == kSlots) {
-      written_.store(head_, std::memory_order_release);
-      for (unsigned spin = 0; head_ - (done_seen_ = done_.load(std::memory_order_acquire)) == kSlots; ++spin) {
-        if (failed_.load(std::memory_order_acquire)) throw BackEndFailed{};
-        pause(spin);
-      }
-    }
-    return slots_[head_ % kSlots];
-  }
-  void push() {  // shown at once: every kBatch-th job and the marks but EndObject
-    const DrawJob::Kind k = slots_[head_ % kSlots].kind;
-    if (++head_ % kBatch == 0 || k == DrawJob::Kind::End || k == DrawJob::Kind::BeginObject)
-      written_.store(head_, std::memory_order_release);
-  }
-  // The reader: the next job (null when the writer aborted), released once done with.
-  const DrawJob* next() {
-    if (tail_ == written_seen_) {
-      done_.store(tail_, std::memory_order_release);
-      for (unsigned spin = 0; tail_ == (written_seen_ = written_.load(std::memory_order_acquire)); ++spin) {
-        if (aborted_.load(std::memory_order_acquire)) return nullptr;
-        pause(spin);
-      }
-    }
-    return &slots_[tail_ % kSlots];
-  }
-  void release() {
-    if (++tail_ % kBatch == 0) done_.store(tail_, std::memory_order_release);
-  }
-  void fail(std::exception_ptr e) {
-    error_ = std::move(e);
-    failed_.store(true, std::memory_order_release);
-  }
-  void abort() { aborted_.store(true, std::memory_order_release); }
-  // After the reader has ended (joined): its exception, if it failed.
-  std::exception_ptr error() const { return error_; }
-  // Thrown by slot() when the reader has failed.
-  struct BackEndFailed {};
-
- private:
-  static constexpr size_t kSlots = 256, kBatch = 16;
-  static void pause(unsigned spin) {
-    if (spin < 1024) _mm_pause();
-    else std::this_thread::yield();
-  }
-  // Each side's own fields in cache lines of their own: a line written by one thread and read
-  // by the other moves between the cores at every write (on builtin:sphere's two-thread gouraud
-  // frame the writer's load of head_, beside the reader's tail_, took a tenth of its time).
-  std::vector<DrawJob> slots_;
-  std::exception_ptr error_;
-  alignas(64) size_t head_ = 0, done_seen_ = 0;     // the writer's
-  alignas(64) size_t tail_ = 0, written_seen_ = 0;  // the reader's
-  alignas(64) std::atomic<size_t> written_{0};
-  alignas(64) std::atomic<size_t> done_{0};
-  alignas(64) std::atomic<bool> failed_{false}, aborted_{false};
-};
+// The jobs in order, from the front end to the back end: 256 slots, shown 16 at a time and at
+// each object's start (its vertices, which the back end helps with) and the frame's end.
+using DrawQueue = SpscRing<DrawJob, 256, 16>;
 
 // The thread that draws the back ends of two-thread frames: made with the first and kept for
 // the next, one frame at a time (`frame`). Between frames it spins for up to 2 ms before it
@@ -331,7 +261,7 @@ void SceneDrawer::drawObject(size_t oi) {
     t.n = verts_.size();
     t.next.store(0, std::memory_order_relaxed);
     t.done.store(0, std::memory_order_relaxed);
-    queue_->push();  // shown to the back end at once (release)
+    queue_->push(true);  // shown to the back end at once (release)
     t.work();
     t.waitAll();
   }
@@ -509,15 +439,15 @@ void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& eng
       cleared = true;
       drawBackEnd(q, *back, scene, engines);
     } catch (...) {
-      q.fail(std::current_exception());
+      q.stop(std::current_exception());
     }
   };
   worker.start(back_end);
   try {
     for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
     q.slot().kind = DrawJob::Kind::End;
-    q.push();
-  } catch (const DrawQueue::BackEndFailed&) {
+    q.push(true);
+  } catch (const DrawQueue::ReaderStopped&) {
     // the back end's exception, below
   } catch (...) {
     q.abort();

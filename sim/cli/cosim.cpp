@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -39,6 +40,10 @@ class CosimCmd final : public Command {
                    "span unit: after this many descriptors, offer none until the unit is idle, so that a failing "
                    "case replays from a short window (the full-rate unit is otherwise never idle); 0: never")
         ->check(countIn(0, kMaxStreamTriangles));
+    app.add_option("--threads", threads_,
+                   "span unit: 2 runs the stimulus and the model on a second thread, ahead of the verilated unit "
+                   "(the same result); default 2 where the machine has two hardware threads, else 1")
+        ->check(countIn(1, 2));
     table_.add(app);
     app.add_option("--prom", prom_, "PROM hex file the RTL loads (default: the table written to a temporary file); "
                                     "it must hold the table the options describe");
@@ -60,7 +65,7 @@ class CosimCmd final : public Command {
                     "applies to --unit spec only");
       return runSpan();
     }
-    requireAbsent(app, {"--mode", "--triangles", "--ready", "--drain-every"}, "applies to --unit span only");
+    requireAbsent(app, {"--mode", "--triangles", "--ready", "--drain-every", "--threads"}, "applies to --unit span only");
     if (exhaustive_) requireAbsent(app, {"--vectors", "--gap"}, "and --exhaustive exclude each other");
     return runSpec();
   }
@@ -69,6 +74,7 @@ class CosimCmd final : public Command {
   TableOptions table_;
   std::string unit_ = "spec", prom_, fail_dir_ = ".", mode_ = "serial";
   uint64_t triangles_ = 100000, drain_every_ = SpanCosimOptions{}.drain_every;
+  int threads_ = std::thread::hardware_concurrency() >= 2 ? 2 : 1;
   double ready_prob_ = 0.8;
   bool exhaustive_ = false, json_ = false, quiet_ = false;
   uint64_t vectors_ = 1'000'000, seed_ = 1;
@@ -95,6 +101,7 @@ int CosimCmd::runSpan() {
   o.seed = seed_;
   o.ready_prob = ready_prob_;
   o.drain_every = drain_every_;
+  o.threads = threads_;
   o.fail_dir = fs::absolute(fail_dir_).string();
   o.progress = [&](uint64_t) {
     progress.update(static_cast<double>(descs.generated()), static_cast<double>(triangles_), "triangles");
@@ -104,6 +111,7 @@ int CosimCmd::runSpan() {
     nlohmann::json j = {{"unit", "span"},
                         {"mode", cfg.name},
                         {"seed", seed_},
+                        {"threads", threads_},
                         {"triangles", r.triangles},
                         {"generated", descs.generated()},
                         {"dropped_at_setup", descs.dropped()},
@@ -118,11 +126,11 @@ int CosimCmd::runSpan() {
     std::cout << j.dump(2) << "\n";
   } else {
     std::printf("cosim span/%s seed %llu: %llu triangles drawn (%llu generated, %llu dropped by setup), %llu fragments, "
-                "%llu cycles, %llu mismatches, %.2f s (%.1f M fragments/s)\n",
+                "%llu cycles, %llu mismatches, %.2f s on %d thread%s (%.1f M fragments/s)\n",
                 cfg.name.c_str(), static_cast<unsigned long long>(seed_), static_cast<unsigned long long>(r.triangles),
                 static_cast<unsigned long long>(descs.generated()), static_cast<unsigned long long>(descs.dropped()),
                 static_cast<unsigned long long>(r.fragments), static_cast<unsigned long long>(r.cycles),
-                static_cast<unsigned long long>(r.mismatches), r.seconds,
+                static_cast<unsigned long long>(r.mismatches), r.seconds, threads_, threads_ == 1 ? "" : "s",
                 r.seconds > 0 ? r.fragments / r.seconds / 1e6 : 0.0);
   }
   if (r.first) {

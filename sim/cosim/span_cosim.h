@@ -37,6 +37,11 @@ struct SpanCosimOptions {
   // (below) is replayed from the last idle cycle.
   uint64_t drain_every = 32;
   std::function<void(uint64_t done)> progress;  // called every 4096 triangles
+  // 2: the stimulus and the model (`next` and `progress` with them) on a thread of their own,
+  // up to 256 cycles ahead of the verilated unit, which stays on the calling thread. The result
+  // is the same as on one thread; only where the run stops early (max_mismatches) may `next`
+  // have been called for descriptors the run did not reach.
+  int threads = 1;
   // Fault injection for the checker's own tests: run the model with other parameters than
   // the verilated unit (e.g. another lane layout) so that the comparison must fail.
   std::optional<SpanParams> model_params;
