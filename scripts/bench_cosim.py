@@ -2,7 +2,7 @@
 """bench_cosim.py: the span co-simulation's speed on one thread and on two, measured side by side.
 
   scripts/bench_cosim.py [--modes serial,seg4,...] [--rounds R] [--triangles N] [--seed S]
-                         [--shadesim BIN] [--json-out FILE]
+                         [--shadesim BIN]
 
 Every round runs, for every mode, `shadesim cosim --unit span --mode MODE --triangles N --seed S
 --threads T` with T = 1 and T = 2, one after the other (1 first on odd rounds, 2 first on even
@@ -78,7 +78,6 @@ def main(argv):
     p.add_argument("--triangles", type=int, default=200000)
     p.add_argument("--seed", type=int, default=7)
     p.add_argument("--shadesim", default=os.path.join(ROOT, "build", "sim", "shadesim"))
-    p.add_argument("--json-out")
     a = p.parse_args(argv)
     try:
         if a.rounds < 1 or a.triangles < 1 or a.seed < 0:
@@ -98,10 +97,6 @@ def main(argv):
         print(f"bench_cosim: {e}", file=sys.stderr)
         return 2
     report(a, results)
-    if a.json_out:
-        with open(a.json_out + ".tmp", "w", encoding="utf-8") as f:
-            json.dump({"triangles": a.triangles, "seed": a.seed, "rounds": a.rounds, "modes": results}, f, indent=1)
-        os.replace(a.json_out + ".tmp", a.json_out)
     return 0
 
 

@@ -181,7 +181,7 @@ constexpr size_t kDescSlots = kMaxHeld + (kChunks + 1) * kChunkCycles + 2;
 class alignas(64) SpanStimulus {
  public:
   SpanStimulus(const SpanParams& p, const std::function<bool(SpanDesc&)>& next, const SpanCosimOptions& opts,
-           std::vector<SpanDesc>& descs)
+               std::vector<SpanDesc>& descs)
       : model_(p), next_(next), opts_(opts), descs_(descs), rng_(opts.seed), ready_(opts.ready_prob),
         gap_(opts.desc_gap_prob) {
     model_.reset();
@@ -334,14 +334,11 @@ class alignas(64) SpanChecker {
 // A chunk of cycles packed for the checker's thread: per cycle what SpanDut::tickCheck
 // compares, in 64-bit words. A word of the inputs, desc_ready, out_valid, the attributes per
 // valid lane and the lanes' valid bits; the tag when out_valid; per valid lane a word of its
-// pixel and one per attribute. (The records of the model's outputs as they are, lanes of
-// every attribute the unit could have, took two to four times the bytes; the slower of this
-// VM's two core placements moves them at about 13 ns per 64-byte line, which then made two
-// threads slower than one.)
-// Each in cache lines of its own: chunks side by side in a line put the writer's stores to one
-// (each word appended moves its vector's end) under the reader's loads from the one before,
-// and on this VM's slower core placement the line's trips between the cores made two threads
-// run at half the speed of one.
+// pixel and one per attribute (serial: 7 words on a cycle with a fragment, against 200 bytes
+// of SpanOut with its lanes' room for 16 attributes). Each chunk in cache lines of its own:
+// chunks side by side in a line put the writer's stores to one (each word appended moves its
+// vector's end) under the reader's loads from the one before, and the line's trips between the
+// cores held serial's two threads to 8 M fragments/s on this VM's slower core placement.
 struct alignas(64) CycleChunk {
   std::vector<uint64_t> words;
   uint64_t first_cycle = 0;  // the model's cycles before the chunk's first
@@ -350,9 +347,10 @@ struct alignas(64) CycleChunk {
 };
 
 // The n words at p fetched for writing (PREFETCHW), all at once, before the cycles are packed
-// into them: the reader's core last read them, and stores that each wait for their line (a few
-// lines in flight fill the store queue) made two threads run at half the speed of one on this
-// VM's slower core placement (a core-to-core round trip of 550 ns instead of 120).
+// into them. The reader's core last read them; a store waits for its line, and a few lines in
+// flight fill the store queue. On this VM's slower core placement (a core-to-core round trip of
+// about 550 ns instead of 120) that held serial's two threads to 8 M fragments/s, and 15.5-16
+// with the prefetch; on the faster one both ran 17.5-18.3.
 void prefetchForWrite(const uint64_t* p, size_t n) {
   for (size_t i = 0; i < n; i += 8) asm volatile("prefetchw %0" ::"m"(p[i]));
 }
