@@ -206,7 +206,9 @@ TEST(SpanCosim, TwoThreadsEqualOneThread) {
   }
   // One-pixel triangles back to back, the consumer always ready: a descriptor every few cycles,
   // the most the stimulus can take ahead of the checker (SpanStimulus' ring of descriptors).
+  const std::vector<std::string> built = rtlSpanConfigs();
   for (const std::string mode : {"serialfull", "seg8full", "sierpinskifull"}) {
+    if (std::find(built.begin(), built.end(), mode) == built.end()) continue;  // not in a subset build
     SpanCosimOptions o;
     o.ready_prob = 1;
     o.desc_gap_prob = 0;
