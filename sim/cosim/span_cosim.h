@@ -9,6 +9,8 @@
 // FST waveform), and saved as a vector file (sim/vectors/vector_file.h: the descriptors, the
 // inputs and the model's expected outputs, cycle by cycle) that `shadesim replay` and the Icarus
 // testbench replay alone; the last descriptor and the out_ready pattern are also written as JSON.
+// On two threads (SpanCosimOptions::threads) the stimulus and the model run ahead of the
+// verilated unit on a thread of their own, with the same result.
 #pragma once
 
 #include <cstdint>
