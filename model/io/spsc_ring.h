@@ -45,6 +45,8 @@ class SpscRing {
     }
     return slots_[head_ % Slots];
   }
+  // The writer's slot k after the current one, to prefetch (the reader may still hold it).
+  const T& ahead(size_t k) const { return slots_[(head_ + k) % Slots]; }
   void push(bool show_now = false) {
     if (++head_ % Batch == 0 || show_now) written_.store(head_, std::memory_order_release);
   }
