@@ -10,6 +10,7 @@
 
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <exception>
 #include <thread>
 #include <vector>
@@ -17,6 +18,15 @@
 #include <immintrin.h>
 
 namespace shd {
+
+// The cache lines of [from, to) fetched for writing (PREFETCHW). A writer's next slots were last
+// read by the reader's core: without it each store to them waits for its line, and a few lines
+// in flight fill the store queue (the users say what it saved).
+inline void prefetchForWrite(const void* from, const void* to) {
+  const uintptr_t end = reinterpret_cast<uintptr_t>(to);
+  for (uintptr_t a = reinterpret_cast<uintptr_t>(from) & ~uintptr_t{63}; a < end; a += 64)
+    asm volatile("prefetchw %0" ::"m"(*reinterpret_cast<const char*>(a)));
+}
 
 template <class T, size_t Slots, size_t Batch>
 class SpscRing {

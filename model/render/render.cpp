@@ -113,22 +113,18 @@ struct DrawJob {
 // builtin:sphere took 1.11 ms, more than one thread's, and 0.585 with it (docs/performance.md;
 // the whole slot fetched: 0.85-0.91, and 3 % slower when the cores are near).
 void prefetchJobForWrite(const DrawJob& j) {
-  auto lines = [](const void* from, const void* to) {
-    for (const char* c = static_cast<const char*>(from); c < static_cast<const char*>(to); c += 64)
-      asm volatile("prefetchw %0" ::"m"(*c));
-  };
-  auto object = [&](const auto& o) { lines(&o, &o + 1); };
+  auto object = [](const auto& o) { prefetchForWrite(&o, &o + 1); };
   const SetupResult& s = j.setup;
-  lines(&j, &j.transform);
+  prefetchForWrite(&j, &j.transform);
   if (s.desc) {
-    lines(&*s.desc, &s.desc->tri[0] + 1);
-    lines(reinterpret_cast<const char*>(&s.desc + 1) - 1, &s.desc + 1);  // the lane-triangles' count, engaged
+    prefetchForWrite(&*s.desc, &s.desc->tri[0] + 1);
+    prefetchForWrite(reinterpret_cast<const char*>(&s.desc + 1) - 1, &s.desc + 1);  // the lane-triangles' count, engaged
   }
   object(s.dropped);
   object(s.tri);
   object(s.edges);
   object(s.plane);
-  lines(j.walk.events.data(), j.walk.events.data() + j.walk.events.size());  // as many as the slot's last walk
+  prefetchForWrite(j.walk.events.data(), j.walk.events.data() + j.walk.events.size());  // as many as the slot's last walk
 }
 
 // The jobs in order, from the front end to the back end: 256 slots, shown 16 at a time and at

@@ -346,15 +346,6 @@ struct alignas(64) CycleChunk {
   bool end = false;  // the stream ended after these cycles
 };
 
-// The n words at p fetched for writing (PREFETCHW), all at once, before the cycles are packed
-// into them. The reader's core last read them; a store waits for its line, and a few lines in
-// flight fill the store queue. On this VM's slower core placement (a core-to-core round trip of
-// about 550 ns instead of 120) that held serial's two threads to 8 M fragments/s, and 15.5-16
-// with the prefetch; on the faster one both ran 17.5-18.3.
-void prefetchForWrite(const uint64_t* p, size_t n) {
-  for (size_t i = 0; i < n; i += 8) asm volatile("prefetchw %0" ::"m"(p[i]));
-}
-
 void packCycle(const CycleInputs& c, const SpanOut& exp, std::vector<uint64_t>& w) {
   uint64_t mask = 0, nattr = 0;
   for (size_t l = 0; l < exp.lane.size(); ++l)
@@ -410,7 +401,11 @@ uint64_t runTwoThreads(SpanStimulus& stim, SpanChecker& checker, const SpanParam
       for (bool more = true; more;) {
         CycleChunk& k = ring.slot();
         k.words.clear();
-        prefetchForWrite(k.words.data(), k.words.capacity());
+        // Its lines fetched for writing all at once, before the cycles are packed into them. On
+        // this VM's slower core placement (a core-to-core round trip of about 550 ns instead of
+        // 120) that took serial's two threads from 8 M fragments/s to 15.5-16; on the faster
+        // one both ran 17.5-18.3.
+        prefetchForWrite(k.words.data(), k.words.data() + k.words.capacity());
         k.first_cycle = stim.cycle();
         k.cycles = 0;
         while (k.cycles < kChunkCycles && (more = stim.step(c, exp))) {
