@@ -18,6 +18,7 @@
 #include "raster/desc_stream.h"
 #include "cosim/replay.h"
 #include "cosim/span_cosim.h"
+#include "io/files.h"
 #include "vectors/vector_gen.h"
 // Verilator's own headers are not -Wextra clean (verilated_types.h:1127, an unused parameter).
 #pragma GCC diagnostic push
@@ -158,17 +159,14 @@ TEST_P(SpanCosimWrongModel, IsDetectedAndItsSavedCaseFailsAloneAtItsLastCycle) {
               rr.first->describe().c_str());
 }
 
-INSTANTIATE_TEST_SUITE_P(Pairs, SpanCosimWrongModel,
-                         testing::Values(WrongModelCase{"seg2", "evenodd", 8, 32},
-                                         WrongModelCase{"seg2full", "evenoddfull", 8, 3}),
+const WrongModelCase kWrongModels[] = {{"seg2", "evenodd", 8, 32}, {"seg2full", "evenoddfull", 8, 3}};
+
+INSTANTIATE_TEST_SUITE_P(Pairs, SpanCosimWrongModel, testing::ValuesIn(kWrongModels),
                          [](const testing::TestParamInfo<WrongModelCase>& i) { return std::string(i.param.rtl); });
 
 namespace {
 
-std::string fileText(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-}
+std::string fileText(const std::string& path) { return readInputFile(path, uint64_t{1} << 30); }
 
 // The same run on one thread and on two (SpanCosimOptions::threads), each with a fail directory
 // of its own under `dir`.
@@ -231,7 +229,7 @@ TEST(SpanCosim, TwoThreadsEqualOneThread) {
     EXPECT_EQ(r[1].cycles, r[0].cycles) << mode;
   }
   for (const uint64_t limit : {uint64_t{16}, uint64_t{1}}) {
-    for (const WrongModelCase& w : {WrongModelCase{"seg2", "evenodd", 8, 32}, WrongModelCase{"seg2full", "evenoddfull", 8, 3}}) {
+    for (const WrongModelCase& w : kWrongModels) {
       SpanCosimOptions o;
       o.model_params = spanParams(w.model);
       o.drain_every = w.drain_every;

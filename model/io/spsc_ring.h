@@ -28,6 +28,13 @@ inline void prefetchForWrite(const void* from, const void* to) {
     asm volatile("prefetchw %0" ::"m"(*reinterpret_cast<const char*>(a)));
 }
 
+// One round of a wait by spinning: a pause, and after 1,024 rounds a yield, so that a waiter
+// sharing its core with the thread it waits for lets it run.
+inline void spinPause(unsigned spin) {
+  if (spin < 1024) _mm_pause();
+  else std::this_thread::yield();
+}
+
 template <class T, size_t Slots, size_t Batch>
 class SpscRing {
   static_assert(Slots % Batch == 0, "a batch never wraps");
@@ -50,7 +57,7 @@ class SpscRing {
       written_.store(head_, std::memory_order_release);
       for (unsigned spin = 0; head_ - (done_seen_ = done_.load(std::memory_order_acquire)) == Slots; ++spin) {
         if (stopped_.load(std::memory_order_acquire)) throw ReaderStopped{};
-        pause(spin);
+        spinPause(spin);
       }
     }
     return slots_[head_ % Slots];
@@ -69,7 +76,7 @@ class SpscRing {
       done_.store(tail_, std::memory_order_release);
       for (unsigned spin = 0; tail_ == (written_seen_ = written_.load(std::memory_order_acquire)); ++spin) {
         if (aborted_.load(std::memory_order_acquire)) return nullptr;
-        pause(spin);
+        spinPause(spin);
       }
     }
     return &slots_[tail_ % Slots];
@@ -88,10 +95,6 @@ class SpscRing {
   struct ReaderStopped {};
 
  private:
-  static void pause(unsigned spin) {
-    if (spin < 1024) _mm_pause();
-    else std::this_thread::yield();
-  }
   // Each side's own fields in cache lines of their own: a line written by one thread and read
   // by the other moves between the cores at every write (on builtin:sphere's two-thread gouraud
   // frame the writer's load of head_, beside the reader's tail_, took a tenth of its time).

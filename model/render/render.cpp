@@ -85,7 +85,7 @@ struct SharedTransform {
     }
   }
   void waitAll() const {
-    while (done.load(std::memory_order_acquire) < n) _mm_pause();
+    for (unsigned spin = 0; done.load(std::memory_order_acquire) < n; ++spin) spinPause(spin);
   }
 };
 
@@ -439,7 +439,6 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
     q.release();
   }
 }
-
 
 // The frame on two threads: this one the front end (SceneDrawer with a queue), another the back
 // end (drawBackEnd with a frame of its own, on the same buffers and span engine). Every pixel
