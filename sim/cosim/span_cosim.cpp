@@ -338,7 +338,7 @@ class alignas(64) SpanChecker {
 // of SpanOut with its lanes' room for 16 attributes). Each chunk in cache lines of its own:
 // chunks side by side in a line put the writer's stores to one (each word appended moves its
 // vector's end) under the reader's loads from the one before, and the line's trips between the
-// cores held serial's two threads to 8 M fragments/s on this VM's slower core placement.
+// cores slowed both (docs/span-unit.md, "Two threads").
 struct alignas(64) CycleChunk {
   std::vector<uint64_t> words;
   uint64_t first_cycle = 0;  // the model's cycles before the chunk's first
@@ -401,10 +401,10 @@ uint64_t runTwoThreads(SpanStimulus& stim, SpanChecker& checker, const SpanParam
       for (bool more = true; more;) {
         CycleChunk& k = ring.slot();
         k.words.clear();
-        // Its lines fetched for writing all at once, before the cycles are packed into them. On
-        // this VM's slower core placement (a core-to-core round trip of about 550 ns instead of
-        // 120) that took serial's two threads from 8 M fragments/s to 15.5-16; on the faster
-        // one both ran 17.5-18.3.
+        // Its lines fetched for writing all at once, before the cycles are packed into them. With
+        // this VM's cores far apart (a core-to-core round trip of about 550 ns instead of 120)
+        // that made serial's two threads 1.94-2.00x as fast, interleaved, and 0.99-1.02x with
+        // them near (docs/span-unit.md, "Two threads").
         prefetchForWrite(k.words.data(), k.words.data() + k.words.capacity());
         k.first_cycle = stim.cycle();
         k.cycles = 0;
