@@ -3,11 +3,17 @@
 // pass/fail. The peer is idx3d III on the same sphere (its flat and lookup-table "Phong"):
 // compare only runs taken side by side, interleaved, and report ratios (docs/performance.md).
 // phong-fixed's label says whether the AVX-512 kernel ran. The RTL-in-the-loop frame time is
-// printed by `shadesim render --rtl`.
+// printed by `shadesim render --rtl`. Setup and Walk time two parts of a Gouraud frame alone,
+// per triangle: triangle setup and the span walk.
 //   build/testbench/bench_render [--benchmark_filter=...]
+#include <random>
+
 #include <benchmark/benchmark.h>
 
 #include "device/prom.h"
+#include "raster/setup.h"
+#include "raster/span_walk.h"
+#include "render/pipeline.h"
 #include "config/registry.h"
 #include "render/fixed_simd.h"
 #include "render/render.h"
@@ -43,8 +49,81 @@ void BM_Frame(benchmark::State& state, Method method, const char* mode, const ch
                                                 benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// The screen triangles a Gouraud frame of builtin:sphere draws, as setup takes them (the
+// renderer's serial unit and attribute widths): their vertices, with colours and depths drawn
+// at random in the ranges of the frame's (setup's arithmetic and the walk do not depend on
+// their values beyond their widths).
+struct SphereTriangles {
+  RasterConfig rc;
+  std::vector<std::array<SetupVertex, 3>> v;
+};
+SphereTriangles sphereTriangles() {
+  const Scene scene = loadScene("builtin:sphere");
+  RenderOptions opt;
+  opt.method = Method::Gouraud;
+  ModelSpanEngine span(spanConfig("serial").rtl);
+  RenderResult frame;
+  render(scene, opt, span, SpecEngines{}, frame);
+  SphereTriangles s;
+  s.rc.width = frame.fb.width;
+  s.rc.height = frame.fb.height;
+  s.rc.subpixel_bits = opt.subpixel_bits;
+  s.rc.unit = span.params();
+  s.rc.attr_frac_bits = {kColourFrac, kColourFrac, kColourFrac, kUnitFrac};
+  std::mt19937_64 rng(19);
+  std::uniform_real_distribution<double> colour(0, 255), w(0.05, 0.2);
+  for (const ScreenTriangleInfo& t : frame.triangles) {
+    std::array<SetupVertex, 3>& v = s.v.emplace_back();
+    for (size_t i = 0; i < 3; ++i) {
+      v[i].x = t.xy[i][0];
+      v[i].y = t.xy[i][1];
+      v[i].attr = {colour(rng), colour(rng), colour(rng), w(rng)};
+    }
+  }
+  return s;
+}
+
+void perTriangle(benchmark::State& state, size_t n) {
+  state.counters["triangles"] = static_cast<double>(n);
+  state.counters["ns/triangle"] =
+      benchmark::Counter(static_cast<double>(n), benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// Triangle setup alone (setupTriangle) of sphereTriangles(): the frame's setup share.
+void BM_Setup(benchmark::State& state) {
+  const SphereTriangles tris = sphereTriangles();
+  SetupResult res;
+  for (auto _ : state)
+    for (size_t i = 0; i < tris.v.size(); ++i) {
+      setupTriangle(tris.v[i], static_cast<uint32_t>(i), tris.rc, res);
+      benchmark::DoNotOptimize(res.desc);
+    }
+  perTriangle(state, tris.v.size());
+}
+
+// The span walk alone (walkSpanUnit with a run consumer, as the colour methods walk) of
+// sphereTriangles()' descriptors, the runs summed instead of drawn.
+void BM_Walk(benchmark::State& state) {
+  const SphereTriangles tris = sphereTriangles();
+  std::vector<SpanDesc> descs;
+  for (const auto& v : tris.v) {
+    const SetupResult r = setupTriangle(v, 0, tris.rc);
+    if (r.desc) descs.push_back(*r.desc);
+  }
+  uint64_t sum = 0;
+  for (auto _ : state)
+    for (const SpanDesc& d : descs) {
+      walkSpanUnit(tris.rc.unit, d, [&](int32_t x, int32_t, const int64_t*) { sum += static_cast<uint64_t>(x); },
+                   [&](const RowRun& r) { sum += static_cast<uint64_t>(r.count) + static_cast<uint64_t>(r.a0[0]); });
+      benchmark::DoNotOptimize(sum);
+    }
+  perTriangle(state, descs.size());
+}
+
 }  // namespace
 
+BENCHMARK(BM_Setup)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Walk)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Frame, flat, Method::Flat, "serial", "")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Frame, gouraud, Method::Gouraud, "serial", "")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Frame, gouraud_classical, Method::GouraudClassical, "serial", "")->Unit(benchmark::kMillisecond);

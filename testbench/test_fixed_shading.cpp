@@ -393,70 +393,99 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   EXPECT_GT(stops, 500u);
 }
 
-// The colour-run kernels (fixed_simd::colourRunAvx512, colourRunAvx2) against the flat/Gouraud
-// run loop, pixel by pixel: runs of 1 to 40 pixels from every start offset, over depth buffers
-// holding codes above, below and equal to the run's (and 0), with colour codes below 0, within
-// [0, 255 2^frac] and above (the clamp), for fraction bits 1 to 23. The pixels that fail the z-test keep their depth, tag and colour,
-// and no other byte changes (the AVX2 kernel's blends: the room to the row's end is the
-// buffer's, the run's own or none, at random).
+// The colour-run kernels (fixed_simd::colourRunsAvx512, colourRunsAvx2) against the flat/Gouraud
+// run loop, pixel by pixel: calls of 1 to 4 runs with the same steps, each run of 1 to 40 pixels
+// from every start offset in a buffer of its own, over depth buffers holding codes above, below
+// and equal to the run's (and 0), with colour codes below 0, within [0, 255 2^frac] and above
+// (the clamp), for fraction bits 1 to 23. The pixels that fail the z-test keep their depth, tag
+// and colour, and no other byte changes (the AVX2 kernel's blends: the room to the row's end is
+// the buffer's, the run's own or none, at random).
 static void checkColourKernel(const char* name, fixed_simd::ColourKernel kernel) {
   std::mt19937_64 rng(22);
-  uint64_t fragments = 0, passed = 0, clamped = 0;
+  uint64_t fragments = 0, passed = 0, clamped = 0, calls_of_many = 0;
   for (int t = 0; t < 20000; ++t) {
-    fixed_simd::ColourRun r;
-    r.px = randomRunPixels(rng, t);
+    fixed_simd::ColourRuns r;
     r.frac = std::array<int, 5>{1, 5, 12, 12, 23}[rng() % 5];
+    r.n = 1 + rng() % 4;
+    calls_of_many += r.n > 1 ? 1 : 0;
     const int64_t top = int64_t{255} << r.frac;
-    std::array<int64_t, 3> step{};
-    for (size_t ch = 0; ch < 3; ++ch) {
-      // Start and end around [0, top]: the codes are affine along the run, as the span unit's.
-      const int64_t lo = -top / 4 - 2, span = top + top / 2 + 4;
-      // (and within int32_t, as the span unit's codes are).
-      auto pick = [&] {
-        return std::clamp<int64_t>(lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(span)), INT32_MIN, INT32_MAX);
-      };
-      const int64_t c0 = pick(), c1 = pick();
-      // The step mod 2^32, as the span unit's (exact where the codes are: they fit int32_t).
-      step[ch] = r.px.count > 1 ? (c1 - c0) / static_cast<int64_t>(r.px.count - 1) : 0;
-      r.c[ch] = static_cast<int32_t>(c0);
-      r.dc[ch] = static_cast<int32_t>(static_cast<uint32_t>(step[ch]));
-    }
-    std::vector<uint8_t> rgb(3 * kRunBuffer);
+    std::vector<uint8_t> rgb(3 * kRunBuffer * r.n);
     for (uint8_t& b : rgb) b = static_cast<uint8_t>(rng());
-    std::vector<int32_t> depth = depthAround(rng, r.px), tri(depth.size(), -1);
+    std::vector<int32_t> depth, tri(kRunBuffer * r.n, -1);
+    std::array<int64_t, 3> step{};
+    std::vector<fixed_simd::RunPixels> px(r.n);
+    for (size_t i = 0; i < r.n; ++i) {
+      fixed_simd::ColourRuns::Row& row = r.rows[i];
+      px[i] = randomRunPixels(rng, t);
+      if (i > 0) {  // the first run's steps, and no more pixels than it has (its codes fit int32_t)
+        px[i].dz = px[0].dz;
+        px[i].count = std::min(px[i].count, px[0].count);
+      }
+      const std::vector<int32_t> d = depthAround(rng, px[i]);
+      depth.insert(depth.end(), d.begin(), d.end());
+      row.p = px[i].p + i * kRunBuffer;
+      row.count = px[i].count;
+      row.z = px[i].z;
+      row.room = std::array<size_t, 3>{kRunBuffer - px[i].p, px[i].count, 0}[rng() % 3];
+      for (size_t ch = 0; ch < 3; ++ch) {
+        if (i > 0) {  // the first run's codes moved by up to a quarter of the range, where they still fit
+          const int64_t delta = static_cast<int64_t>(rng() % static_cast<uint64_t>(top / 2 + 1)) - top / 4;
+          const int64_t c0 = int64_t{r.rows[0].c[ch]} + delta, c1 = c0 + step[ch] * static_cast<int64_t>(row.count - 1);
+          const bool fits = std::min(c0, c1) >= INT32_MIN && std::max(c0, c1) <= INT32_MAX;
+          row.c[ch] = static_cast<int32_t>(fits ? c0 : r.rows[0].c[ch]);
+          continue;
+        }
+        // Start and end around [0, top]: the codes are affine along the run, as the span unit's.
+        const int64_t lo = -top / 4 - 2, span = top + top / 2 + 4;
+        // (and within int32_t, as the span unit's codes are).
+        auto pick = [&] {
+          return std::clamp<int64_t>(lo + static_cast<int64_t>(rng() % static_cast<uint64_t>(span)), INT32_MIN, INT32_MAX);
+        };
+        const int64_t c0 = pick(), c1 = pick();
+        // The step mod 2^32, as the span unit's (exact where the codes are: they fit int32_t).
+        step[ch] = row.count > 1 ? (c1 - c0) / static_cast<int64_t>(row.count - 1) : 0;
+        row.c[ch] = static_cast<int32_t>(c0);
+        r.dc[ch] = static_cast<int32_t>(static_cast<uint32_t>(step[ch]));
+      }
+    }
+    r.dz = px[0].dz;
     std::vector<int32_t> want_depth = depth, want_tri = tri;
     std::vector<uint8_t> want_rgb = rgb;
     uint64_t want_fresh = 0, want_passed = 0;
-    for (size_t k = 0; k < r.px.count; ++k) {
-      if (!zTestWrite(r.px, k, 9, want_depth, want_tri, want_fresh)) continue;
-      ++want_passed;
-      const size_t p = r.px.p + k;
-      for (size_t ch = 0; ch < 3; ++ch) {
-        const int64_t code = int64_t{r.c[ch]} + static_cast<int64_t>(k) * step[ch];
-        clamped += code < 0 || code > top ? 1 : 0;
-        want_rgb[3 * p + ch] = unorm8FromCode(code, r.frac);
+    for (size_t i = 0; i < r.n; ++i) {
+      fixed_simd::RunPixels at = px[i];
+      at.p = r.rows[i].p;
+      for (size_t k = 0; k < at.count; ++k) {
+        if (!zTestWrite(at, k, 9, want_depth, want_tri, want_fresh)) continue;
+        ++want_passed;
+        const size_t p = at.p + k;
+        for (size_t ch = 0; ch < 3; ++ch) {
+          const int64_t code = int64_t{r.rows[i].c[ch]} + static_cast<int64_t>(k) * step[ch];
+          clamped += code < 0 || code > top ? 1 : 0;
+          want_rgb[3 * p + ch] = unorm8FromCode(code, r.frac);
+        }
+        ++passed;
       }
-      ++passed;
+      fragments += at.count;
     }
-    r.room = std::array<size_t, 3>{kRunBuffer - r.px.p, r.px.count, 0}[rng() % 3];
     const fixed_simd::Target target{depth.data(), tri.data(), 9, kRunWidth};
     uint64_t got_passed = 0;
     const uint64_t fresh = kernel(r, target, rgb.data(), got_passed);
-    ASSERT_EQ(depth, want_depth) << name << " run " << t;
-    ASSERT_EQ(tri, want_tri) << name << " run " << t;
+    ASSERT_EQ(depth, want_depth) << name << " call " << t;
+    ASSERT_EQ(tri, want_tri) << name << " call " << t;
     for (size_t i = 0; i < rgb.size(); ++i)
-      ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << name << " run " << t << " frac " << r.frac << " byte " << i;
-    ASSERT_EQ(fresh, want_fresh) << name << " run " << t;
-    ASSERT_EQ(got_passed, want_passed) << name << " run " << t;
-    fragments += r.px.count;
+      ASSERT_EQ(int{rgb[i]}, int{want_rgb[i]}) << name << " call " << t << " frac " << r.frac << " byte " << i;
+    ASSERT_EQ(fresh, want_fresh) << name << " call " << t;
+    ASSERT_EQ(got_passed, want_passed) << name << " call " << t;
   }
   EXPECT_GT(passed, fragments / 4);
   EXPECT_LT(passed, fragments * 3 / 4);
   EXPECT_GT(clamped, passed / 10);
+  EXPECT_GT(calls_of_many, 10000u);
 }
 
 TEST(FixedSimd, ColourRunEqualsTheRunLoop) {
   if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
-  if (fixed_simd::cpuHasAvx512()) checkColourKernel("AVX-512", fixed_simd::colourRunAvx512);
-  if (fixed_simd::cpuHasAvx2()) checkColourKernel("AVX2", fixed_simd::colourRunAvx2);
+  if (fixed_simd::cpuHasAvx512()) checkColourKernel("AVX-512", fixed_simd::colourRunsAvx512);
+  if (fixed_simd::cpuHasAvx2()) checkColourKernel("AVX2", fixed_simd::colourRunsAvx2);
 }

@@ -80,15 +80,28 @@ class RoundingDivider {
   explicit RoundingDivider(int64_t den) : den_(den), inv_(1.0 / static_cast<double>(den)) {}
   int64_t operator()(i128 num) const {
     if (den_ >= kLimit || num <= -kLimit || num >= kLimit) return static_cast<int64_t>(roundDiv(num, den_));
-    const int64_t n = static_cast<int64_t>(num);
-    int64_t q = static_cast<int64_t>(static_cast<double>(n) * inv_);  // truncated estimate
-    int64_t r = n - q * den_;                                          // exact: |q den| < 2^53 + den
-    // The estimate is within 2 of num / den (open interval), so r lies in (-2 den, 2 den) and
-    // one correction step, without a branch, brings it into (-den, den).
-    const int64_t down = r <= -den_ ? 1 : 0, up = r >= den_ ? 1 : 0;
-    q += up - down;
-    r += (down - up) * den_;
-    return roundHalfEvenFrom(q, r, den_);  // |r| < den
+    return (*this)(static_cast<int64_t>(num));
+  }
+  int64_t operator()(int64_t num) const { return plus(0, num); }
+  // round-half-even(base + num / den): the truncated quotient and remainder of num / den, then
+  // roundHalfEvenFrom(base + q, r, den), whose floor and parity are those of base + num / den.
+  // No overflow: |q| <= |num| / den, and base is an attribute code (|base| < 2^61) with
+  // den = 2 det >= 2, or 0.
+  int64_t plus(int64_t base, int64_t num) const {
+    int64_t q = 0, r = 0;
+    if (den_ >= kLimit || num <= -kLimit || num >= kLimit) {
+      q = num / den_;  // one 64-bit division
+      r = num % den_;
+    } else {
+      q = static_cast<int64_t>(static_cast<double>(num) * inv_);  // truncated estimate
+      r = num - q * den_;                                          // exact: |q den| < 2^53 + den
+      // The estimate is within 2 of num / den (open interval), so r lies in (-2 den, 2 den) and
+      // one correction step, without a branch, brings it into (-den, den).
+      const int64_t down = r <= -den_ ? 1 : 0, up = r >= den_ ? 1 : 0;
+      q += up - down;
+      r += (down - up) * den_;
+    }
+    return roundHalfEvenFrom(base + q, r, den_);  // |r| < den
   }
 
  private:
@@ -412,6 +425,42 @@ void snapVertices(const std::array<SetupVertex, 3>& v, uint32_t tag, const Raste
   }
 }
 
+// The attribute planes' codes (see the header): the gradients per pixel nx 2^S / det and
+// ny 2^S / det, and the exact plane at the reference pixel's centre (cx, cy) (u units),
+// a0 + (nx (cx - U0) + ny (cy - V0)) / (2 det), each rounded half to even. In 64-bit integers
+// where every product and sum provably fits (checked: the common case), else in 128 bits.
+void setPlane(const SnappedTriangle& t, int S, int64_t u0, int64_t v0, AttributePlane& pl) {
+  const RoundingDivider by_det(t.det), by_2det(2 * t.det);
+  const int64_t dx1 = t.X[1] - t.X[0], dy1 = t.Y[1] - t.Y[0], dx2 = t.X[2] - t.X[0], dy2 = t.Y[2] - t.Y[0];
+  const int64_t dcx = ((2 * pl.xref + 1) << S) - u0, dcy = ((2 * pl.yref + 1) << S) - v0;
+  const size_t K = t.a.size();
+  pl.didx.resize(K);
+  pl.didy.resize(K);
+  pl.iref.resize(K);
+  for (size_t k = 0; k < K; ++k) {
+    const auto& a = t.a[k];
+    const int64_t da1 = a[1] - a[0], da2 = a[2] - a[0];  // |a| < 2^61: no overflow
+    int64_t p1, p2, p3, p4, nx, ny, sx, sy, rx, ry, num;
+    const bool fits = !__builtin_mul_overflow(da1, dy2, &p1) && !__builtin_mul_overflow(da2, dy1, &p2) &&
+                      !__builtin_sub_overflow(p1, p2, &nx) && !__builtin_mul_overflow(dx1, da2, &p3) &&
+                      !__builtin_mul_overflow(dx2, da1, &p4) && !__builtin_sub_overflow(p3, p4, &ny) &&
+                      !__builtin_mul_overflow(nx, int64_t{1} << S, &sx) && !__builtin_mul_overflow(ny, int64_t{1} << S, &sy) &&
+                      !__builtin_mul_overflow(nx, dcx, &rx) && !__builtin_mul_overflow(ny, dcy, &ry) &&
+                      !__builtin_add_overflow(rx, ry, &num);
+    if (fits) {
+      pl.didx[k] = by_det(sx);  // per pixel = per subpixel * 2^S
+      pl.didy[k] = by_det(sy);
+      pl.iref[k] = by_2det.plus(a[0], num);
+      continue;
+    }
+    const i128 nx128 = static_cast<i128>(da1) * dy2 - static_cast<i128>(da2) * dy1;
+    const i128 ny128 = static_cast<i128>(dx1) * da2 - static_cast<i128>(dx2) * da1;
+    pl.didx[k] = by_det(nx128 * (i128{1} << S));
+    pl.didy[k] = by_det(ny128 * (i128{1} << S));
+    pl.iref[k] = by_2det(2 * static_cast<i128>(t.det) * a[0] + nx128 * dcx + ny128 * dcy);
+  }
+}
+
 }  // namespace
 
 SetupResult setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const RasterConfig& cfg) {
@@ -457,19 +506,7 @@ void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const Rast
   const int64_t py_min = *std::min_element(t.Y.begin(), t.Y.end()) >> S;
   pl.xref = std::clamp<int64_t>(px_min, 0, cfg.width - 1);
   pl.yref = std::clamp<int64_t>(py_min, 0, cfg.height - 1);
-  const i128 det = t.det;
-  const RoundingDivider by_det(t.det), by_2det(2 * t.det);
-  const i128 cx = (2 * static_cast<i128>(pl.xref) + 1) << S, cy = (2 * static_cast<i128>(pl.yref) + 1) << S;
-  for (int k = 0; k < K; ++k) {
-    const auto& a = t.a[static_cast<size_t>(k)];
-    const i128 nx = static_cast<i128>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) - static_cast<i128>(a[2] - a[0]) * (t.Y[1] - t.Y[0]);
-    const i128 ny = static_cast<i128>(t.X[1] - t.X[0]) * (a[2] - a[0]) - static_cast<i128>(t.X[2] - t.X[0]) * (a[1] - a[0]);
-    // per pixel = per subpixel * 2^S
-    pl.didx.push_back(by_det(nx * (i128{1} << S)));
-    pl.didy.push_back(by_det(ny * (i128{1} << S)));
-    // exact plane at the reference pixel centre, in u units: I = a0 + (nx (cx - U0) + ny (cy - V0)) / (2 det)
-    pl.iref.push_back(by_2det(2 * det * a[0] + nx * (cx - xu[0]) + ny * (cy - yu[0])));
-  }
+  setPlane(t, S, xu[0], yu[0], pl);
 
   // Lane-triangles in the walker frame, built in place in the descriptor.
   SpanDesc& d = res.desc.emplace();

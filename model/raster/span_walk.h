@@ -63,17 +63,21 @@ inline int64_t firstGroup(const SpanParams& p, int64_t xs) {
   return any;
 }
 
+// One DDA step of edge g's state st.
+[[gnu::always_inline]] inline void stepEdge(const SpanEdge& g, SpanDdaState& st, int coord_bits) {
+  const int64_t r = st.r - g.m;
+  const int64_t borrow = r < 0 ? 1 : 0;  // without a branch: r's sign is data, not a pattern
+  st.r = r + (g.div & -borrow);
+  st.q = wrapTo(u(st.q + g.k + borrow), coord_bits);
+}
+
 // The ROW cycle's register update of one lane-triangle's edges: the DDA step of every edge
 // active at w that stays active at w + 1.
 inline void stepEdges(const SpanLaneTri& t, int64_t w, SpanDdaState* e, int coord_bits) {
   for (int s = 0; s < 3; ++s) {
     const SpanEdge& g = t.edge[s];
     if (w < g.row_first || w >= g.row_last) continue;
-    SpanDdaState& st = e[s];
-    const int64_t r = st.r - g.m;
-    const int64_t borrow = r < 0 ? 1 : 0;  // without a branch: r's sign is data, not a pattern
-    st.r = r + (g.div & -borrow);
-    st.q = wrapTo(u(st.q + g.k + borrow), coord_bits);
+    stepEdge(g, e[s], coord_bits);
   }
 }
 
@@ -179,6 +183,90 @@ inline bool runRow(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t,
 // No run consumer: every row fragment by fragment.
 struct NoRuns {};
 
+// Whether walkSpanUnit may walk descriptor d (a single lane-triangle t) by stretches of rows
+// (plainRows), the renderer's 4 attributes of 32 bits being known: t neither flipped nor
+// interleaved, the walk's rows within CoordBits (so w + 1 never wraps), every pixel of t's rows
+// and columns within PixBits (runRow's check, once per triangle), and every didx within 32 bits
+// (so that runRow's end of a row, v_lo + didx n1 with |n1| < 2^32, is exact in int64_t).
+inline bool plainWalk(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t) {
+  const int64_t lim = int64_t{1} << (p.CoordBits - 1), pix_lim = int64_t{1} << p.PixBits;
+  bool ok = !t.flip && !d.interleave && d.row_first >= -lim && d.row_last < lim && t.clip_x0 + int64_t{t.ox} >= 0 &&
+            t.clip_x1 + int64_t{t.ox} < pix_lim && t.row_first + int64_t{t.oy} >= 0 && t.row_last + int64_t{t.oy} < pix_lim;
+  for (int a = 0; a < 4; ++a) ok = ok && d.didx[static_cast<size_t>(a)] == wrapTo(u(d.didx[static_cast<size_t>(a)]), 32);
+  return ok;
+}
+
+// A stretch of walker rows [first, last] of a single lane-triangle t over which the same edges
+// bound its span and the same edges step; left, right: the bounding edges when they are one
+// left and one right edge and the rows are t's (else -1).
+struct RowStretch {
+  int64_t last = 0;
+  int left = -1, right = -1;
+  bool step_left = false, step_right = false;
+};
+inline RowStretch rowStretch(const SpanLaneTri& t, int64_t first, int64_t row_last) {
+  RowStretch s;
+  s.last = row_last;
+  auto cut = [&](int64_t r) {  // what held changes at row r
+    if (r > first && r - 1 < s.last) s.last = r - 1;
+  };
+  cut(t.row_first);
+  cut(int64_t{t.row_last} + 1);
+  const bool in_t = t.row_first <= first && first <= t.row_last;
+  int lefts = 0, rights = 0;
+  for (int k = 0; k < 3; ++k) {
+    const SpanEdge& g = t.edge[k];
+    if (g.row_first > g.row_last) continue;  // an unused slot
+    cut(g.row_first);
+    cut(g.row_last);  // its last row bounds without a step
+    cut(int64_t{g.row_last} + 1);
+    if (first < g.row_first || first > g.row_last) continue;
+    (g.right ? s.right : s.left) = k;
+    ++(g.right ? rights : lefts);
+    (g.right ? s.step_right : s.step_left) = first < g.row_last;
+  }
+  if (!in_t || lefts != 1 || rights != 1) s.left = s.right = -1;
+  return s;
+}
+
+// walkSpanUnit's rows w .. s.last of a single lane-triangle t that plainWalk accepts, over a
+// stretch with one left and one right edge: the same ROW cycles, runs, fragments and counts
+// as its row-by-row walk, without the tests that the stretch and plainWalk settle once.
+template <class Sink, class RunSink>
+void plainRows(const SpanParams& p, const SpanDesc& d, const SpanLaneTri& t, const RowStretch& s, int64_t w,
+               SpanDdaState* e, int64_t* irow, SpanWalk& walk, SpanStream& timing, Sink& emit, RunSink& emit_run) {
+  const SpanEdge &gl = t.edge[s.left], &gr = t.edge[s.right];
+  SpanDdaState &el = e[s.left], &er = e[s.right];
+  const int L = p.LanesPerTri;
+  std::array<int64_t, 4> a0, da;
+  for (; w <= s.last; ++w) {
+    ++walk.row_cycles;
+    uint64_t groups = 0;
+    const int64_t lo = std::max<int64_t>(t.clip_x0, el.q), hi = std::min<int64_t>(t.clip_x1, -er.q);
+    if (lo <= hi) {
+      const int64_t xg0 = firstGroup(p, lo), n1 = hi - lo;
+      groups = static_cast<uint64_t>(L == 1 ? hi - xg0 + 1 : (hi - xg0) / L + 1);
+      walk.span_cycles += groups;
+      bool whole = true;  // runRow's test: the row's end value fits 32 bits
+      for (size_t a = 0; a < 4; ++a) {
+        a0[a] = wrapTo(u(irow[a]) + u(d.didx[a]) * u(lo - d.xref) + u(t.aoff[a]), 32);
+        const int64_t end = a0[a] + d.didx[a] * n1;  // exact: |didx| <= 2^31, 0 <= n1 < 2^32
+        whole = whole && end == wrapTo(u(end), 32);
+        da[a] = n1 > 0 ? d.didx[a] : 0;
+      }
+      if (whole)
+        emit_run(RowRun{static_cast<int32_t>(lo + t.ox), static_cast<int32_t>(w + t.oy), 1, n1 + 1, a0.data(), da.data()});
+      else
+        singleRow<4, 32>(p, d, t, w, lo, hi, irow, emit);
+      walk.fragments += static_cast<uint64_t>(n1 + 1);
+    }
+    if (p.RowAhead) timing.row(groups);
+    if (s.step_left) stepEdge(gl, el, p.CoordBits);
+    if (s.step_right) stepEdge(gr, er, p.CoordBits);
+    for (size_t a = 0; a < 4; ++a) irow[a] = wrapTo(u(irow[a]) + u(d.didy[a]), 32);
+  }
+}
+
 }  // namespace span_detail
 
 // The fragments of one descriptor, in the order SpanUnitModel hands them over with out_ready
@@ -280,8 +368,21 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   };
   // The ROW cycles, with NumAttr and AttrBits known at compile time when they are the
   // renderer's 4 and 32 (the wraps become sign extensions of the low word).
+  // A single lane-triangle with runs (the renderer's serial, evenodd and segment units) by
+  // stretches of rows where plainWalk allows it (plainRows), else row by row.
   auto rows = [&](auto kc, auto ab) {
+    constexpr bool kPlain = decltype(kc)::value == 4 && decltype(ab)::value == 32 && !std::is_same_v<std::decay_t<RunSink>, NoRuns>;
+    const bool plain = kPlain && T == 1 && plainWalk(p, d, d.tri[0]);
     for (int64_t w = d.row_first;; w = wrapTo(u(w + 1), p.CoordBits)) {
+      if constexpr (kPlain) {
+        const RowStretch s = plain ? rowStretch(d.tri[0], w, d.row_last) : RowStretch{};
+        if (s.left >= 0) {
+          plainRows(p, d, d.tri[0], s, w, e.data(), irow.data(), walk, timing, emit, emit_run);
+          if (s.last == d.row_last) break;
+          w = s.last;
+          continue;
+        }
+      }
       ++walk.row_cycles;
       groups = 0;
       if (T == 1) singleLaneRow(w, kc, ab);

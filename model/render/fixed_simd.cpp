@@ -173,41 +173,53 @@ SHD_AVX2 inline __m256i packRgb(__m256i x) {
                                                  0, 1, 2, 4, 5, 6, 8, 9, 10, 12, 13, 14, -1, -1, -1, -1));
 }
 
-// Fragments k .. k + 7 of a colour run: unorm8FromCode of each channel's code (clamped to
-// [0, 255 2^frac], rounded half up to an integer), packed by packRgb.
-SHD_AVX2 inline __m256i colourBytes8(const ColourRun& r, size_t k) {
-  const __m128i frac = _mm_cvtsi32_si128(r.frac);
-  const __m256i top = _mm256_set1_epi32(255 << r.frac), half = _mm256_set1_epi32(1 << (r.frac - 1));
+// A run's constants in 8 lanes: lane i's offset i d from the run's group base, for the depth and
+// each colour channel, and the colour's clamp and rounding.
+struct RunLanes {
+  __m256i dz, dc[3];
+  __m256i top, half;
+  __m128i frac;
+};
+SHD_AVX2 inline RunLanes runLanes(const ColourRuns& r) {
+  RunLanes l;
+  l.dz = _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(r.dz)));
+  for (size_t ch = 0; ch < 3; ++ch) l.dc[ch] = _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(r.dc[ch]));
+  l.top = _mm256_set1_epi32(255 << r.frac);
+  l.half = _mm256_set1_epi32(1 << (r.frac - 1));
+  l.frac = _mm_cvtsi32_si128(r.frac);
+  return l;
+}
+
+// Fragments k .. k + 7 of a colour run whose fragment k has the codes ck: unorm8FromCode of each
+// channel's code (clamped to [0, 255 2^frac], rounded half up to an integer), packed by packRgb.
+SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_t, 3>& ck) {
   __m256i px = _mm256_setzero_si256();
-  for (int ch = 0; ch < 3; ++ch) {
-    const __m256i code = _mm256_add_epi32(
-        _mm256_set1_epi32(static_cast<int32_t>(static_cast<uint32_t>(r.c[ch]) + static_cast<uint32_t>(k) * static_cast<uint32_t>(r.dc[ch]))),
-        _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(r.dc[ch])));
+  for (size_t ch = 0; ch < 3; ++ch) {
+    const __m256i code = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(ck[ch])), l.dc[ch]);
     const __m256i u8 = _mm256_srl_epi32(
-        _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), top), half), frac);
-    px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * ch));
+        _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), l.top), l.half), l.frac);
+    px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * static_cast<int>(ch)));
   }
   return packRgb(px);
 }
 
-// The z-test of fragments k .. k + 7 of a run (those below px.count): their depth codes
-// against the buffer's, and where they pass the codes and the tag written. Returns the passing
-// lanes; adds to fresh those whose depth was 0. The accesses are 8 lanes wide (32 bytes): wider
-// ones, even with their lanes masked off, would overlap the next step's and stall its load
-// behind this store.
-SHD_AVX512 inline __mmask8 zTest8(const Target& t, const RunPixels& px, size_t k, uint64_t& fresh) {
-  const __mmask8 valid = static_cast<__mmask8>((1u << std::min<size_t>(8, px.count - k)) - 1);
-  const __m256i zk = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(px.z + static_cast<uint32_t>(k) * px.dz)),
-                                      _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(px.dz))));
-  int32_t* const depth = t.depth + px.p + k;
+// The z-test of the 8 fragments at depth + 0 .. 7 (those below `left`), fragment i with the
+// depth code zk + dz_lanes[i]: against the buffer's, and where they pass the codes and the tag
+// written (tri: the tag buffer at the same pixel). Returns the passing lanes; adds to fresh
+// those whose depth was 0. The accesses are 8 lanes wide (32 bytes): wider ones, even with
+// their lanes masked off, would overlap the next step's and stall its load behind this store.
+SHD_AVX512 inline __mmask8 zTest8(const Target& t, int32_t* depth, int32_t* tri, size_t left, uint32_t zk,
+                                  __m256i dz_lanes, uint64_t& fresh) {
+  const __mmask8 valid = static_cast<__mmask8>((1u << std::min<size_t>(8, left)) - 1);
+  const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), dz_lanes);
   // The row after next, most likely this triangle's: its depth in the cache by then.
   __builtin_prefetch(depth + 2 * t.width);
   __builtin_prefetch(depth + 2 * t.width + 7);
   const __m256i old = _mm256_maskz_loadu_epi32(valid, depth);
-  const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, zk, old);
+  const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, z, old);
   fresh += static_cast<uint64_t>(__builtin_popcount(_mm256_mask_cmpeq_epi32_mask(pass, old, _mm256_setzero_si256())));
-  _mm256_mask_storeu_epi32(depth, pass, zk);
-  _mm256_mask_storeu_epi32(t.tri + px.p + k, pass, _mm256_set1_epi32(t.tag));
+  _mm256_mask_storeu_epi32(depth, pass, z);
+  _mm256_mask_storeu_epi32(tri, pass, _mm256_set1_epi32(t.tag));
   return pass;
 }
 
@@ -236,10 +248,12 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
   const __m512i l0 = _mm512_set1_epi64(static_cast<int64_t>(r.l)), dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl));
   const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
+  const __m256i dz_lanes = _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(r.px.dz)));
   size_t n = b.n, k = first;
   uint64_t covered = 0;
   for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
-    const __mmask8 pass = zTest8(t, r.px, k, covered);
+    const __mmask8 pass = zTest8(t, t.depth + r.px.p + k, t.tri + r.px.p + k, r.px.count - k,
+                                 r.px.z + static_cast<uint32_t>(k) * r.px.dz, dz_lanes, covered);
     // Fragments k .. k + 7 in 64-bit lanes (k < 2^32).
     const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
     const __m512i sq =
@@ -260,71 +274,90 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   return std::min(k, r.px.count);
 }
 
-// colourRun in AVX2: zTest8 and the colour of colourRunAvx512 below with vector masks for the
-// mask registers; the depth and tag through masked 32-bit stores, the colour bytes as below.
-SHD_AVX2 uint64_t colourRunAvx2(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
+// colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
+// the mask registers; the depth and tag through masked 32-bit stores, the colour bytes as below.
+SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  const RunLanes l = runLanes(r);
   const __m256i lanes = lanes8();
   const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
   const __m256i tag = _mm256_set1_epi32(t.tag), zero = _mm256_setzero_si256();
-  const uint32_t dz = r.px.dz;
   uint64_t covered = 0;
-  for (size_t k = 0; k < r.px.count; k += 8) {
-    const int n = static_cast<int>(std::min<size_t>(8, r.px.count - k));
-    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
-    const __m256i zk = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * dz)),
-                                        _mm256_mullo_epi32(lanes, _mm256_set1_epi32(static_cast<int32_t>(dz))));
-    int32_t* const depth = t.depth + r.px.p + k;
-    __builtin_prefetch(depth + 2 * t.width);
-    __builtin_prefetch(depth + 2 * t.width + 7);
-    const __m256i old = _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
-    const __m256i pass_v = _mm256_and_si256(valid, _mm256_cmpgt_epi32(zk, old));
-    const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
-    if (pass == 0) continue;
-    passed += static_cast<uint64_t>(__builtin_popcount(pass));
-    const unsigned fresh = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, zero))));
-    covered += static_cast<uint64_t>(__builtin_popcount(pass & fresh));
-    _mm256_maskstore_epi32(depth, pass_v, zk);
-    _mm256_maskstore_epi32(t.tri + r.px.p + k, pass_v, tag);
-    // The 8 pixels' 24 bytes, in order.
-    alignas(32) uint8_t bytes[32];
-    _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(r, k), join));
-    uint8_t* const out = rgb + 3 * (r.px.p + k);
-    if (pass == 0xFF) {
-      std::memcpy(out, bytes, 24);
-    } else if (k + 11 <= r.room) {  // 32 bytes = 10 2/3 pixels, all in the row
-      // The passing pixels' bytes (their lanes' all-ones packed like the colours), the rest as read.
-      const __m256i mask = _mm256_permutevar8x32_epi32(packRgb(pass_v), join);
-      const __m256i was = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(out));
-      const __m256i now = _mm256_load_si256(reinterpret_cast<const __m256i*>(bytes));
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, now, mask));
-    } else {
-      for (unsigned m = pass; m != 0; m &= m - 1) {
-        const int i = __builtin_ctz(m);
-        std::memcpy(out + 3 * i, bytes + 3 * i, 3);
+  for (size_t i = 0; i < r.n; ++i) {
+    const ColourRuns::Row& row = r.rows[i];
+    uint32_t zk = row.z;
+    std::array<uint32_t, 3> ck;
+    for (size_t ch = 0; ch < 3; ++ch) ck[ch] = static_cast<uint32_t>(row.c[ch]);
+    for (size_t k = 0; k < row.count; k += 8) {
+      const int n = static_cast<int>(std::min<size_t>(8, row.count - k));
+      const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
+      const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), l.dz);
+      int32_t* const depth = t.depth + row.p + k;
+      __builtin_prefetch(depth + 2 * t.width);
+      __builtin_prefetch(depth + 2 * t.width + 7);
+      const __m256i old = _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
+      const __m256i pass_v = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
+      const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
+      if (pass != 0) {
+        passed += static_cast<uint64_t>(__builtin_popcount(pass));
+        const unsigned fresh = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, zero))));
+        covered += static_cast<uint64_t>(__builtin_popcount(pass & fresh));
+        _mm256_maskstore_epi32(depth, pass_v, z);
+        _mm256_maskstore_epi32(t.tri + row.p + k, pass_v, tag);
+        // The 8 pixels' 24 bytes, in order.
+        alignas(32) uint8_t bytes[32];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(l, ck), join));
+        uint8_t* const out = rgb + 3 * (row.p + k);
+        if (pass == 0xFF) {
+          std::memcpy(out, bytes, 24);
+        } else if (k + 11 <= row.room) {  // 32 bytes = 10 2/3 pixels, all in the row
+          // The passing pixels' bytes (their lanes' all-ones packed like the colours), the rest as read.
+          const __m256i mask = _mm256_permutevar8x32_epi32(packRgb(pass_v), join);
+          const __m256i was = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(out));
+          const __m256i now = _mm256_load_si256(reinterpret_cast<const __m256i*>(bytes));
+          _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, now, mask));
+        } else {
+          for (unsigned m = pass; m != 0; m &= m - 1) {
+            const int b = __builtin_ctz(m);
+            std::memcpy(out + 3 * b, bytes + 3 * b, 3);
+          }
+        }
       }
+      zk += 8 * r.dz;
+      for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(r.dc[ch]);
     }
   }
   return covered;
 }
 
-SHD_AVX512 uint64_t colourRunAvx512(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
-  uint64_t covered = 0;
-  for (size_t k = 0; k < r.px.count; k += 8) {
-    const __mmask8 pass = zTest8(t, r.px, k, covered);
-    passed += static_cast<uint64_t>(__builtin_popcount(pass));
-    if (pass == 0) continue;
-    const __m256i bytes = colourBytes8(r, k);
-    // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
-    const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
-    uint8_t* const out = rgb + 3 * (r.px.p + k);
-    _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
-    _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
+SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  const RunLanes l = runLanes(r);
+  uint64_t covered = 0, pass_count = 0;
+  for (size_t i = 0; i < r.n; ++i) {
+    const ColourRuns::Row& row = r.rows[i];
+    uint32_t zk = row.z;
+    std::array<uint32_t, 3> ck;
+    for (size_t ch = 0; ch < 3; ++ch) ck[ch] = static_cast<uint32_t>(row.c[ch]);
+    for (size_t k = 0; k < row.count; k += 8) {
+      const __mmask8 pass = zTest8(t, t.depth + row.p + k, t.tri + row.p + k, row.count - k, zk, l.dz, covered);
+      pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
+      if (pass != 0) {
+        const __m256i bytes = colourBytes8(l, ck);
+        // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
+        const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
+        uint8_t* const out = rgb + 3 * (row.p + k);
+        _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
+        _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
+      }
+      zk += 8 * r.dz;
+      for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(r.dc[ch]);
+    }
   }
+  passed += pass_count;
   return covered;
 }
 
 ColourKernel colourKernel() {
-  return available() ? colourRunAvx512 : availableAvx2() ? colourRunAvx2 : nullptr;
+  return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
 }
 
 #pragma GCC diagnostic pop
@@ -342,11 +375,11 @@ uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64
 size_t bufferRun(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRun: built without the vector kernel");
 }
-uint64_t colourRunAvx512(const ColourRun&, const Target&, uint8_t*, uint64_t&) {
-  throw std::logic_error("fixed_simd::colourRunAvx512: built without the vector kernels");
+uint64_t colourRunsAvx512(const ColourRuns&, const Target&, uint8_t*, uint64_t&) {
+  throw std::logic_error("fixed_simd::colourRunsAvx512: built without the vector kernels");
 }
-uint64_t colourRunAvx2(const ColourRun&, const Target&, uint8_t*, uint64_t&) {
-  throw std::logic_error("fixed_simd::colourRunAvx2: built without the vector kernels");
+uint64_t colourRunsAvx2(const ColourRuns&, const Target&, uint8_t*, uint64_t&) {
+  throw std::logic_error("fixed_simd::colourRunsAvx2: built without the vector kernels");
 }
 ColourKernel colourKernel() { return nullptr; }
 

@@ -24,7 +24,7 @@ namespace shd::fixed_simd {
 // The CPU runs the vector kernel (AVX-512 F, DQ, CD, VL and BW), and SHD_SCALAR is not set in the
 // environment (which forces the scalar path, for comparisons).
 bool available();
-// The CPU runs the AVX2 colour-run kernel (colourRunAvx2, without AVX-512), and SHD_SCALAR is not set.
+// The CPU runs the AVX2 colour-run kernel (colourRunsAvx2, without AVX-512), and SHD_SCALAR is not set.
 bool availableAvx2();
 // The CPU alone (SHD_SCALAR not consulted): what the kernels below need.
 bool cpuHasAvx512();
@@ -86,27 +86,36 @@ struct Target {
   size_t width = 0;  // pixels per row: the row after next is prefetched
 };
 
-// A run of flat or Gouraud fragments: fragment k of px with the colour codes c[ch] + k dc[ch]
-// (frac fraction bits, 1 <= frac <= 23; the run's codes fit int32_t, as the span unit's do for
-// AttrBits <= 32).
-struct ColourRun {
-  RunPixels px;
-  std::array<int32_t, 3> c{}, dc{};
+// Runs of flat or Gouraud fragments, each left to right, with the same steps (a triangle's
+// rows, drawn with one call): fragment k of run i at pixel rows[i].p + k, with the depth code
+// rows[i].z + k dz (mod 2^32) and the colour codes rows[i].c[ch] + k dc[ch] (frac fraction bits,
+// 1 <= frac <= 23; a run's codes fit int32_t, as the span unit's do for AttrBits <= 32).
+struct ColourRuns {
+  static constexpr size_t kCap = 64;
+  struct Row {
+    size_t p = 0, count = 0;
+    size_t room = 0;  // pixels from the run's first to the end of its row (the AVX2 kernel's blends)
+    uint32_t z = 0;
+    std::array<int32_t, 3> c{};
+  };
+  std::array<int32_t, 3> dc{};
+  uint32_t dz = 0;
   int frac = 12;
-  size_t room = 0;  // pixels from the run's first to the end of its row (the AVX2 kernel's blends)
+  size_t n = 0;  // rows[0 .. n - 1]
+  std::array<Row, kCap> rows;
 };
 
-// The run's z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
-// and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch]. Returns the
-// passing pixels whose depth was 0 (not covered before); adds the passing pixels to passed.
-// Two kernels, each for a CPU with its instructions: AVX-512 and AVX2, the same operations on
-// 8 lanes. AVX2 has no byte-masked store: a group's colour bytes are blended into the 32 bytes
-// there (the bytes of other pixels written back as read) where those lie within the run's row
-// (room), else written pixel by pixel, so no pixel of another row is touched.
-uint64_t colourRunAvx512(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed);
-uint64_t colourRunAvx2(const ColourRun& r, const Target& t, uint8_t* rgb, uint64_t& passed);
+// The runs' z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
+// and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch], run after run.
+// Returns the passing pixels whose depth was 0 (not covered before); adds the passing pixels to
+// passed. Two kernels, each for a CPU with its instructions: AVX-512 and AVX2, the same
+// operations on 8 lanes. AVX2 has no byte-masked store: a group's colour bytes are blended into
+// the 32 bytes there (the bytes of other pixels written back as read) where those lie within
+// the run's row (room), else written pixel by pixel, so no pixel of another row is touched.
+uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed);
+uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed);
 // The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else null.
-using ColourKernel = uint64_t (*)(const ColourRun&, const Target&, uint8_t*, uint64_t&);
+using ColourKernel = uint64_t (*)(const ColourRuns&, const Target&, uint8_t*, uint64_t&);
 ColourKernel colourKernel();
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:

@@ -14,6 +14,50 @@ namespace shd {
 
 namespace {
 
+// A triangle's left-to-right runs waiting for the vector kernel (fixed_simd::colourKernel), which
+// draws them with one call when the triangle's walk ends, or before any other write of the
+// triangle (a run from right to left, a single fragment), so that the pixels are written in
+// the walk's order.
+struct PendingRuns {
+  fixed_simd::ColourKernel kernel;  // null: nothing waits, every run takes the loop below
+  const fixed_simd::Target& target;
+  uint8_t* rgb;
+  uint64_t& covered;
+  uint64_t& rejected;
+  fixed_simd::ColourRuns& runs;  // the unit's, empty between triangles
+  uint64_t fragments = 0;  // of the runs waiting
+  bool stepped = false;    // runs.dc and dz are the waiting runs' steps (a run of one pixel has none)
+
+  void add(const RowRun& r, int W) {
+    // The runs of one call share their steps; a run of one pixel takes any.
+    const bool same = !stepped || r.count == 1 ||
+                      (r.da[0] == runs.dc[0] && r.da[1] == runs.dc[1] && r.da[2] == runs.dc[2] &&
+                       static_cast<uint32_t>(r.da[3]) == runs.dz);
+    if (runs.n == runs.rows.size() || !same) flush();
+    if (!stepped && r.count > 1) {
+      for (size_t k = 0; k < 3; ++k) runs.dc[k] = static_cast<int32_t>(r.da[k]);
+      runs.dz = static_cast<uint32_t>(r.da[3]);
+      stepped = true;
+    }
+    fixed_simd::ColourRuns::Row& row = runs.rows[runs.n++];
+    row.p = static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0);
+    row.count = static_cast<size_t>(r.count);
+    row.room = static_cast<size_t>(W - r.x0);
+    row.z = static_cast<uint32_t>(r.a0[3]);
+    for (size_t k = 0; k < 3; ++k) row.c[k] = static_cast<int32_t>(r.a0[k]);
+    fragments += row.count;
+  }
+  void flush() {
+    if (runs.n == 0) return;
+    uint64_t passed = 0;
+    covered += kernel(runs, target, rgb, passed);
+    rejected += fragments - passed;
+    runs.n = 0;
+    fragments = 0;
+    stepped = false;
+  }
+};
+
 // Flat and Gouraud: z-test, then the interpolated colour codes straight to unorm8 (what
 // combine() gives them).
 struct ColourFragment {
@@ -22,7 +66,9 @@ struct ColourFragment {
   int W;
   uint64_t& covered;
   uint64_t& rejected;
+  PendingRuns& pending;
   void operator()(int32_t x, int32_t y, const int64_t* attr) const {
+    pending.flush();
     const size_t p = static_cast<size_t>(y) * static_cast<size_t>(W) + static_cast<size_t>(x);
     __builtin_prefetch(depth + p + W);  // the row below: most likely this triangle's next
     if (attr[3] <= depth[p]) {
@@ -34,25 +80,25 @@ struct ColourFragment {
   }
 };
 
-// The same for a whole run of a row (walkSpanUnit's run consumer): the loop in registers, the
-// newly covered pixels and the rejected fragments counted once per run. When the colour codes at both ends of the run lie
-// in [0, 255 2^12] so do all between (they are affine), and unorm8FromCode is the rounding
-// shift alone.
+// The same for a whole run of a row (walkSpanUnit's run consumer): left to right to the vector
+// kernel (PendingRuns), else a loop in registers, the newly covered pixels and the rejected
+// fragments counted once per run. When the colour codes at both ends of the run lie in
+// [0, 255 2^12] so do all between (they are affine), and unorm8FromCode is the rounding shift
+// alone.
 struct ColourRunLoop {
   PixelWriter write;
   int32_t* depth;
   int W;
   uint64_t& covered;
   uint64_t& rejected;
-  fixed_simd::ColourKernel kernel;  // null: the loop below for every run
-  const fixed_simd::Target& target;
-  uint8_t* rgb;
+  PendingRuns& pending;
 
   void operator()(const RowRun& r) const {
-    if (kernel != nullptr && r.dx == 1) {
-      vectorRun(r);
+    if (pending.kernel != nullptr && r.dx == 1) {
+      pending.add(r, W);
       return;
     }
+    pending.flush();
     const auto put = write;
     const int64_t count = r.count;  // a local: r may alias the pixels' byte stores
     std::array<uint64_t, 3> a, da;
@@ -84,43 +130,31 @@ struct ColourRunLoop {
     covered += newly;
     rejected += static_cast<uint64_t>(count) - passed;
   }
-
-  // A left-to-right run in AVX-512 or AVX2 (fixed_simd::colourKernel).
-  void vectorRun(const RowRun& r) const {
-    fixed_simd::ColourRun run;
-    run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(W) + static_cast<size_t>(r.x0),
-              static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])};
-    for (size_t k = 0; k < 3; ++k) {
-      run.c[k] = static_cast<int32_t>(r.a0[k]);
-      run.dc[k] = static_cast<int32_t>(r.da[k]);
-    }
-    run.frac = kColourFrac;
-    run.room = static_cast<size_t>(W - r.x0);
-    uint64_t passed = 0;
-    covered += kernel(run, target, rgb, passed);
-    rejected += run.px.count - passed;
-  }
 };
 
-// The colour units' drawing: the walk with the fragment sink and the run loop.
-void drawColourRuns(Frame& f, const SpanTriangle& t) {
+// The colour units' drawing: the walk with the fragment sink and the run loop (runs: the unit's
+// buffer of the runs waiting for the vector kernel).
+void drawColourRuns(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs) {
   Framebuffer& fb = f.fb;
   const int W = f.W;
   const PixelWriter write = f.writer(t.tag);
   const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
-  ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected};
-  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected,
-                    f.colour_kernel, target, fb.rgb.data()};
+  runs.frac = kColourFrac;
+  PendingRuns pending{f.colour_kernel, target, fb.rgb.data(), f.st.pixels_covered, f.st.depth_rejected, runs};
+  ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, pending};
+  ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, pending};
   f.walk(t, fragment, run);
+  pending.flush();
 }
 
 class GouraudUnit final : public MethodUnit {
  public:
   explicit GouraudUnit(Frame& f) : MethodUnit(Method::Gouraud), f_(f) {}
-  void draw(const SpanTriangle& t) override { drawColourRuns(f_, t); }
+  void draw(const SpanTriangle& t) override { drawColourRuns(f_, t, runs_); }
 
  private:
   Frame& f_;
+  fixed_simd::ColourRuns runs_;
 };
 
 class FlatUnit final : public MethodUnit {
@@ -135,11 +169,12 @@ class FlatUnit final : public MethodUnit {
     colour_ = f_.shadeNow(fn, centroid);
     for (size_t k = 1; k + 1 < fan.size(); ++k) out.push_back({{fan[0], fan[k], fan[k + 1]}, this, method(), &colour_});
   }
-  void draw(const SpanTriangle& t) override { drawColourRuns(f_, t); }
+  void draw(const SpanTriangle& t) override { drawColourRuns(f_, t, runs_); }
 
  private:
   Frame& f_;
   std::array<double, 3> colour_{};
+  fixed_simd::ColourRuns runs_;
 };
 
 }  // namespace
