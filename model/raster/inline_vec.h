@@ -68,6 +68,13 @@ class InlineVec {
     for (size_t i = n_; i < n; ++i) ::new (static_cast<void*>(a_ + i)) T(v);
     n_ = n;
   }
+  // n elements, those beyond the current size left uninitialised, for the caller to write
+  // (trivial types only: reading one before writing it is as reading an uninitialised int).
+  void resizeForOverwrite(size_t n) {
+    static_assert(std::is_trivial<T>::value, "resizeForOverwrite leaves elements unconstructed");
+    check(n);
+    n_ = n;
+  }
   void push_back(const T& v) {
     check(n_ + 1);
     ::new (static_cast<void*>(a_ + n_)) T(v);

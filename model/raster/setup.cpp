@@ -45,6 +45,17 @@ __attribute__((noinline)) int64_t floorDivWide(i128 a, i128 b) {
   return q - static_cast<int64_t>(((a64 % b64) != 0) & (a64 < 0));  // without a branch, as roundHalfEvenFrom
 }
 [[gnu::always_inline]] inline int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
+// ceil(a / b) for b > 0 in 64 bits: one division.
+[[gnu::always_inline]] inline int64_t ceilDiv64(int64_t a, int64_t b) {
+  const int64_t q = a / b;
+  return q + static_cast<int64_t>(((a % b) != 0) & (a > 0));
+}
+// ceil((x y - c) / b) for b > 0: in 64 bits where x y - c fits, else in 128.
+[[gnu::always_inline]] inline int64_t ceilDivOfProduct(int64_t x, int64_t y, int64_t c, int64_t b) {
+  int64_t xy = 0, n = 0;
+  if (!__builtin_mul_overflow(x, y, &xy) && !__builtin_sub_overflow(xy, c, &n)) return ceilDiv64(n, b);
+  return ceilDiv(static_cast<i128>(x) * y - c, b);
+}
 
 // round-half-even(num / den) from the truncated quotient q and remainder r of num / den
 // (|r| < den, den > 0): floor first, then up when the remainder is above half, or exactly half
@@ -199,7 +210,7 @@ void trimEmptyRows(SpanLaneTri& t, const SpanParams& p) {
       const SpanEdge& g = t.edge[s];
       if (r1 < g.row_first || r1 > g.row_last) continue;
       const int64_t n = r1 - g.row_first;
-      at[s].q = g.q + n * g.k + ceilDiv(static_cast<i128>(n) * g.m - g.r, g.div);
+      at[s].q = g.q + n * g.k + ceilDivOfProduct(n, g.m, g.r, g.div);
     }
     if (span_detail::laneRowBounds(t, r1, at.data(), lo, hi)) break;
   }
@@ -290,16 +301,27 @@ bool buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
     // In the walker frame: E = A x + B (stride w + phase) + C (stride 1: the frame's own).
     const i128 B = stride == 1 ? e.B : static_cast<i128>(e.B) * stride;
     const i128 C = stride == 1 ? e.C : e.C + static_cast<i128>(e.B) * phase;
-    const i128 N = -(B * ea + C);  // x >= N/D (left), x <= -N/D (right)
-    const int64_t q = ceilDiv(N, D);
+    // N = -(B ea + C): x >= N/D (left), x <= -N/D (right). The start q = ceil(N / D) and
+    // r = q D - N (in [0, D): exact mod 2^64), in 64 bits where B ea + C fits (stride 1, the
+    // common case), else in 128.
+    int64_t q = 0, r = 0, bea = 0, nn = 0;
+    if (stride == 1 && !__builtin_mul_overflow(e.B, ea, &bea) && !__builtin_add_overflow(bea, e.C, &nn) && nn != INT64_MIN) {
+      q = ceilDiv64(-nn, D);
+      r = static_cast<int64_t>(static_cast<uint64_t>(q) * static_cast<uint64_t>(D) + static_cast<uint64_t>(nn));
+    } else {
+      const i128 N = -(B * ea + C);
+      q = ceilDiv(N, D);
+      r = static_cast<int64_t>(static_cast<i128>(q) * D - N);
+    }
     d.q = static_cast<int32_t>(q);
-    d.r = static_cast<int64_t>(static_cast<i128>(q) * D - N);
+    d.r = r;
     d.div = D;
-    if (eb > ea) {  // the DDA steps: -B = k D + m
-      const int64_t k = floorDiv(-B, D);
+    if (eb > ea) {  // the DDA steps: -B = k D + m (m in [0, D): exact mod 2^64)
+      const int64_t k = stride == 1 ? floorDiv(-e.B, D) : floorDiv(-B, D);
       requireCoord(k, p, "edge DDA step k");
       d.k = static_cast<int32_t>(k);
-      d.m = static_cast<int64_t>(-B - static_cast<i128>(k) * D);
+      d.m = stride == 1 ? static_cast<int64_t>(static_cast<uint64_t>(-e.B) - static_cast<uint64_t>(k) * static_cast<uint64_t>(D))
+                        : static_cast<int64_t>(-B - static_cast<i128>(k) * D);
     }
     // While active the bound lies within the edge's horizontal extent (+-1): it fits.
     requireCoord(q, p, "edge DDA quotient");
@@ -408,7 +430,7 @@ void snapVertices(const std::array<SetupVertex, 3>& v, uint32_t tag, const Raste
     t.X[i] = snapHalfEven(v[i].x, S);
     t.Y[i] = snapHalfEven(v[i].y, S);
   }
-  t.a.assign(static_cast<size_t>(K), {});
+  t.a.resizeForOverwrite(static_cast<size_t>(K));  // every code written below
   const int64_t err_bound = (1 + int64_t{cfg.width} + cfg.height) / 2 + 2;  // codes, see header
   const int64_t lim = (int64_t{1} << (p.AttrBits - 1)) - 1 - err_bound;
   for (int k = 0; k < K; ++k) {
@@ -434,9 +456,9 @@ void setPlane(const SnappedTriangle& t, int S, int64_t u0, int64_t v0, Attribute
   const int64_t dx1 = t.X[1] - t.X[0], dy1 = t.Y[1] - t.Y[0], dx2 = t.X[2] - t.X[0], dy2 = t.Y[2] - t.Y[0];
   const int64_t dcx = ((2 * pl.xref + 1) << S) - u0, dcy = ((2 * pl.yref + 1) << S) - v0;
   const size_t K = t.a.size();
-  pl.didx.resize(K);
-  pl.didy.resize(K);
-  pl.iref.resize(K);
+  pl.didx.resizeForOverwrite(K);  // each written below
+  pl.didy.resizeForOverwrite(K);
+  pl.iref.resizeForOverwrite(K);
   for (size_t k = 0; k < K; ++k) {
     const auto& a = t.a[k];
     const int64_t da1 = a[1] - a[0], da2 = a[2] - a[0];  // |a| < 2^61: no overflow
@@ -565,22 +587,30 @@ void setupTriangle(const std::array<SetupVertex, 3>& v, uint32_t tag, const Rast
   d.row_first = static_cast<int32_t>(row_first);
   d.row_last = static_cast<int32_t>(row_last);
   d.xref = static_cast<int32_t>(pl.xref);
-  auto wrap = [&](i128 x) { return span_detail::wrapTo(static_cast<uint64_t>(x), p.AttrBits); };  // mod 2^AttrBits
+  // Every code the unit takes is mod 2^AttrBits (AttrBits < 64): formed mod 2^64 in uint64_t,
+  // which equals the exact value mod 2^64, then wrapped.
+  auto wrap = [&](uint64_t x) { return span_detail::wrapTo(x, p.AttrBits); };
+  auto u = [](int64_t x) { return static_cast<uint64_t>(x); };
+  auto planeAt = [&](size_t k, int64_t px, int64_t py) {  // AttributePlane::at mod 2^64
+    return u(pl.iref[k]) + u(pl.didx[k]) * u(px - pl.xref) + u(pl.didy[k]) * u(py - pl.yref);
+  };
   // The walker plane I_w(x, w) is the screen plane at (x, ystride w).
   const int64_t ystride = d.interleave ? p.NumTri : 1;
-  for (int k = 0; k < K; ++k) {
-    d.iref.push_back(wrap(pl.at(k, d.xref, ystride * d.row_first)));
-    d.didx.push_back(wrap(pl.didx[static_cast<size_t>(k)]));
-    d.didy.push_back(wrap(static_cast<i128>(pl.didy[static_cast<size_t>(k)]) * ystride));
+  const size_t Ku = static_cast<size_t>(K);
+  d.iref.resizeForOverwrite(Ku);  // each written below
+  d.didx.resizeForOverwrite(Ku);
+  d.didy.resizeForOverwrite(Ku);
+  for (size_t k = 0; k < Ku; ++k) {
+    d.iref[k] = wrap(planeAt(k, d.xref, ystride * d.row_first));
+    d.didx[k] = wrap(u(pl.didx[k]));
+    d.didy[k] = wrap(u(pl.didy[k]) * u(ystride));
   }
   for (SpanLaneTri& l : lanes) {
     // Lane attribute = I_w + aoff, or aoff - I_w when flipped, with I_w the walker plane: the
     // lane's pixel (x + ox, ystride w + oy) has the value I_w(x, w) + didx ox + didy oy.
-    for (int k = 0; k < K; ++k) {
-      const i128 dx = pl.didx[static_cast<size_t>(k)], dy = pl.didy[static_cast<size_t>(k)];
-      l.aoff.push_back(l.flip ? wrap(static_cast<i128>(pl.at(k, 0, 0)) + pl.at(k, l.ox, l.oy))
-                              : wrap(dx * l.ox + dy * l.oy));
-    }
+    l.aoff.resizeForOverwrite(Ku);
+    for (size_t k = 0; k < Ku; ++k)
+      l.aoff[k] = wrap(l.flip ? planeAt(k, 0, 0) + planeAt(k, l.ox, l.oy) : u(pl.didx[k]) * u(l.ox) + u(pl.didy[k]) * u(l.oy));
   }
 }
 

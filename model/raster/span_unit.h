@@ -221,8 +221,10 @@ struct SpanOut {
 };
 
 // An edge's DDA registers: the quotient q and remainder r of the current row.
+// Trivial (no member initialisers): the walk's registers are left uninitialised beyond the edges
+// a descriptor uses (zeroing all twelve cost a `rep stos` per triangle); `{}` zeroes.
 struct SpanDdaState {
-  int64_t q = 0, r = 0;
+  int64_t q, r;
 };
 
 // The full-rate unit's cycles (RowAhead = 1) over a stream of descriptors presented back to back

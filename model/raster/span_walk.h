@@ -293,7 +293,7 @@ SpanWalk walkSpanUnit(const SpanParams& p, const SpanDesc& d, Sink&& consumer, R
   SpanStream& timing = stream != nullptr ? *stream : alone;
   const uint64_t stream_end = timing.end();
   uint64_t groups = 0;  // the lane groups (SPAN cycles) of the current row
-  std::array<SpanDdaState, kMaxLaneTri * 3> e;  // the first 3 T set here (zeroing all costs more than a row)
+  std::array<SpanDdaState, kMaxLaneTri * 3> e;  // the first 3 T set here, the rest left uninitialised
   for (int j = 0; j < T; ++j)
     for (int s = 0; s < 3; ++s) {
       const SpanEdge& g = d.tri[static_cast<size_t>(j)].edge[s];

@@ -106,8 +106,12 @@ void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, cons
                           PVertex* verts, size_t begin, size_t end) {
   const NormalTransform to_world(obj.transform);
   for (size_t i = begin; i < end; ++i) {
-    verts[i] = PVertex{};
-    transformVertex(obj, basis, cam, proj, to_world, i, verts[i]);
+    // The fields transformVertex may leave as they are reset one by one (clearing the whole
+    // vertex first was a `rep stos` per vertex).
+    PVertex& v = verts[i];
+    v.x = v.y = v.w = 0;
+    v.colour = {};
+    transformVertex(obj, basis, cam, proj, to_world, i, v);
   }
 }
 

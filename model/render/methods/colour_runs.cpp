@@ -25,10 +25,10 @@ struct PendingRuns {
   uint64_t& covered;
   uint64_t& rejected;
   fixed_simd::ColourRuns& runs;  // the unit's, empty between triangles
-  uint64_t fragments = 0;  // of the runs waiting
-  bool stepped = false;    // runs.dc and dz are the waiting runs' steps (a run of one pixel has none)
+  bool stepped = false;          // runs.dc and dz are the waiting runs' steps (a run of one pixel has none)
 
-  void add(const RowRun& r, int W) {
+  // Inlined into the walk's rows; the kernel's call (flush) is not.
+  [[gnu::always_inline]] void add(const RowRun& r, int W) {
     // The runs of one call share their steps; a run of one pixel takes any.
     const bool same = !stepped || r.count == 1 ||
                       (r.da[0] == runs.dc[0] && r.da[1] == runs.dc[1] && r.da[2] == runs.dc[2] &&
@@ -45,15 +45,14 @@ struct PendingRuns {
     row.room = static_cast<size_t>(W - r.x0);
     row.z = static_cast<uint32_t>(r.a0[3]);
     for (size_t k = 0; k < 3; ++k) row.c[k] = static_cast<int32_t>(r.a0[k]);
-    fragments += row.count;
   }
-  void flush() {
+  [[gnu::noinline]] void flush() {
     if (runs.n == 0) return;
-    uint64_t passed = 0;
+    uint64_t passed = 0, fragments = 0;
+    for (size_t i = 0; i < runs.n; ++i) fragments += runs.rows[i].count;
     covered += kernel(runs, target, rgb, passed);
     rejected += fragments - passed;
     runs.n = 0;
-    fragments = 0;
     stepped = false;
   }
 };
@@ -93,11 +92,12 @@ struct ColourRunLoop {
   uint64_t& rejected;
   PendingRuns& pending;
 
-  void operator()(const RowRun& r) const {
-    if (pending.kernel != nullptr && r.dx == 1) {
-      pending.add(r, W);
-      return;
-    }
+  [[gnu::always_inline]] void operator()(const RowRun& r) const {
+    if (pending.kernel != nullptr && r.dx == 1) pending.add(r, W);
+    else loopRun(r);
+  }
+
+  [[gnu::noinline]] void loopRun(const RowRun& r) const {
     pending.flush();
     const auto put = write;
     const int64_t count = r.count;  // a local: r may alias the pixels' byte stores
