@@ -100,14 +100,6 @@ Mat4 Mat4::operator*(const Mat4& o) const {
   return r;
 }
 
-Vec3 Mat4::point(Vec3 p) const { return direction(p) + Vec3{m[0][3], m[1][3], m[2][3]}; }
-
-Vec3 Mat4::direction(Vec3 d) const {
-  return {m[0][0] * d.x + m[0][1] * d.y + m[0][2] * d.z,
-          m[1][0] * d.x + m[1][1] * d.y + m[1][2] * d.z,
-          m[2][0] * d.x + m[2][1] * d.y + m[2][2] * d.z};
-}
-
 double Mat4::determinant3() const {
   return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
          m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
@@ -129,12 +121,6 @@ NormalTransform::NormalTransform(const Mat4& t) : mirror(t.determinant3() < 0) {
   c[2][0] = m[0][1] * m[1][2] - m[0][2] * m[1][1];
   c[2][1] = m[0][2] * m[1][0] - m[0][0] * m[1][2];
   c[2][2] = m[0][0] * m[1][1] - m[0][1] * m[1][0];
-}
-
-Vec3 NormalTransform::operator()(Vec3 n) const {
-  const Vec3 r{c[0][0] * n.x + c[0][1] * n.y + c[0][2] * n.z, c[1][0] * n.x + c[1][1] * n.y + c[1][2] * n.z,
-               c[2][0] * n.x + c[2][1] * n.y + c[2][2] * n.z};
-  return normalize(mirror ? -r : r);
 }
 
 Mesh worldMesh(const SceneObject& obj) {

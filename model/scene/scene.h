@@ -115,8 +115,12 @@ struct Mat4 {
   static Mat4 scale(Vec3 s);
   static Mat4 rotateDeg(Vec3 xyz);  // rotation about x, then y, then z
   Mat4 operator*(const Mat4& o) const;
-  Vec3 point(Vec3 p) const;
-  Vec3 direction(Vec3 d) const;  // no translation
+  // Inline (per vertex of every frame).
+  Vec3 point(Vec3 p) const { return direction(p) + Vec3{m[0][3], m[1][3], m[2][3]}; }
+  Vec3 direction(Vec3 d) const {  // no translation
+    return {m[0][0] * d.x + m[0][1] * d.y + m[0][2] * d.z, m[1][0] * d.x + m[1][1] * d.y + m[1][2] * d.z,
+            m[2][0] * d.x + m[2][1] * d.y + m[2][2] * d.z};
+  }
   Vec3 normal(Vec3 n) const;     // by the inverse transpose, normalised
   double determinant3() const;   // of the linear (upper-left 3x3) part; < 0 mirrors
 };
@@ -125,7 +129,11 @@ struct Mat4 {
 // sign of det computed once; operator() equals Mat4::normal bit for bit.
 struct NormalTransform {
   explicit NormalTransform(const Mat4& t);
-  Vec3 operator()(Vec3 n) const;
+  Vec3 operator()(Vec3 n) const {
+    const Vec3 r{c[0][0] * n.x + c[0][1] * n.y + c[0][2] * n.z, c[1][0] * n.x + c[1][1] * n.y + c[1][2] * n.z,
+                 c[2][0] * n.x + c[2][1] * n.y + c[2][2] * n.z};
+    return normalize(mirror ? -r : r);
+  }
   double c[3][3];
   bool mirror;  // det < 0
 };

@@ -94,14 +94,6 @@ CameraBasis cameraBasis(const Camera& cam) {
   return {right, up, forward};
 }
 
-Vec3 toCameraDirection(const CameraBasis& b, Vec3 d) {
-  return {dot(b.right, d), dot(b.up, d), dot(b.forward, d)};
-}
-
-Vec3 toCameraSpace(const CameraBasis& b, const Camera& cam, Vec3 p) {
-  return toCameraDirection(b, p - cam.eye);
-}
-
 std::vector<ScreenTriangle> projectFrontFaces(const Mesh& mesh, const Camera& cam) {
   const CameraBasis basis = cameraBasis(cam);
   const double cx = 0.5 * cam.width, cy = 0.5 * cam.height;

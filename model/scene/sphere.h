@@ -128,8 +128,9 @@ struct CameraBasis {
 CameraBasis cameraBasis(const Camera& cam);
 
 // Camera-space coordinates (X, Y, Z) of a point, and of a direction (no translation).
-Vec3 toCameraSpace(const CameraBasis& b, const Camera& cam, Vec3 p);
-Vec3 toCameraDirection(const CameraBasis& b, Vec3 d);
+// Inline: per vertex of every frame.
+inline Vec3 toCameraDirection(const CameraBasis& b, Vec3 d) { return {dot(b.right, d), dot(b.up, d), dot(b.forward, d)}; }
+inline Vec3 toCameraSpace(const CameraBasis& b, const Camera& cam, Vec3 p) { return toCameraDirection(b, p - cam.eye); }
 
 struct ScreenVertexPos {
   double x, y;  // pixels, y down; pixel (i, j) covers [i, i+1) x [j, j+1)
