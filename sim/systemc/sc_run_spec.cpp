@@ -52,13 +52,15 @@ std::unique_ptr<SpecVectors> loadSpecFile(const ScOptions& o, const SpecUnitPara
   return file;
 }
 
-// A temporary PROM file, removed with this object.
+// A temporary PROM file and, for the piecewise kind, its segment ROM (path + kSegRomSuffix),
+// removed with this object.
 struct TempProm {
   std::string path;
   ~TempProm() {
     if (!path.empty()) {
       std::error_code ec;
       fs::remove(path, ec);
+      fs::remove(path + kSegRomSuffix, ec);
     }
   }
 };
