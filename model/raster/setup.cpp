@@ -286,11 +286,10 @@ bool buildLaneTri(InlineVec<SpanLaneTri, kMaxLaneTri>& lanes, const Geom& g, boo
     d.r = r;
     d.div = D;
     if (eb > ea) {  // the DDA steps: -B = k D + m (m in [0, D): exact mod 2^64)
-      const int64_t k = stride == 1 ? floorDiv(-e.B, D) : floorDiv(-B, D);
+      const int64_t k = floorDiv(-B, D);
       requireCoord(k, p, "edge DDA step k");
       d.k = static_cast<int32_t>(k);
-      d.m = stride == 1 ? static_cast<int64_t>(static_cast<uint64_t>(-e.B) - static_cast<uint64_t>(k) * static_cast<uint64_t>(D))
-                        : static_cast<int64_t>(-B - static_cast<i128>(k) * D);
+      d.m = static_cast<int64_t>(0 - static_cast<uint64_t>(B) - static_cast<uint64_t>(k) * static_cast<uint64_t>(D));
     }
     // While active the bound lies within the edge's horizontal extent (+-1): it fits.
     requireCoord(q, p, "edge DDA quotient");
