@@ -190,6 +190,19 @@ SHD_AVX2 inline RunLanes runLanes(const ColourRuns& r) {
   return l;
 }
 
+// A run's codes at its group of fragments k .. k + 7: the depth code zk and the colour codes ck
+// of fragment k (mod 2^32), from the run's first and stepped 8 fragments at a time.
+struct GroupCodes {
+  uint32_t zk;
+  std::array<uint32_t, 3> ck;
+  explicit GroupCodes(const ColourRuns::Row& row)
+      : zk(row.z), ck{static_cast<uint32_t>(row.c[0]), static_cast<uint32_t>(row.c[1]), static_cast<uint32_t>(row.c[2])} {}
+  void next(const ColourRuns& r) {
+    zk += 8 * r.dz;
+    for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(r.dc[ch]);
+  }
+};
+
 // Fragments k .. k + 7 of a colour run whose fragment k has the codes ck: unorm8FromCode of each
 // channel's code (clamped to [0, 255 2^frac], rounded half up to an integer), packed by packRgb.
 SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_t, 3>& ck) {
@@ -276,8 +289,8 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
 
 // colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
 // the mask registers; the depth and tag through masked 32-bit stores, the colour bytes as below.
-// The loops over the runs and their groups are the AVX-512 kernel's, written out in each: one
-// iterator over the groups shared by both made a Gouraud frame 1-6 % slower (4 interleaved runs).
+// The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
+// iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
 SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
   const RunLanes l = runLanes(r);
   const __m256i lanes = lanes8();
@@ -286,13 +299,11 @@ SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* 
   uint64_t covered = 0;
   for (size_t i = 0; i < r.n; ++i) {
     const ColourRuns::Row& row = r.rows[i];
-    uint32_t zk = row.z;
-    std::array<uint32_t, 3> ck;
-    for (size_t ch = 0; ch < 3; ++ch) ck[ch] = static_cast<uint32_t>(row.c[ch]);
-    for (size_t k = 0; k < row.count; k += 8) {
+    GroupCodes g(row);
+    for (size_t k = 0; k < row.count; k += 8, g.next(r)) {
       const int n = static_cast<int>(std::min<size_t>(8, row.count - k));
       const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
-      const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), l.dz);
+      const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(g.zk)), l.dz);
       int32_t* const depth = t.depth + row.p + k;
       __builtin_prefetch(depth + 2 * t.width);
       __builtin_prefetch(depth + 2 * t.width + 7);
@@ -307,7 +318,7 @@ SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* 
         _mm256_maskstore_epi32(t.tri + row.p + k, pass_v, tag);
         // The 8 pixels' 24 bytes, in order.
         alignas(32) uint8_t bytes[32];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(l, ck), join));
+        _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(l, g.ck), join));
         uint8_t* const out = rgb + 3 * (row.p + k);
         if (pass == 0xFF) {
           std::memcpy(out, bytes, 24);
@@ -324,8 +335,6 @@ SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* 
           }
         }
       }
-      zk += 8 * r.dz;
-      for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(r.dc[ch]);
     }
   }
   return covered;
@@ -336,22 +345,18 @@ SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8
   uint64_t covered = 0, pass_count = 0;
   for (size_t i = 0; i < r.n; ++i) {
     const ColourRuns::Row& row = r.rows[i];
-    uint32_t zk = row.z;
-    std::array<uint32_t, 3> ck;
-    for (size_t ch = 0; ch < 3; ++ch) ck[ch] = static_cast<uint32_t>(row.c[ch]);
-    for (size_t k = 0; k < row.count; k += 8) {
-      const __mmask8 pass = zTest8(t, t.depth + row.p + k, t.tri + row.p + k, row.count - k, zk, l.dz, covered);
+    GroupCodes g(row);
+    for (size_t k = 0; k < row.count; k += 8, g.next(r)) {
+      const __mmask8 pass = zTest8(t, t.depth + row.p + k, t.tri + row.p + k, row.count - k, g.zk, l.dz, covered);
       pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
       if (pass != 0) {
-        const __m256i bytes = colourBytes8(l, ck);
+        const __m256i bytes = colourBytes8(l, g.ck);
         // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
         const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
         uint8_t* const out = rgb + 3 * (row.p + k);
         _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
         _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
       }
-      zk += 8 * r.dz;
-      for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(r.dc[ch]);
     }
   }
   passed += pass_count;

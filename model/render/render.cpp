@@ -377,21 +377,14 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
 // counted as Frame::walk counts it: on this side, with the span engine's stream.
 void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w) {
   w.events.clear();
+  // Each event built whole (an emplace_back() and then its fields cleared the event first, a
+  // `rep stos` per row).
   auto fragment = [&w](int32_t x, int32_t y, const int64_t* attr) {
-    RecordedWalk::Event& e = w.events.emplace_back();
-    e.x0 = x;
-    e.y = y;
-    std::copy(attr, attr + e.a0.size(), e.a0.begin());
+    w.events.push_back({false, x, y, 1, 1, {attr[0], attr[1], attr[2], attr[3]}, {}});
   };
   auto run = [&w](const RowRun& r) {
-    RecordedWalk::Event& e = w.events.emplace_back();
-    e.run = true;
-    e.x0 = r.x0;
-    e.y = r.y;
-    e.dx = r.dx;
-    e.count = r.count;
-    std::copy(r.a0, r.a0 + e.a0.size(), e.a0.begin());
-    std::copy(r.da, r.da + e.da.size(), e.da.begin());
+    w.events.push_back(
+        {true, r.x0, r.y, r.dx, r.count, {r.a0[0], r.a0[1], r.a0[2], r.a0[3]}, {r.da[0], r.da[1], r.da[2], r.da[3]}});
   };
   const SpanWalk wk = walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull());
   f_.st.span_cycles += wk.cycles;
