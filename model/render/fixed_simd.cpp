@@ -162,9 +162,11 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
   return true;
 }
 
-// Lanes 0 .. 7 as 32-bit values.
 // AVX2 helpers, inlined into the AVX2 and the AVX-512 kernels (a subset of either's target).
+// Lanes 0 .. 7 as 32-bit values.
 SHD_AVX2 inline __m256i lanes8() { return _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0); }
+// Lane i's offset i d from its group's first fragment, for a step d (mod 2^32).
+SHD_AVX2 inline __m256i laneSteps(uint32_t d) { return _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(d))); }
 
 // Within each 128-bit half: pixels' bytes r g b (of 32-bit lanes r | g << 8 | b << 16) packed
 // into the first 12 bytes, the last 4 zero.
@@ -182,8 +184,8 @@ struct RunLanes {
 };
 SHD_AVX2 inline RunLanes runLanes(const ColourRuns& r) {
   RunLanes l;
-  l.dz = _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(r.dz)));
-  for (size_t ch = 0; ch < 3; ++ch) l.dc[ch] = _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(r.dc[ch]));
+  l.dz = laneSteps(r.dz);
+  for (size_t ch = 0; ch < 3; ++ch) l.dc[ch] = laneSteps(static_cast<uint32_t>(r.dc[ch]));
   l.top = _mm256_set1_epi32(255 << r.frac);
   l.half = _mm256_set1_epi32(1 << (r.frac - 1));
   l.frac = _mm_cvtsi32_si128(r.frac);
@@ -261,7 +263,7 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
   const __m512i l0 = _mm512_set1_epi64(static_cast<int64_t>(r.l)), dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl));
   const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
-  const __m256i dz_lanes = _mm256_mullo_epi32(lanes8(), _mm256_set1_epi32(static_cast<int32_t>(r.px.dz)));
+  const __m256i dz_lanes = laneSteps(r.px.dz);
   size_t n = b.n, k = first;
   uint64_t covered = 0;
   for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
