@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "raster/exact_int.h"
 #include "raster/span_walk.h"
 
 
@@ -17,78 +18,7 @@ namespace shd {
 namespace {
 
 using i128 = __int128;
-
-// round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven, without its format checks: the
-// callers have bounded |v 2^frac| well below 2^62 (the guard band, the attribute range). 2^frac
-// as a double multiplier is exact, like ldexp. Below 2^51 in magnitude, adding and subtracting
-// 1.5 * 2^52 rounds to an integer half to even in IEEE double (the default rounding mode, as
-// nearbyint uses) without a libm call; larger values go through nearbyint.
-int64_t snapHalfEven(double v, int frac) {
-  const double x = v * static_cast<double>(int64_t{1} << frac);
-  constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
-  if (std::fabs(x) < 2251799813685248.0) return static_cast<int64_t>((x + kMagic) - kMagic);  // 2^51
-  return static_cast<int64_t>(std::nearbyint(x));
-}
-
-bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }
-
-__attribute__((noinline)) int64_t floorDivWide(i128 a, i128 b) {
-  i128 q = a / b;
-  if ((a % b) != 0 && a < 0) --q;
-  return static_cast<int64_t>(q);
-}
-// b > 0. Inlined: the common case is one 64-bit division, the 128-bit one out of line.
-[[gnu::always_inline]] inline int64_t floorDiv(i128 a, i128 b) {
-  if (!fitsI64(a) || !fitsI64(b)) return floorDivWide(a, b);
-  const int64_t a64 = static_cast<int64_t>(a), b64 = static_cast<int64_t>(b);
-  const int64_t q = a64 / b64;
-  return q - static_cast<int64_t>(((a64 % b64) != 0) & (a64 < 0));  // without a branch, as roundHalfEvenFrom
-}
-[[gnu::always_inline]] inline int64_t ceilDiv(i128 a, i128 b) { return -floorDiv(-a, b); }  // b > 0
-// ceil(a / b) for b > 0 in 64 bits: one division.
-[[gnu::always_inline]] inline int64_t ceilDiv64(int64_t a, int64_t b) {
-  const int64_t q = a / b;
-  return q + static_cast<int64_t>(((a % b) != 0) & (a > 0));
-}
-// ceil((x y - c) / b) for b > 0: in 64 bits where x y - c fits, else in 128.
-[[gnu::always_inline]] inline int64_t ceilDivOfProduct(int64_t x, int64_t y, int64_t c, int64_t b) {
-  int64_t xy = 0, n = 0;
-  if (!__builtin_mul_overflow(x, y, &xy) && !__builtin_sub_overflow(xy, c, &n)) return ceilDiv64(n, b);
-  return ceilDiv(static_cast<i128>(x) * y - c, b);
-}
-
-// round-half-even(num / den) from the truncated quotient q and remainder r of num / den
-// (|r| < den, den > 0): floor first, then up when the remainder is above half, or exactly half
-// with q odd (r vs den - r: no overflow of 2r).
-// Without branches: the remainder's sign and the rounding are data, not a pattern (setup
-// runs a dozen of these per triangle; mispredicted branches cost more than the arithmetic).
-template <class T>
-T roundHalfEvenFrom(T q, T r, T den) {
-  const T neg = r < 0 ? 1 : 0;
-  q -= neg;
-  r += den * neg;
-  const T rest = den - r;
-  return q + static_cast<T>((r > rest) | ((r == rest) & ((q & 1) != 0)));
-}
-
-// round-half-even(num / den), den > 0: in 64 bits with one division when both fit (the
-// common case, inlined), else in 128 bits.
-__attribute__((noinline)) i128 roundDivWide(i128 num, i128 den) { return roundHalfEvenFrom(num / den, num % den, den); }
-inline i128 roundDiv(i128 num, i128 den) {
-  if (!fitsI64(num) || !fitsI64(den)) return roundDivWide(num, den);
-  const int64_t n = static_cast<int64_t>(num), d = static_cast<int64_t>(den);
-  return roundHalfEvenFrom(n / d, n % d, d);
-}
-
-// round-half-even(base + num / den), den > 0, in 64 bits: one division, then
-// roundHalfEvenFrom(base + q, r, den), whose floor and parity are those of base + num / den.
-// No overflow: |q| <= |num| / den, and base is an attribute code (|base| < 2^61) with
-// den = 2 det >= 2, or 0. (A quotient estimated from one reciprocal of den and corrected in
-// integers took 2-4 % longer a Gouraud frame than the division on a 2-core AMD EPYC VM,
-// interleaved runs.)
-inline int64_t roundDivPlus(int64_t base, int64_t num, int64_t den) {
-  return roundHalfEvenFrom(base + num / den, num % den, den);
-}
+using namespace exact;
 
 // A triangle in one frame: vertices in u units and its three biased edge functions in that
 // frame's pixel coordinates (edge s runs from vertex s to vertex s+1).
@@ -141,12 +71,6 @@ Geom reflected(const Geom& g, int64_t ox, int64_t oy, int S) {
   return w;
 }
 
-// Rows whose pixel centre (2w+1)*2^S lies in [lo, hi] (u units): floor and ceiling divisions
-// by step = 2^(S+1) as arithmetic shifts (floor for any sign; |lo|, |hi| are far below 2^62).
-std::pair<int64_t, int64_t> centreRows(int64_t lo, int64_t hi, int S) {
-  const int64_t half = int64_t{1} << S;
-  return {-((half - lo) >> (S + 1)), (hi - half) >> (S + 1)};
-}
 
 [[noreturn]] __attribute__((noinline, cold)) void coordDoesNotFit(int64_t v, const SpanParams& p, const char* what) {
   throw std::logic_error(fmt::format("setup: {} = {} does not fit CoordBits {}", what, v, p.CoordBits));
@@ -415,10 +339,8 @@ void snapVertices(const std::array<SetupVertex, 3>& v, uint32_t tag, const Raste
   }
 }
 
-// The attribute planes' codes (see the header): the gradients per pixel nx 2^S / det and
-// ny 2^S / det, and the exact plane at the reference pixel's centre (cx, cy) (u units),
-// a0 + (nx (cx - U0) + ny (cy - V0)) / (2 det), each rounded half to even. In 64-bit integers
-// where every product and sum provably fits (checked: the common case), else in 128 bits.
+// The attribute planes' codes (see the header and planeCodes64): in 64-bit integers where every
+// product and sum provably fits (checked: the common case), else in 128 bits.
 void setPlane(const SnappedTriangle& t, int S, int64_t u0, int64_t v0, AttributePlane& pl) {
   const int64_t det2 = 2 * t.det;
   const int64_t dx1 = t.X[1] - t.X[0], dy1 = t.Y[1] - t.Y[0], dx2 = t.X[2] - t.X[0], dy2 = t.Y[2] - t.Y[0];
@@ -429,20 +351,8 @@ void setPlane(const SnappedTriangle& t, int S, int64_t u0, int64_t v0, Attribute
   pl.iref.resizeForOverwrite(K);
   for (size_t k = 0; k < K; ++k) {
     const auto& a = t.a[k];
+    if (planeCodes64(a, dx1, dy1, dx2, dy2, dcx, dcy, t.det, S, pl.didx[k], pl.didy[k], pl.iref[k])) continue;
     const int64_t da1 = a[1] - a[0], da2 = a[2] - a[0];  // |a| < 2^61: no overflow
-    int64_t p1, p2, p3, p4, nx, ny, sx, sy, rx, ry, num;
-    const bool fits = !__builtin_mul_overflow(da1, dy2, &p1) && !__builtin_mul_overflow(da2, dy1, &p2) &&
-                      !__builtin_sub_overflow(p1, p2, &nx) && !__builtin_mul_overflow(dx1, da2, &p3) &&
-                      !__builtin_mul_overflow(dx2, da1, &p4) && !__builtin_sub_overflow(p3, p4, &ny) &&
-                      !__builtin_mul_overflow(nx, int64_t{1} << S, &sx) && !__builtin_mul_overflow(ny, int64_t{1} << S, &sy) &&
-                      !__builtin_mul_overflow(nx, dcx, &rx) && !__builtin_mul_overflow(ny, dcy, &ry) &&
-                      !__builtin_add_overflow(rx, ry, &num);
-    if (fits) {
-      pl.didx[k] = roundDivPlus(0, sx, t.det);  // per pixel = per subpixel * 2^S
-      pl.didy[k] = roundDivPlus(0, sy, t.det);
-      pl.iref[k] = roundDivPlus(a[0], num, det2);
-      continue;
-    }
     const i128 nx128 = static_cast<i128>(da1) * dy2 - static_cast<i128>(da2) * dy1;
     const i128 ny128 = static_cast<i128>(dx1) * da2 - static_cast<i128>(dx2) * da1;
     pl.didx[k] = static_cast<int64_t>(roundDiv(nx128 * (i128{1} << S), t.det));

@@ -290,7 +290,8 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
 }
 
 // colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
-// the mask registers; the depth and tag through masked 32-bit stores, the colour bytes as below.
+// the mask registers; the depth and tag blended into 32-byte stores within the row (else masked
+// 32-bit stores), the colour bytes as below.
 // The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
 // iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
 SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
@@ -309,15 +310,27 @@ SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* 
       int32_t* const depth = t.depth + row.p + k;
       __builtin_prefetch(depth + 2 * t.width);
       __builtin_prefetch(depth + 2 * t.width + 7);
-      const __m256i old = _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
+      // The 8 pixels lie in the run's row: plain loads, and stores of the blend (the pixels
+      // that do not pass written back as read). Masked stores (vpmaskmovd) are slow on AMD
+      // (docs/performance.md); they remain for a group at the row's right end.
+      const bool in_row = k + 8 <= row.room;
+      int32_t* const tri = t.tri + row.p + k;
+      const __m256i old = in_row ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(depth))
+                                 : _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
       const __m256i pass_v = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
       const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
       if (pass != 0) {
         passed += static_cast<uint64_t>(__builtin_popcount(pass));
         const unsigned fresh = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, zero))));
         covered += static_cast<uint64_t>(__builtin_popcount(pass & fresh));
-        _mm256_maskstore_epi32(depth, pass_v, z);
-        _mm256_maskstore_epi32(t.tri + row.p + k, pass_v, tag);
+        if (in_row) {
+          _mm256_storeu_si256(reinterpret_cast<__m256i*>(depth), _mm256_blendv_epi8(old, z, pass_v));
+          const __m256i tri_old = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(tri));
+          _mm256_storeu_si256(reinterpret_cast<__m256i*>(tri), _mm256_blendv_epi8(tri_old, tag, pass_v));
+        } else {
+          _mm256_maskstore_epi32(depth, pass_v, z);
+          _mm256_maskstore_epi32(tri, pass_v, tag);
+        }
         // The 8 pixels' 24 bytes, in order.
         alignas(32) uint8_t bytes[32];
         _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(l, g.ck), join));

@@ -109,9 +109,10 @@ struct ColourRuns {
 // and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch], run after run.
 // Returns the passing pixels whose depth was 0 (not covered before); adds the passing pixels to
 // passed. Two kernels, each for a CPU with its instructions: AVX-512 and AVX2, the same
-// operations on 8 lanes. AVX2 has no byte-masked store: a group's colour bytes are blended into
-// the 32 bytes there (the bytes of other pixels written back as read) where those lie within
-// the run's row (room), else written pixel by pixel, so no pixel of another row is touched.
+// operations on 8 lanes. AVX2 has no byte-masked store, and its masked 32-bit store is slow on
+// AMD: a group's colour bytes, depth codes and tags are blended into the 32 bytes there (those
+// of other pixels written back as read) where those lie within the run's row (room), else
+// written pixel by pixel (colour) or by masked stores, so no pixel of another row is touched.
 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed);
 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed);
 // The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else null.

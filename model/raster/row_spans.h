@@ -1,0 +1,94 @@
+// Small screen triangles set up straight to the rows the span unit shows: for a unit of a single
+// lane-triangle (NumTri 1: serial, evenodd, the segments, and their full-rate units) with 4
+// attributes of 32 bits, the renderer's unit, a triangle of at most RowSpans::kMaxRows rows is
+// set up to its rows' spans [lo, hi] and its attribute plane, instead of a span descriptor
+// (raster/setup.h) that the walk (raster/span_walk.h) then turns into the same rows.
+//
+// The same fragments, values and cycles, by construction:
+//   - the vertices, the attribute codes, the edge functions with their top-left bias and the
+//     plane's codes are setup's (the same exact integer operations, raster/exact_int.h);
+//   - a row's span is every pixel of the viewport whose centre passes the three biased edge
+//     functions (raster/setup.h: rasterizeReference's set), each edge's bound found by its DDA
+//     from the first row. The unit tests only the edges active in a row (whose vertical extent
+//     holds the row's centre); the third one's half-plane holds the span of the other two,
+//     since a centre on the row inside both and on the third edge's line would lie on that
+//     edge, so within its extent: the same pixels. (Its extended line's bound may lie far away;
+//     the DDA's values are exact in 64 bits here, where the unit's registers would wrap.)
+//   - the rows are trimmed to the first and the last with a pixel, as setup trims them; rows
+//     in between without a pixel stay (a ROW cycle each);
+//   - a covered pixel's attribute is the plane there, exactly: the triangle is taken only when
+//     the plane fits 32 bits at the corners of its pixels' bounding box (so at every covered
+//     pixel, the plane being affine), where the unit's values mod 2^32 are these;
+//   - the cycles (countRowSpans) are the walk's: a ROW cycle per row, the lane groups of each
+//     row, the IDLE cycle, or the full-rate unit's stream fed row by row.
+// setupRowSpans declines (General) whatever it does not settle itself: a vertex or attribute
+// setup refuses (the caller's setupTriangle then says why), a larger triangle, a plane or a
+// DDA step that does not fit its narrow formats. Test RowSpans.* compares it with setup and the
+// walk on the generator's triangles and on slivers, and Render.RowSpansEqualTheSpanWalk whole
+// frames.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "raster/setup.h"
+#include "raster/span_unit.h"
+
+namespace shd {
+
+struct RowSpans {
+  static constexpr int kMaxRows = 64;
+  struct Vertex {
+    double x = 0, y = 0;         // pixels, y down
+    std::array<double, 4> attr;  // in the attribute's units, as SetupVertex::attr
+  };
+  int32_t y0 = 0, rows = 0;  // screen rows y0 .. y0 + rows - 1; the first and the last hold a pixel
+  int32_t x0 = 0;            // span[0]'s lo: the first pixel, (x0, y0)
+  std::array<int64_t, 4> a0;            // the attribute codes at the first pixel
+  std::array<int64_t, 4> didx, didy;    // the plane's gradients (SetupResult::plane's), within int32_t
+  std::array<std::array<int16_t, 2>, kMaxRows> span;  // [lo, hi] of row y0 + i; lo > hi: no pixel
+};
+
+// What setupRowSpans needs of a raster configuration, once per frame.
+struct RowSpansConfig {
+  // The unit is of one lane-triangle with 4 attributes of 32 bits, and the viewport and the
+  // guard band are within the bounds setupRowSpans's arithmetic assumes (int16_t columns,
+  // subpixel coordinates below 2^29).
+  bool applies = false;
+  int S = 4, W = 0, H = 0;
+  int64_t k_lim = 0;                 // |DDA step k| < 2^(CoordBits - 1): setup's register bound
+  double guard = 0;                  // setup's guard band, px
+  std::array<int, 4> frac{};         // the attributes' fraction bits
+  std::array<double, 4> scale{};     // 2^frac
+  double lim = 0;                    // setup's bound of |attribute 2^frac|
+  explicit RowSpansConfig(const RasterConfig& cfg);
+};
+
+enum class RowSpansSetup {
+  Drawn,    // `out` holds it
+  Dropped,  // setup drops it: zero area, or no pixel centre inside it in the viewport
+  General,  // not settled here: set it up with setupTriangle
+};
+RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, RowSpans& out);
+
+// The cycles and fragments walkSpanUnit counts for the descriptor setup makes of the same
+// triangle (p: the unit, NumTri 1), the full-rate unit's on `stream` (as walkSpanUnit's).
+SpanWalk countRowSpans(const SpanParams& p, const RowSpans& s, SpanStream* stream);
+
+// The rows' fragments as walkSpanUnit hands them to a run consumer: one RowRun per row with a
+// pixel, top to bottom, each left to right.
+template <class RunSink>
+inline void emitRowSpans(const RowSpans& s, RunSink& run) {
+  std::array<int64_t, 4> a, da;
+  for (int32_t i = 0; i < s.rows; ++i) {
+    const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo > hi) continue;
+    for (size_t k = 0; k < 4; ++k) {
+      a[k] = s.a0[k] + s.didx[k] * (lo - s.x0) + s.didy[k] * i;  // exact: the plane fits int32_t here
+      da[k] = hi > lo ? s.didx[k] : 0;
+    }
+    run(RowRun{static_cast<int32_t>(lo), s.y0 + i, 1, hi - lo + 1, a.data(), da.data()});
+  }
+}
+
+}  // namespace shd

@@ -1,0 +1,248 @@
+// The row spans of small triangles (raster/row_spans.h) against setup and the walk: the same
+// triangles dropped, the same fragments in the same order with the same values, the same
+// cycles, on the generator's triangles and on hand-made edge cases, in every mode of one
+// lane-triangle (the paper's units and the full-rate ones).
+#include "test_util.h"
+#include "raster/desc_stream.h"
+#include "raster/row_spans.h"
+#include "raster/setup.h"
+#include "raster/span_walk.h"
+#include "raster/trigen.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+
+#include <fmt/format.h>
+
+using namespace shd;
+using shd::testutil::spanModes;
+using shd::testutil::spanParams;
+
+namespace {
+
+// The renderer's raster configuration (render/render.cpp): colour in LSBs with 12 fraction
+// bits, depth with 28.
+RasterConfig rendererConfig(const std::string& mode, int w = 512, int h = 512) {
+  RasterConfig c;
+  c.width = w;
+  c.height = h;
+  c.unit = spanParams(mode);
+  c.attr_frac_bits = {12, 12, 12, 28};
+  c.validate();
+  return c;
+}
+
+struct Frag {
+  int32_t x, y;
+  std::array<int64_t, 4> a;
+  bool operator==(const Frag& o) const { return x == o.x && y == o.y && a == o.a; }
+};
+
+// Expands runs (and single fragments) into fragments, in order.
+struct Collect {
+  std::vector<Frag>& out;
+  void operator()(int32_t x, int32_t y, const int64_t* a) { out.push_back({x, y, {a[0], a[1], a[2], a[3]}}); }
+  void operator()(const RowRun& r) {
+    for (int64_t i = 0; i < r.count; ++i)
+      out.push_back({static_cast<int32_t>(r.x0 + i * r.dx), r.y,
+                     {r.a0[0] + i * r.da[0], r.a0[1] + i * r.da[1], r.a0[2] + i * r.da[2], r.a0[3] + i * r.da[3]}});
+  }
+};
+
+struct Tally {
+  std::map<RowSpansSetup, long> outcome;
+  long drawn_by_setup = 0;
+};
+
+// One triangle both ways; the streams carry the full-rate unit's timing from triangle to
+// triangle. Returns a description of the first difference, or "".
+std::string compare(const std::array<SetupVertex, 3>& sv, const RasterConfig& cfg, const RowSpansConfig& rc,
+                    SpanStream& walk_stream, SpanStream& spans_stream, Tally& tally) {
+  std::array<RowSpans::Vertex, 3> rv;
+  for (size_t i = 0; i < 3; ++i) {
+    rv[i].x = sv[i].x;
+    rv[i].y = sv[i].y;
+    for (size_t k = 0; k < 4; ++k) rv[i].attr[k] = sv[i].attr[k];
+  }
+  RowSpans spans;
+  const RowSpansSetup got = setupRowSpans(rv, rc, spans);
+  ++tally.outcome[got];
+  SetupResult s;
+  try {
+    s = setupTriangle(sv, 1, cfg);
+  } catch (const std::exception& e) {
+    return got == RowSpansSetup::General ? "" : fmt::format("setup throws ({}) but the row spans took it", e.what());
+  }
+  if (s.desc) ++tally.drawn_by_setup;
+  if (got == RowSpansSetup::General) {
+    // Set up and walked alone, on both streams (the renderer's frame feeds its one stream so).
+    auto none = [](int32_t, int32_t, const int64_t*) {};
+    if (s.desc && cfg.unit.RowAhead) {
+      walkSpanUnit(cfg.unit, *s.desc, none, span_detail::NoRuns{}, &walk_stream);
+      walkSpanUnit(cfg.unit, *s.desc, none, span_detail::NoRuns{}, &spans_stream);
+    }
+    return "";
+  }
+  if (got == RowSpansSetup::Dropped) return s.desc ? "row spans drop a triangle setup keeps" : "";
+  if (!s.desc) return fmt::format("row spans keep a triangle setup drops ({})", s.dropped);
+  std::vector<Frag> want, have;
+  Collect cw{want}, ch{have};
+  SpanStream* ws = cfg.unit.RowAhead ? &walk_stream : nullptr;
+  SpanStream* ss = cfg.unit.RowAhead ? &spans_stream : nullptr;
+  const SpanWalk w = walkSpanUnit(cfg.unit, *s.desc, cw, cw, ws);
+  emitRowSpans(spans, ch);
+  const SpanWalk c = countRowSpans(cfg.unit, spans, ss);
+  if (want.size() != have.size()) return fmt::format("{} fragments, the walk {}", have.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i)
+    if (!(want[i] == have[i]))
+      return fmt::format("fragment {}: ({}, {}) [{} {} {} {}], the walk ({}, {}) [{} {} {} {}]", i, have[i].x, have[i].y,
+                         have[i].a[0], have[i].a[1], have[i].a[2], have[i].a[3], want[i].x, want[i].y, want[i].a[0],
+                         want[i].a[1], want[i].a[2], want[i].a[3]);
+  if (c.cycles != w.cycles || c.fragments != w.fragments || c.row_cycles != w.row_cycles || c.span_cycles != w.span_cycles)
+    return fmt::format("cycles {} rows {} spans {} fragments {}, the walk {} {} {} {}", c.cycles, c.row_cycles,
+                       c.span_cycles, c.fragments, w.cycles, w.row_cycles, w.span_cycles, w.fragments);
+  if (s.desc->row_first != spans.y0 || s.desc->row_last != spans.y0 + spans.rows - 1)
+    return fmt::format("rows {}..{}, setup {}..{}", spans.y0, spans.y0 + spans.rows - 1, s.desc->row_first,
+                       s.desc->row_last);
+  for (size_t k = 0; k < 4; ++k)
+    if (spans.didx[k] != s.plane.didx[k] || spans.didy[k] != s.plane.didy[k])
+      return fmt::format("attribute {}: gradients {} {}, setup {} {}", k, spans.didx[k], spans.didy[k], s.plane.didx[k],
+                         s.plane.didy[k]);
+  return "";
+}
+
+std::string describe(const std::array<SetupVertex, 3>& v) {
+  return fmt::format("({}, {}) ({}, {}) ({}, {}) attributes [{} {} {} {}] [{} {} {} {}] [{} {} {} {}]", v[0].x, v[0].y,
+                     v[1].x, v[1].y, v[2].x, v[2].y, v[0].attr[0], v[0].attr[1], v[0].attr[2], v[0].attr[3], v[1].attr[0],
+                     v[1].attr[1], v[1].attr[2], v[1].attr[3], v[2].attr[0], v[2].attr[1], v[2].attr[2], v[2].attr[3]);
+}
+
+// The modes of one lane-triangle, where the row spans apply.
+std::vector<std::string> singleLaneModes() {
+  std::vector<std::string> out;
+  for (const std::string& m : spanModes())
+    if (spanParams(m).NumTri == 1) out.push_back(m);
+  return out;
+}
+
+}  // namespace
+
+TEST(RowSpans, EqualSetupAndTheWalkOnGeneratorTriangles) {
+  const std::vector<std::string> modes = singleLaneModes();
+  ASSERT_GE(modes.size(), 8u);  // serial, evenodd, seg2, seg4, seg8, and full-rate units
+  for (const std::string& m : modes) {
+    const RasterConfig cfg = rendererConfig(m);
+    const RowSpansConfig rc(cfg);
+    ASSERT_TRUE(rc.applies) << m;
+    TriangleGenerator gen(31);
+    SpanStream ws, ss;
+    Tally tally;
+    for (int n = 0; n < 20000; ++n) {
+      const GenTriangle t = gen.next();
+      const std::array<SetupVertex, 3> sv = toSetupVertices(t, 4);
+      const std::string diff = compare(sv, cfg, rc, ws, ss, tally);
+      ASSERT_EQ(diff, "") << m << " " << t.kind() << " " << describe(sv);
+      ASSERT_EQ(ws.end(), ss.end()) << m << " triangle " << n;
+    }
+    // Most of the generator's triangles are small: the comparison above is not vacuous.
+    EXPECT_GT(tally.outcome[RowSpansSetup::Drawn], tally.drawn_by_setup * 9 / 10) << m;
+    EXPECT_GT(tally.outcome[RowSpansSetup::Dropped], 500) << m;
+    EXPECT_GT(tally.outcome[RowSpansSetup::General], 0) << m;  // the large and the screen class
+  }
+}
+
+TEST(RowSpans, FullRateStreamOfSmallTrianglesKeepsItsTiming) {
+  // Small triangles only, so that every one takes the row spans, the stream's timing carried
+  // from each to the next.
+  TriGenOptions opt;
+  opt.size_weight = {0.4, 0.3, 0.3, 0, 0};
+  opt.shape_weight = {0.3, 0, 0.15, 0.05, 0.1, 0.2};  // no slivers (their gradients may leave 32 bits)
+  for (const std::string& m : singleLaneModes()) {
+    if (spanParams(m).RowAhead == 0) continue;
+    const RasterConfig cfg = rendererConfig(m);
+    const RowSpansConfig rc(cfg);
+    TriangleGenerator gen(32, opt);
+    SpanStream ws, ss;
+    Tally tally;
+    for (int n = 0; n < 5000; ++n) {
+      const std::array<SetupVertex, 3> sv = toSetupVertices(gen.next(), 4);
+      ASSERT_EQ(compare(sv, cfg, rc, ws, ss, tally), "") << m << " " << describe(sv);
+      ASSERT_EQ(ws.end(), ss.end()) << m << " triangle " << n;
+    }
+    EXPECT_EQ(tally.outcome[RowSpansSetup::General], 0) << m;
+    EXPECT_GT(ws.end(), 15000u) << m;  // a stream of thousands of rows
+  }
+}
+
+TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
+  // A small viewport, triangles around and across its edges, on pixel corners and centres,
+  // slivers, and every attribute range end.
+  std::mt19937_64 rng(33);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const std::string& m : {std::string("serial"), std::string("evenodd"), std::string("seg4full")}) {
+    const RasterConfig cfg = rendererConfig(m, 64, 48);
+    const RowSpansConfig rc(cfg);
+    SpanStream ws, ss;
+    Tally tally;
+    for (int n = 0; n < 20000; ++n) {
+      const int kind = static_cast<int>(rng() % 5);
+      const double cx = u(rng) * 90 - 13, cy = u(rng) * 68 - 10, r = kind == 0 ? 1.5 : (kind == 1 ? 30 : 6);
+      std::array<SetupVertex, 3> v;
+      for (SetupVertex& x : v) {
+        x.x = cx + (u(rng) * 2 - 1) * r;
+        x.y = cy + (u(rng) * 2 - 1) * r;
+        if (kind == 2) x.x = std::round(x.x), x.y = std::round(x.y);
+        if (kind == 3) x.x = std::round(x.x) + 0.5, x.y = std::round(x.y) + 0.5;
+        const double ends[] = {0, 255, u(rng) * 255};
+        x.attr = {ends[rng() % 3], ends[rng() % 3], ends[rng() % 3], rng() % 2 ? 1.0 : u(rng)};
+      }
+      if (kind == 4) {  // a sliver: the third vertex a hair off the first edge's midpoint
+        v[2].x = v[0].x + (v[1].x - v[0].x) * 0.5 + (u(rng) - 0.5) * 0.05;
+        v[2].y = v[0].y + (v[1].y - v[0].y) * 0.5;
+      }
+      ASSERT_EQ(compare(v, cfg, rc, ws, ss, tally), "") << m << " " << describe(v);
+    }
+    EXPECT_GT(tally.outcome[RowSpansSetup::Drawn], 8000) << m;
+    EXPECT_GT(tally.outcome[RowSpansSetup::Dropped], 1000) << m;
+  }
+}
+
+TEST(RowSpans, DeclineWhatSetupRefusesOrTheyCannotHold) {
+  const RasterConfig cfg = rendererConfig("serial");
+  const RowSpansConfig rc(cfg);
+  auto vtx = [](double x, double y, std::array<double, 4> a = {10, 20, 30, 0.5}) {
+    RowSpans::Vertex v;
+    v.x = x;
+    v.y = y;
+    v.attr = a;
+    return v;
+  };
+  RowSpans s;
+  EXPECT_EQ(setupRowSpans({vtx(10, 10), vtx(20, 12), vtx(12, 18)}, rc, s), RowSpansSetup::Drawn);
+  EXPECT_EQ(s.y0, 10);
+  // 64 rows are held, 65 are not (setup then walks them).
+  EXPECT_EQ(setupRowSpans({vtx(10.5, 10), vtx(60, 10), vtx(10.5, 73.9)}, rc, s), RowSpansSetup::Drawn);
+  EXPECT_EQ(s.rows, 64);
+  EXPECT_EQ(setupRowSpans({vtx(10.5, 10), vtx(60, 10), vtx(10.5, 74.9)}, rc, s), RowSpansSetup::General);
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(setupRowSpans({vtx(nan, 10), vtx(20, 12), vtx(12, 18)}, rc, s), RowSpansSetup::General);
+  EXPECT_EQ(setupRowSpans({vtx(10, 10), vtx(20, inf), vtx(12, 18)}, rc, s), RowSpansSetup::General);
+  EXPECT_EQ(setupRowSpans({vtx(10, 10), vtx(20, 12), vtx(9000, 18)}, rc, s), RowSpansSetup::General);  // guard band
+  EXPECT_EQ(setupRowSpans({vtx(10, 10), vtx(20, 12, {10, nan, 30, 0.5}), vtx(12, 18)}, rc, s), RowSpansSetup::General);
+  EXPECT_EQ(setupRowSpans({vtx(10, 10), vtx(20, 12, {1e9, 0, 0, 0.5}), vtx(12, 18)}, rc, s), RowSpansSetup::General);
+  EXPECT_EQ(setupRowSpans({vtx(10, 10), vtx(20, 12), vtx(30, 14)}, rc, s), RowSpansSetup::Dropped);  // collinear
+  EXPECT_EQ(setupRowSpans({vtx(-30, 10), vtx(-20, 12), vtx(-25, 18)}, rc, s), RowSpansSetup::Dropped);  // off screen
+  // A depth gradient of 2^31 codes per pixel or more (a sliver nearly edge-on) is not held.
+  EXPECT_EQ(setupRowSpans({vtx(10.5, 10, {0, 0, 0, 0}), vtx(10.5625, 10, {0, 0, 0, 1}), vtx(10.5, 14, {0, 0, 0, 0})}, rc, s),
+            RowSpansSetup::General);
+  // Units of four lane-triangles, or with other attributes, do not take row spans at all.
+  EXPECT_FALSE(RowSpansConfig(rendererConfig("sierpinski")).applies);
+  RasterConfig three = cfg;
+  three.unit.NumAttr = 3;
+  three.attr_frac_bits = {12, 12, 12};
+  EXPECT_FALSE(RowSpansConfig(three).applies);
+}
