@@ -4,13 +4,15 @@
 // compare only runs taken side by side, interleaved, and report ratios (docs/performance.md).
 // phong-fixed's label says whether the AVX-512 kernel ran. The RTL-in-the-loop frame time is
 // printed by `shadesim render --rtl`. Setup and Walk time two parts of a Gouraud frame alone,
-// per triangle: triangle setup and the span walk.
+// per triangle: triangle setup and the span walk; RowSpans what the frame runs instead, the
+// same triangles set up straight to their rows' spans.
 //   build/testbench/bench_render [--benchmark_filter=...]
 #include <random>
 
 #include <benchmark/benchmark.h>
 
 #include "device/prom.h"
+#include "raster/row_spans.h"
 #include "raster/setup.h"
 #include "raster/span_walk.h"
 #include "render/pipeline.h"
@@ -101,6 +103,31 @@ void BM_Setup(benchmark::State& state) {
   perTriangle(state, tris.v.size());
 }
 
+// The same triangles set up straight to their rows' spans (setupRowSpans), where the renderer
+// takes them so (every one of the sphere's).
+void BM_RowSpans(benchmark::State& state) {
+  const SphereTriangles tris = sphereTriangles();
+  const RowSpansConfig rc(tris.rc);
+  std::vector<std::array<RowSpans::Vertex, 3>> v;
+  for (const auto& t : tris.v) {
+    std::array<RowSpans::Vertex, 3>& r = v.emplace_back();
+    for (size_t i = 0; i < 3; ++i) {
+      r[i].x = t[i].x;
+      r[i].y = t[i].y;
+      for (size_t k = 0; k < 4; ++k) r[i].attr[k] = t[i].attr[k];
+    }
+  }
+  RowSpans res;
+  size_t general = 0;
+  for (auto _ : state)
+    for (const auto& t : v) {
+      general += setupRowSpans(t, rc, res) == RowSpansSetup::General;
+      benchmark::DoNotOptimize(res.rows);
+    }
+  perTriangle(state, v.size());
+  state.counters["general"] = static_cast<double>(general) / static_cast<double>(state.iterations());
+}
+
 // The span walk alone (walkSpanUnit with a run consumer, as the colour methods walk) of
 // sphereTriangles()' descriptors, the runs summed instead of drawn.
 void BM_Walk(benchmark::State& state) {
@@ -124,6 +151,7 @@ void BM_Walk(benchmark::State& state) {
 
 BENCHMARK(BM_Setup)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Walk)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_RowSpans)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_Frame, flat, Method::Flat, "serial", "")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Frame, gouraud, Method::Gouraud, "serial", "")->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_Frame, gouraud_classical, Method::GouraudClassical, "serial", "")->Unit(benchmark::kMillisecond);

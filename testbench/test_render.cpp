@@ -701,6 +701,70 @@ TEST(Render, VectorPathsEqualTheScalarPaths) {
   EXPECT_GT(pixels, fixed_simd::available() ? 5000000u : 2000000u);  // 6.1 million (AVX2 alone: 2.4) covered pixels compared
 }
 
+// Small triangles set up straight to their rows' spans (raster/row_spans.h) against setup and
+// the walk for every triangle, on whole frames: the same colours, depths, triangle ids, screen
+// triangles and statistics, for every method whose units take rows' spans (and modified-gouraud
+// and adaptive, which draw with them), device lobes at the vertices and per pixel, on one thread
+// and two, in the paper's units and a full-rate one, on scenes of small and of large triangles.
+TEST(Render, RowSpansEqualTheSpanWalk) {
+  auto counts = [](const RenderStats& t) {  // every count but the rows' spans
+    return std::vector<uint64_t>{t.triangles, t.culled_back, t.culled_outside, t.culled_no_pixel, t.clipped, t.drawn,
+                                 t.fragments, t.pixels_covered, t.span_cycles, t.spec_cycles, t.spec_evaluations,
+                                 t.spec_at_zero, t.depth_rejected, t.divisions, t.split_parts, t.normalisations,
+                                 t.adaptive_gouraud, t.adaptive_phong};
+  };
+  const std::string teapots = "/usr/share/assimp/models/Collada/teapots.DAE";
+  ASSERT_TRUE(fs::exists(teapots)) << teapots << " missing: scripts/install_deps.sh installs assimp-testmodels";
+  struct Case {
+    Method m;
+    const char* brdf;
+    int threads;
+  };
+  const Case cases[] = {{Method::Flat, "", 1},          {Method::Gouraud, "", 1},
+                        {Method::Gouraud, "quadratic", 1}, {Method::Phong, "", 1},
+                        {Method::PhongIncremental, "quadratic", 1}, {Method::PhongFixed, "", 1},
+                        {Method::PhongFixed, "quadratic", 1}, {Method::ModifiedGouraud, "", 1},
+                        {Method::Adaptive, "", 1},       {Method::Flat, "", 2},
+                        {Method::Gouraud, "", 2},        {Method::PhongFixed, "", 2}};
+  uint64_t by_rows = 0, drawn = 0;
+  for (const std::string scene : {"builtin:sphere", "builtin:torus", "builtin:materials", "builtin:plane", teapots.c_str()}) {
+    const Scene s = loadScene(scene);
+    for (const char* mode : {"serial", "evenodd", "seg8full"})
+      for (const Case& c : cases) {
+        if (std::string(mode) == "evenodd" && c.threads == 1 && c.m != Method::Gouraud && c.m != Method::PhongFixed) continue;
+        ModelEngines e(mode);
+        RenderOptions o;
+        o.method = c.m;
+        o.threads = c.threads;
+        o.brdf = std::string(c.brdf).empty() && scene == "builtin:materials" ? "blinn" : c.brdf;
+        const RenderResult rows = render(s, o, e.span, e.view);
+        o.row_spans = false;
+        const RenderResult walked = render(s, o, e.span, e.view);
+        const std::string what = fmt::format("{} {} {} {} thread(s) {}", scene, toString(c.m), c.brdf, c.threads, mode);
+        auto firstDiff = [](const auto& x, const auto& y) {  // -1: none
+          if (x.size() != y.size()) return ptrdiff_t{0};
+          const auto d = std::mismatch(x.begin(), x.end(), y.begin());
+          return d.first == x.end() ? ptrdiff_t{-1} : d.first - x.begin();
+        };
+        ASSERT_EQ(firstDiff(rows.fb.rgb, walked.fb.rgb), -1) << what << ": colour byte";
+        ASSERT_EQ(firstDiff(rows.fb.depth, walked.fb.depth), -1) << what << ": depth of pixel";
+        ASSERT_EQ(firstDiff(rows.fb.tri, walked.fb.tri), -1) << what << ": triangle id of pixel";
+        ASSERT_EQ(rows.triangles.size(), walked.triangles.size()) << what;
+        for (size_t i = 0; i < rows.triangles.size(); ++i) {
+          const ScreenTriangleInfo &a = rows.triangles[i], &b = walked.triangles[i];
+          ASSERT_TRUE(a.object == b.object && a.mesh_triangle == b.mesh_triangle && a.xy == b.xy) << what << ": triangle " << i;
+        }
+        const RenderStats &a = rows.stats, &b = walked.stats;
+        EXPECT_EQ(b.row_spans, 0u) << what;
+        by_rows += a.row_spans;
+        drawn += a.drawn;
+        EXPECT_EQ(counts(a), counts(b)) << what;
+      }
+  }
+  // Most of these scenes' screen triangles are small: rows' spans drew them.
+  EXPECT_GT(by_rows, drawn / 2) << by_rows << " of " << drawn;
+}
+
 // A frame rendered into the result of an earlier one, whose clear then covers only the
 // rectangle drawn before (prepareClear, clearRect), equals the frame rendered afresh: every buffer,
 // byte for byte, for a colour method, phong-fixed and the exact reference (its LSB buffers).

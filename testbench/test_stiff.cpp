@@ -1119,7 +1119,7 @@ TEST(Stiff, SquaredNormRecurrenceOverTheLongestSpan) {
   std::vector<SpanFragment> frags;
   walkSpanUnit(cfg.unit, *s.desc, frags);
   ASSERT_EQ(frags.size(), 4096u * 4u);
-  SquaredNorms recurrence(s);
+  SquaredNorms recurrence({s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]});
   long double worst_rel = 0;
   uint64_t min_f = UINT64_MAX, max_f = 0;
   for (const SpanFragment& f : frags) {

@@ -94,27 +94,23 @@ inline std::pair<int64_t, int64_t> centreRows(int64_t lo, int64_t hi, int S) {
   return {-((half - lo) >> (S + 1)), (hi - half) >> (S + 1)};
 }
 
-// One attribute plane's codes (raster/setup.h) in 64 bits: the gradients per pixel nx 2^S / det
-// and ny 2^S / det, and the exact plane at the reference pixel's centre, at (dcx, dcy) from
-// vertex 0 (u units), a0 + (nx dcx + ny dcy) / (2 det), each rounded half to even, with
-// nx = (a1 - a0) dy2 - (a2 - a0) dy1 and ny = dx1 (a2 - a0) - dx2 (a1 - a0) (subpixel vertex
-// differences, det > 0, |a| < 2^61). False, the outputs unspecified, where a product or sum
-// does not fit int64_t (checked): the caller computes them in 128 bits instead.
-inline bool planeCodes64(const std::array<int64_t, 3>& a, int64_t dx1, int64_t dy1, int64_t dx2, int64_t dy2,
-                         int64_t dcx, int64_t dcy, int64_t det, int S, int64_t& didx, int64_t& didy, int64_t& iref) {
+// One attribute plane's numerators (raster/setup.h) in 64 bits: the gradients per pixel are
+// sx / det and sy / det, sx = nx 2^S and sy = ny 2^S, and the exact plane at the reference
+// pixel's centre, at (dcx, dcy) from vertex 0 (u units), a0 + num / (2 det), num = nx dcx +
+// ny dcy, each to be rounded half to even, with nx = (a1 - a0) dy2 - (a2 - a0) dy1 and
+// ny = dx1 (a2 - a0) - dx2 (a1 - a0) (subpixel vertex differences, |a| < 2^61). False, the
+// outputs unspecified, where a product or sum does not fit int64_t (checked): the caller
+// computes them in 128 bits instead.
+inline bool planeNumerators64(const std::array<int64_t, 3>& a, int64_t dx1, int64_t dy1, int64_t dx2, int64_t dy2,
+                              int64_t dcx, int64_t dcy, int S, int64_t& sx, int64_t& sy, int64_t& num) {
   const int64_t da1 = a[1] - a[0], da2 = a[2] - a[0];  // |a| < 2^61: no overflow
-  int64_t p1, p2, p3, p4, nx, ny, sx, sy, rx, ry, num;
-  const bool fits = !__builtin_mul_overflow(da1, dy2, &p1) && !__builtin_mul_overflow(da2, dy1, &p2) &&
-                    !__builtin_sub_overflow(p1, p2, &nx) && !__builtin_mul_overflow(dx1, da2, &p3) &&
-                    !__builtin_mul_overflow(dx2, da1, &p4) && !__builtin_sub_overflow(p3, p4, &ny) &&
-                    !__builtin_mul_overflow(nx, int64_t{1} << S, &sx) && !__builtin_mul_overflow(ny, int64_t{1} << S, &sy) &&
-                    !__builtin_mul_overflow(nx, dcx, &rx) && !__builtin_mul_overflow(ny, dcy, &ry) &&
-                    !__builtin_add_overflow(rx, ry, &num);
-  if (!fits) return false;
-  didx = roundDivPlus(0, sx, det);  // per pixel = per subpixel * 2^S
-  didy = roundDivPlus(0, sy, det);
-  iref = roundDivPlus(a[0], num, 2 * det);
-  return true;
+  int64_t p1, p2, p3, p4, nx, ny, rx, ry;
+  return !__builtin_mul_overflow(da1, dy2, &p1) && !__builtin_mul_overflow(da2, dy1, &p2) &&
+         !__builtin_sub_overflow(p1, p2, &nx) && !__builtin_mul_overflow(dx1, da2, &p3) &&
+         !__builtin_mul_overflow(dx2, da1, &p4) && !__builtin_sub_overflow(p3, p4, &ny) &&
+         !__builtin_mul_overflow(nx, int64_t{1} << S, &sx) && !__builtin_mul_overflow(ny, int64_t{1} << S, &sy) &&
+         !__builtin_mul_overflow(nx, dcx, &rx) && !__builtin_mul_overflow(ny, dcy, &ry) &&
+         !__builtin_add_overflow(rx, ry, &num);
 }
 
 }  // namespace shd::exact

@@ -151,9 +151,12 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   const int64_t dcx = ((2 * xref + 1) << S) - xu[0], dcy = ((2 * yref + 1) << S) - yu[0];
   const int64_t dx1 = X[1] - X[0], dy1 = Y[1] - Y[0], dx2 = X[2] - X[0], dy2 = Y[2] - Y[0];
   for (size_t k = 0; k < 4; ++k) {
-    int64_t didx = 0, didy = 0, iref = 0, corner = 0;
-    if (!planeCodes64(a[k], dx1, dy1, dx2, dy2, dcx, dcy, det, S, didx, didy, iref) || !fits32(didx) || !fits32(didy) ||
-        !planeAt(iref, didx, didy, xmin - xref, o.y0 - yref, corner))
+    int64_t sx = 0, sy = 0, num = 0;
+    if (!planeNumerators64(a[k], dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) return RowSpansSetup::General;
+    const int64_t didx = roundDivPlus(0, sx, det), didy = roundDivPlus(0, sy, det);
+    const int64_t iref = roundDivPlus(a[k][0], num, 2 * det);
+    int64_t corner = 0;
+    if (!fits32(didx) || !fits32(didy) || !planeAt(iref, didx, didy, xmin - xref, o.y0 - yref, corner))
       return RowSpansSetup::General;
     // |didx|, |didy| < 2^31 and the box's sides below 2^15: exact in int64_t from its corner.
     const int64_t across = didx * (xmax - xmin), down = didy * (o.rows - 1);

@@ -339,8 +339,8 @@ void snapVertices(const std::array<SetupVertex, 3>& v, uint32_t tag, const Raste
   }
 }
 
-// The attribute planes' codes (see the header and planeCodes64): in 64-bit integers where every
-// product and sum provably fits (checked: the common case), else in 128 bits.
+// The attribute planes' codes (see the header and planeNumerators64): in 64-bit integers where
+// every product and sum provably fits (checked: the common case), else in 128 bits.
 void setPlane(const SnappedTriangle& t, int S, int64_t u0, int64_t v0, AttributePlane& pl) {
   const int64_t det2 = 2 * t.det;
   const int64_t dx1 = t.X[1] - t.X[0], dy1 = t.Y[1] - t.Y[0], dx2 = t.X[2] - t.X[0], dy2 = t.Y[2] - t.Y[0];
@@ -351,7 +351,13 @@ void setPlane(const SnappedTriangle& t, int S, int64_t u0, int64_t v0, Attribute
   pl.iref.resizeForOverwrite(K);
   for (size_t k = 0; k < K; ++k) {
     const auto& a = t.a[k];
-    if (planeCodes64(a, dx1, dy1, dx2, dy2, dcx, dcy, t.det, S, pl.didx[k], pl.didy[k], pl.iref[k])) continue;
+    int64_t sx = 0, sy = 0, num = 0;
+    if (planeNumerators64(a, dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) {
+      pl.didx[k] = roundDivPlus(0, sx, t.det);  // per pixel = per subpixel * 2^S
+      pl.didy[k] = roundDivPlus(0, sy, t.det);
+      pl.iref[k] = roundDivPlus(a[0], num, det2);
+      continue;
+    }
     const int64_t da1 = a[1] - a[0], da2 = a[2] - a[0];  // |a| < 2^61: no overflow
     const i128 nx128 = static_cast<i128>(da1) * dy2 - static_cast<i128>(da2) * dy1;
     const i128 ny128 = static_cast<i128>(dx1) * da2 - static_cast<i128>(dx2) * da1;

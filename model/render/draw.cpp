@@ -48,7 +48,7 @@ bool Frame::batchesRequests(Method m) const {
 
 void Frame::collect(const SpanTriangle& t) {
   frags.clear();
-  st.span_cycles += span.run(*t.setup.desc, frags).cycles;
+  st.span_cycles += span.run(*t.setup->desc, frags).cycles;
   st.fragments += frags.size();
 }
 

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "raster/row_spans.h"
 #include "raster/setup.h"
 #include "raster/span_walk.h"
 #include "render/fixed_simd.h"
@@ -39,14 +40,20 @@ struct RecordedWalk {
   std::vector<Event> events;
 };
 
-// A screen triangle set up for the span unit, with the method that draws it.
+// A screen triangle set up for the span unit, with the method that draws it: by setup (a span
+// descriptor) or, for a small triangle of a method whose traits allow it, as its rows' spans
+// (raster/row_spans.h: the same fragments and cycles).
 struct SpanTriangle {
   std::array<const PVertex*, 3> v;  // as set up (the fan's, or a split's)
   Method method;
-  const SetupResult& setup;  // setup.desc: its span descriptor; setup.plane: its attribute planes
+  const SetupResult* setup;  // setup->desc: its span descriptor; setup->plane: its attribute planes; or null:
+  const RowSpans* rows;      //   its rows' spans (MethodTraits::row_spans)
   const RasterConfig& raster;
   uint32_t tag;  // its id: the index in RenderResult::triangles, the framebuffer's tri
   const RecordedWalk* walked = nullptr;  // its walk done ahead, or null: Frame::walk walks it
+  bool counted = false;  // rows: its cycles and fragments counted by a two-thread frame's front end
+  // The plane's gradient of attribute k along x (SetupResult::plane.didx).
+  int64_t didx(size_t k) const { return rows != nullptr ? rows->didx[k] : setup->plane.didx[k]; }
 };
 
 class MethodUnit;
@@ -137,7 +144,7 @@ inline std::array<double, 3> barycentric(const std::array<const PVertex*, 3>& v,
 // (biquadratic; test Stiff.BiquadraticSliverStaysWithinItsSamples). Exact: the subpixel
 // coordinates and their products fit a double's 53 bits.
 inline std::array<double, 3> barycentricSnapped(const SpanTriangle& t, int32_t x, int32_t y) {
-  const SnappedTriangle& s = t.setup.tri;
+  const SnappedTriangle& s = t.setup->tri;
   const double one = static_cast<double>(int64_t{1} << t.raster.subpixel_bits);
   const double px = (x + 0.5) * one, py = (y + 0.5) * one;
   const double x0 = static_cast<double>(s.X[0]), y0 = static_cast<double>(s.Y[0]);
@@ -155,7 +162,9 @@ inline std::array<double, 3> barycentricSnapped(const SpanTriangle& t, int32_t x
 // where it restarts.
 class SquaredNorms {
  public:
-  explicit SquaredNorms(const SetupResult& s) : dn_{s.plane.didx[0], s.plane.didx[1], s.plane.didx[2]} {}
+  // dn: the gradients along x of the normal's three attributes.
+  explicit SquaredNorms(const std::array<int64_t, 3>& dn) : dn_(dn) {}
+  explicit SquaredNorms(const SpanTriangle& t) : SquaredNorms({t.didx(0), t.didx(1), t.didx(2)}) {}
   uint64_t operator()(int32_t x, int32_t y, const int64_t* attr) {
     const uint64_t f = y == run_y_ && x == run_next_x_ ? sqn_.next() : sqn_.start({attr[0], attr[1], attr[2]}, dn_);
     run_y_ = y;
@@ -229,14 +238,23 @@ class Frame {
       replay(*t.walked, sink, runs...);
       return;
     }
+    if (t.rows != nullptr) {
+      if (!t.counted) count(countRowSpans(*walker, *t.rows, span.streamOrNull()));
+      if constexpr (sizeof...(Runs) > 0) {
+        emitRowSpans(*t.rows, runs...);
+      } else {
+        auto fragments = [&sink](const RowRun& r) { runFragments(r, sink); };
+        emitRowSpans(*t.rows, fragments);
+      }
+      return;
+    }
     if (walker != nullptr) {
       SpanWalk wk;
       if constexpr (sizeof...(Runs) == 0)
-        wk = walkSpanUnit(*walker, *t.setup.desc, sink, span_detail::NoRuns{}, span.streamOrNull());
+        wk = walkSpanUnit(*walker, *t.setup->desc, sink, span_detail::NoRuns{}, span.streamOrNull());
       else
-        wk = walkSpanUnit(*walker, *t.setup.desc, sink, runs..., span.streamOrNull());
-      st.span_cycles += wk.cycles;
-      st.fragments += wk.fragments;
+        wk = walkSpanUnit(*walker, *t.setup->desc, sink, runs..., span.streamOrNull());
+      count(wk);
       return;
     }
     collect(t);
@@ -268,13 +286,23 @@ class Frame {
       } else if constexpr (sizeof...(Runs) > 0) {
         (runs(RowRun{e.x0, e.y, e.dx, e.count, e.a0.data(), e.da.data()}), ...);
       } else {
-        std::array<int64_t, 4> a = e.a0;
-        for (int64_t i = 0; i < e.count; ++i) {
-          sink(e.x0 + static_cast<int32_t>(i) * e.dx, e.y, static_cast<const int64_t*>(a.data()));
-          for (size_t k = 0; k < a.size(); ++k) a[k] += e.da[k];
-        }
+        runFragments(RowRun{e.x0, e.y, e.dx, e.count, e.a0.data(), e.da.data()}, sink);
       }
     }
+  }
+  // A run's fragments one by one, which is what the walk gives a consumer without runs.
+  template <class Sink>
+  static void runFragments(const RowRun& r, Sink& sink) {
+    std::array<int64_t, 4> a = {r.a0[0], r.a0[1], r.a0[2], r.a0[3]};
+    for (int64_t i = 0; i < r.count; ++i) {
+      sink(r.x0 + static_cast<int32_t>(i) * r.dx, r.y, static_cast<const int64_t*>(a.data()));
+      for (size_t k = 0; k < a.size(); ++k) a[k] += r.da[k];
+    }
+  }
+  // A walk's counts.
+  void count(const SpanWalk& wk) {
+    st.span_cycles += wk.cycles;
+    st.fragments += wk.fragments;
   }
   // The fragments of t from the span engine, in its order, into frags (counted).
   void collect(const SpanTriangle& t);

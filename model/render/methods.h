@@ -45,6 +45,11 @@ struct MethodTraits {
   // or the back (per pixel), so the two threads share no specular unit and no object state; and
   // the unit's draw() reads the setup alone, not SpanTriangle::v (the back end passes none).
   TwoThreads two_threads;
+  // The unit reads of a screen triangle its walk and its plane's gradients alone, so a small one
+  // may come as its rows' spans instead of a setup (SpanTriangle::rows, raster/row_spans.h).
+  // (modified-gouraud and adaptive draw their parts with the gouraud and phong units, whose
+  // rows apply.)
+  bool row_spans;
   std::unique_ptr<MethodUnit> (*make)(Frame&);
 };
 

@@ -100,13 +100,16 @@ struct DrawJob {
   uint32_t tag = 0;                 // Triangle
   size_t object = 0;                // BeginObject
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
-  SetupResult setup;                // Triangle
+  bool spans = false;               // Triangle: set up as rows' spans (else by setup)
+  SetupResult setup;                // Triangle, unless spans
+  RowSpans rows;                    // Triangle, if spans
   RecordedWalk walk;                // Triangle: the front end's walk, for a TwoThreads::AfterWalk method
 };
 
-// The lines of a job's slot that setting a triangle up writes (the descriptor's head, planes
-// and first lane-triangle, the snapped triangle, the edge functions, the plane) and, for a
-// walk recorded ahead, as many events as the slot's last walk had, fetched for writing
+// The lines of a job's slot that setting a triangle up writes (its rows' spans where the slot's
+// last triangle had them, else the descriptor's head, planes and first lane-triangle, the
+// snapped triangle, the edge functions, the plane) and, for a walk recorded ahead, as many
+// events as the slot's last walk had, fetched for writing
 // (PREFETCHW) two jobs before the front end reaches the slot, which the back end's core read
 // last. Without it a store waits for its line: when this VM's two cores are far apart (a
 // core-to-core round trip of 550 ns instead of 120) gouraud's two-thread frame on
@@ -116,6 +119,10 @@ void prefetchJobForWrite(const DrawJob& j) {
   auto object = [](const auto& o) { prefetchForWrite(&o, &o + 1); };
   const SetupResult& s = j.setup;
   prefetchForWrite(&j, &j.transform);
+  if (j.spans) {
+    object(j.rows);
+    return;
+  }
   if (s.desc) {
     prefetchForWrite(&*s.desc, &s.desc->tri[0] + 1);
     prefetchForWrite(reinterpret_cast<const char*>(&s.desc + 1) - 1, &s.desc + 1);  // the lane-triangles' count, engaged
@@ -222,6 +229,8 @@ class SceneDrawer {
   void walkAhead(const SpanDesc& d, RecordedWalk& w);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   void drawPart(const Part& part, uint32_t ti);
+  bool setUp(const Part& part, bool colour_attrs, uint32_t tag, DrawJob* job, const SetupResult*& setup,
+             const RowSpans*& rows);
 
   Frame& f_;
   const Scene& scene_;
@@ -231,6 +240,7 @@ class SceneDrawer {
   MethodUnit& unit_;                  // the frame's method's
   const bool vertex_colours_;         // the method's
   RasterConfig rc_colour_, rc_unit_;  // setup of colour or normal attributes (and depth)
+  std::optional<RowSpansConfig> rs_colour_, rs_unit_;  // and as rows' spans (empty: not at all)
   std::vector<PVertex> verts_;        // the object's
   std::vector<uint8_t> lit_;          // verts_[i].colour is computed
   Poly poly_;                         // a clipped triangle
@@ -238,6 +248,7 @@ class SceneDrawer {
   Parts parts_;                       // its screen triangles
   DrawQueue* const queue_;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
+  RowSpans rows_;                     // the same as rows' spans
 };
 
 SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines,
@@ -262,6 +273,13 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
   // The normal at phong-fixed's NormalFracBits when it runs at runtime widths; the depth as ever.
   const int normal_frac = f.opt.phong_widths ? f.opt.phong_widths->NormalFracBits : kUnitFrac;
   rc_unit_.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
+  // Rows' spans need the model's walk (the RTL takes descriptors).
+  if (f.opt.row_spans && f.walker != nullptr) {
+    rs_colour_.emplace(rc_colour_);
+    rs_unit_.emplace(rc_unit_);
+    if (!rs_colour_->applies) rs_colour_.reset();
+    if (!rs_unit_->applies) rs_unit_.reset();
+  }
 }
 
 void SceneDrawer::drawObject(size_t oi) {
@@ -332,44 +350,79 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   if (st.drawn == drawn_before) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
 }
 
-// A part through the span unit's setup (dropped: culled), recorded, and drawn by its unit.
-void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
-  const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
-  const RasterConfig& rc = colour_attrs ? rc_colour_ : rc_unit_;
-  std::array<SetupVertex, 3> sv;
-  for (size_t i = 0; i < 3; ++i) {
-    const PVertex& v = *part.v[i];
-    sv[i].x = v.x;
-    sv[i].y = v.y;
-    if (colour_attrs) {
-      const std::array<double, 3>& c = part.colour != nullptr ? *part.colour : v.colour;
-      sv[i].attr = {std::clamp(c[0], 0.0, 255.0), std::clamp(c[1], 0.0, 255.0), std::clamp(c[2], 0.0, 255.0), v.w};
-    } else {
-      sv[i].attr = {v.n.x, v.n.y, v.n.z, v.w};
+// A part set up, as its rows' spans where its method and the triangle allow (raster/row_spans.h),
+// else by the span unit's setup, in the job's slot or here: false when dropped (no pixel).
+bool SceneDrawer::setUp(const Part& part, bool colour_attrs, uint32_t tag, DrawJob* job, const SetupResult*& setup,
+                        const RowSpans*& rows) {
+  auto attr = [&](const PVertex& v, size_t k) {
+    if (!colour_attrs) return k == 3 ? v.w : k == 0 ? v.n.x : k == 1 ? v.n.y : v.n.z;
+    const std::array<double, 3>& c = part.colour != nullptr ? *part.colour : v.colour;
+    return k == 3 ? v.w : std::clamp(c[k], 0.0, 255.0);
+  };
+  const std::optional<RowSpansConfig>& rs = colour_attrs ? rs_colour_ : rs_unit_;
+  if (rs && traits(part.method).row_spans) {
+    std::array<RowSpans::Vertex, 3> rv;
+    for (size_t i = 0; i < 3; ++i) {
+      rv[i].x = part.v[i]->x;
+      rv[i].y = part.v[i]->y;
+      for (size_t k = 0; k < 4; ++k) rv[i].attr[k] = attr(*part.v[i], k);
+    }
+    RowSpans& r = job != nullptr ? job->rows : rows_;
+    const RowSpansSetup got = setupRowSpans(rv, *rs, r);
+    if (got == RowSpansSetup::Dropped) return false;
+    if (got == RowSpansSetup::Drawn) {
+      rows = &r;
+      return true;
     }
   }
+  std::array<SetupVertex, 3> sv;
+  for (size_t i = 0; i < 3; ++i) {
+    sv[i].x = part.v[i]->x;
+    sv[i].y = part.v[i]->y;
+    sv[i].attr.resizeForOverwrite(4);
+    for (size_t k = 0; k < 4; ++k) sv[i].attr[k] = attr(*part.v[i], k);
+  }
+  SetupResult& s = job != nullptr ? job->setup : setup_;
+  setupTriangle(sv, tag, colour_attrs ? rc_colour_ : rc_unit_, s);
+  setup = &s;
+  return s.desc.has_value();
+}
+
+// A part set up (dropped: culled), recorded, and drawn by its unit.
+void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
+  const MethodTraits& tr = traits(part.method);
+  const bool colour_attrs = tr.attributes == Attributes::Colour;
+  const RasterConfig& rc = colour_attrs ? rc_colour_ : rc_unit_;
   const uint32_t tag = static_cast<uint32_t>(triangles_.size());
   DrawJob* job = queue_ != nullptr ? &queue_->slot() : nullptr;
   if (job != nullptr) prefetchJobForWrite(queue_->ahead(2));
-  SetupResult& s = job != nullptr ? job->setup : setup_;
-  setupTriangle(sv, tag, rc, s);
-  if (!s.desc) return;  // no pixel centre inside (drawMeshTriangle counts the triangle culled)
+  const SetupResult* setup = nullptr;
+  const RowSpans* rows = nullptr;
+  if (!setUp(part, colour_attrs, tag, job, setup, rows)) return;  // no pixel centre inside (drawMeshTriangle counts it culled)
   ScreenTriangleInfo& info = triangles_.emplace_back();  // filled in place: a local copied in
   info.object = f_.obj.index;                           // stalled on its own partial stores
   info.mesh_triangle = ti;
   for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
   ++f_.st.drawn;
-  f_.fb.markDrawn(std::min({sv[0].x, sv[1].x, sv[2].x}), std::min({sv[0].y, sv[1].y, sv[2].y}),
-                  std::max({sv[0].x, sv[1].x, sv[2].x}), std::max({sv[0].y, sv[1].y, sv[2].y}));
+  f_.st.row_spans += rows != nullptr;
+  const PVertex &v0 = *part.v[0], &v1 = *part.v[1], &v2 = *part.v[2];
+  f_.fb.markDrawn(std::min({v0.x, v1.x, v2.x}), std::min({v0.y, v1.y, v2.y}), std::max({v0.x, v1.x, v2.x}),
+                  std::max({v0.y, v1.y, v2.y}));
   if (job == nullptr) {
-    part.unit->draw(SpanTriangle{part.v, part.method, s, rc, tag});
+    part.unit->draw(SpanTriangle{part.v, part.method, setup, rows, rc, tag});
     return;
   }
   job->kind = DrawJob::Kind::Triangle;
   job->method = part.method;
   job->colour_attrs = colour_attrs;
   job->tag = tag;
-  if (traits(part.method).two_threads == TwoThreads::AfterWalk) walkAhead(*s.desc, job->walk);
+  job->spans = rows != nullptr;
+  // A method walked ahead: its rows counted here, on this side, with the span engine's stream
+  // (as walkAhead counts), and drawn by the back end from the rows.
+  if (tr.two_threads == TwoThreads::AfterWalk) {
+    if (rows != nullptr) f_.count(countRowSpans(*f_.walker, *rows, f_.span.streamOrNull()));
+    else walkAhead(*setup->desc, job->walk);
+  }
   queue_->push();
 }
 
@@ -386,9 +439,7 @@ void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w) {
     w.events.push_back(
         {true, r.x0, r.y, r.dx, r.count, {r.a0[0], r.a0[1], r.a0[2], r.a0[3]}, {r.da[0], r.da[1], r.da[2], r.da[3]}});
   };
-  const SpanWalk wk = walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull());
-  f_.st.span_cycles += wk.cycles;
-  f_.st.fragments += wk.fragments;
+  f_.count(walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull()));
 }
 
 // The back end of a two-thread frame: its own frame (its own counts) and the front end's
@@ -423,9 +474,10 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
       case DrawJob::Kind::Triangle: {
         // No vertices: the methods that split a frame draw from the setup alone (methods.h).
         const std::array<const PVertex*, 3> v = {nullptr, nullptr, nullptr};
-        const bool walked = traits(j->method).two_threads == TwoThreads::AfterWalk;
-        f.unit(j->method).draw(SpanTriangle{v, j->method, j->setup, j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
-                                            walked ? &j->walk : nullptr});
+        const bool ahead = traits(j->method).two_threads == TwoThreads::AfterWalk;
+        f.unit(j->method).draw(SpanTriangle{v, j->method, j->spans ? nullptr : &j->setup, j->spans ? &j->rows : nullptr,
+                                            j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
+                                            ahead && !j->spans ? &j->walk : nullptr, ahead && j->spans});
         break;
       }
     }
@@ -499,6 +551,7 @@ RenderStats& RenderStats::operator+=(const RenderStats& o) {
   culled_no_pixel += o.culled_no_pixel;
   clipped += o.clipped;
   drawn += o.drawn;
+  row_spans += o.row_spans;
   fragments += o.fragments;
   pixels_covered += o.pixels_covered;
   span_cycles += o.span_cycles;

@@ -161,6 +161,10 @@ struct RenderOptions {
   // The AVX-512 paths (render/fixed_simd.h) where the CPU has them; false: the scalar paths
   // alone (the same images: test Render.VectorPathsEqualTheScalarPaths compares them).
   bool vector_kernel = true;
+  // Small triangles set up straight to their rows' spans (raster/row_spans.h) where the method
+  // and the model's span unit allow; false: setup and the walk for every triangle (the same
+  // images and counts: test Render.RowSpansEqualTheSpanWalk compares them).
+  bool row_spans = true;
   // phong-fixed only (std::invalid_argument with another method or invalid widths): absent, the
   // fixed datapath of render/fixed_shading.h with its run and vector kernels; present, the same
   // datapath at these widths, fragment by fragment (render/fixed_widths.h), the span unit
@@ -184,6 +188,8 @@ struct RenderStats {
   uint64_t culled() const { return culled_back + culled_outside + culled_no_pixel; }
   uint64_t clipped = 0;         // triangles cut by the near plane or the guard band
   uint64_t drawn = 0;           // screen triangles sent to the span unit
+  uint64_t row_spans = 0;       //   of which set up straight to their rows' spans (raster/row_spans.h:
+                                //   the model's own way to the same fragments and cycles; not in the JSON)
   uint64_t fragments = 0;
   uint64_t pixels_covered = 0;  // pixels of the final image some triangle wrote
   uint64_t span_cycles = 0;     // span unit cycles over the frame

@@ -131,7 +131,7 @@ class PhongUnit final : public MethodUnit {
   void drawWalked(const SpanTriangle& t, const PixelLighting& light) {
     const int32_t* const depth = f_.fb.depth.data();
     const int W = f_.W;
-    SquaredNorms squaredNorm(t.setup);
+    SquaredNorms squaredNorm(t);
     auto fragment = [&](int32_t x, int32_t y, const int64_t* attr) {
       // phong-incremental: the recurrence runs on every fragment, before the z-test.
       const uint64_t sqnorm = M == Method::PhongIncremental ? squaredNorm(x, y, attr) : 0;

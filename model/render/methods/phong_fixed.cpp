@@ -40,7 +40,7 @@ struct FixedTriangle {
         batched(frame.batchesRequests(Method::PhongFixed)),
         write(frame.writer(tri.tag)),
         target{depth, frame.fb.tri.data(), static_cast<int32_t>(tri.tag), static_cast<size_t>(W)},
-        squared_norm(tri.setup) {}
+        squared_norm(tri) {}
   Frame& f;
   FixedPointShader& shader;
   fixed_simd::Batch& batch;

@@ -29,7 +29,7 @@ class PhongWidthsUnit final : public MethodUnit {
     req_.begin();
     const PixelWriter write = f_.writer(tri.tag);
     const bool batched = f_.batchesRequests(Method::PhongFixed);
-    SquaredNorms squared_norm(tri.setup);
+    SquaredNorms squared_norm(tri);
     FixedWidthsShader& sh = *shader_;
     auto fragment = [&](int32_t x, int32_t y, const int64_t* attr) {
       const uint64_t sqnorm = squared_norm(x, y, attr);

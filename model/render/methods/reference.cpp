@@ -29,7 +29,7 @@ class ReferenceUnit final : public MethodUnit {
     Framebuffer& fb = f_.fb;
     RenderStats& st = f_.st;
     std::vector<SpanFragment>& frags = f_.frags;
-    frags = rasterizeReference(t.setup, t.raster);
+    frags = rasterizeReference(*t.setup, t.raster);
     st.fragments += frags.size();
     const PixelWriter write = f_.writer(t.tag);
     for (const SpanFragment& fr : frags) {
