@@ -153,8 +153,10 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   for (size_t k = 0; k < 4; ++k) {
     int64_t sx = 0, sy = 0, num = 0;
     if (!planeNumerators64(a[k], dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) return RowSpansSetup::General;
-    const int64_t didx = roundDivPlus(0, sx, det), didy = roundDivPlus(0, sy, det);
-    const int64_t iref = roundDivPlus(a[k][0], num, 2 * det);
+    // A constant attribute (flat's colour) has the numerators 0: no division (what it would give).
+    const bool constant = a[k][0] == a[k][1] && a[k][0] == a[k][2];
+    const int64_t didx = constant ? 0 : roundDivPlus(0, sx, det), didy = constant ? 0 : roundDivPlus(0, sy, det);
+    const int64_t iref = constant ? a[k][0] : roundDivPlus(a[k][0], num, 2 * det);
     int64_t corner = 0;
     if (!fits32(didx) || !fits32(didy) || !planeAt(iref, didx, didy, xmin - xref, o.y0 - yref, corner))
       return RowSpansSetup::General;
