@@ -24,6 +24,8 @@ RowSpansConfig::RowSpansConfig(const RasterConfig& cfg) {
   // CoordBits + S <= 31 that is 2^29, so an edge's A and B stay below 2^40, its C below 2^61,
   // det below 2^61, and a row's N = -(B y + C) within int64_t.
   applies = p.NumTri == 1 && p.NumAttr == 4 && p.AttrBits == 32 && p.CoordBits + S <= 31 && W <= 32767;
+  while ((1 << lane_shift) < p.LanesPerTri) ++lane_shift;  // a power of two (SpanParams::validate)
+  align_lanes = p.AlignLanes != 0;
   if (!applies) return;
   for (size_t k = 0; k < 4; ++k) {
     frac[k] = cfg.attrFracBits(static_cast<int>(k));
@@ -115,7 +117,11 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     if (k >= c.k_lim || k < -c.k_lim) return RowSpansSetup::General;
     e[s] = {q, q * D - N, D, k, -B[s] - k * D, A[s] < 0};
   }
-  int64_t first = -1, last = -1;
+  // The rows' spans, with what the unit's cycles and the plane's check below need: the pixels'
+  // bounding columns, the fragments and the lane groups (span_detail::firstGroup: a multiple of
+  // LanesPerTri, a power of two, below a span's first column, which is >= 0 here).
+  int64_t first = -1, last = -1, xmin = c.W, xmax = -1, fragments = 0, groups = 0;
+  const int64_t align = c.align_lanes ? ~((int64_t{1} << c.lane_shift) - 1) : -1;
   for (int64_t i = 0; i <= r1 - r0; ++i) {
     int64_t lo = 0, hi = c.W - 1;
     for (RowEdge& g : e) {
@@ -131,6 +137,10 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     if (any) {
       first = first < 0 ? i : first;
       last = i;
+      xmin = std::min(xmin, lo);
+      xmax = std::max(xmax, hi);
+      fragments += hi - lo + 1;
+      groups += ((hi - (lo & align)) >> c.lane_shift) + 1;
     }
   }
   if (first < 0) return RowSpansSetup::Dropped;  // no pixel centre inside it in the viewport
@@ -138,14 +148,10 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   o.y0 = static_cast<int32_t>(r0 + first);
   o.rows = static_cast<int32_t>(last - first + 1);
   o.x0 = o.span[0][0];
+  o.fragments = static_cast<uint32_t>(fragments);
+  o.groups = static_cast<uint32_t>(groups);
   // The plane (setup's setPlane, its 64-bit path), and its values at the corners of the pixels'
   // bounding box within int32_t (then at every pixel: the plane is affine).
-  int64_t xmin = c.W, xmax = -1;
-  for (int32_t i = 0; i < o.rows; ++i) {
-    if (o.span[static_cast<size_t>(i)][0] > o.span[static_cast<size_t>(i)][1]) continue;
-    xmin = std::min<int64_t>(xmin, o.span[static_cast<size_t>(i)][0]);
-    xmax = std::max<int64_t>(xmax, o.span[static_cast<size_t>(i)][1]);
-  }
   const int64_t xref = std::clamp<int64_t>(std::min({X[0], X[1], X[2]}) >> S, 0, c.W - 1);
   const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
   const int64_t dcx = ((2 * xref + 1) << S) - xu[0], dcy = ((2 * yref + 1) << S) - yu[0];
@@ -173,23 +179,24 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
 
 SpanWalk countRowSpans(const SpanParams& p, const RowSpans& s, SpanStream* stream) {
   SpanWalk w;
+  w.fragments = s.fragments;
+  w.span_cycles = s.groups;
+  w.row_cycles = static_cast<uint64_t>(s.rows);
+  // The paper's unit: the IDLE cycle accepting the descriptor, its ROW and SPAN cycles.
+  if (!p.RowAhead) {
+    w.cycles = 1 + w.row_cycles + w.span_cycles;
+    return w;
+  }
+  // The full-rate unit: the stream fed row by row.
   SpanStream alone;
   SpanStream& timing = stream != nullptr ? *stream : alone;
   const uint64_t end0 = timing.end();
   const int64_t L = p.LanesPerTri;
   for (int32_t i = 0; i < s.rows; ++i) {
     const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
-    uint64_t groups = 0;
-    if (lo <= hi) {
-      groups = static_cast<uint64_t>(L == 1 ? hi - lo + 1 : (hi - span_detail::firstGroup(p, lo)) / L + 1);
-      w.fragments += static_cast<uint64_t>(hi - lo + 1);
-    }
-    w.span_cycles += groups;
-    if (p.RowAhead) timing.row(groups);
+    timing.row(lo <= hi ? static_cast<uint64_t>((hi - span_detail::firstGroup(p, lo)) / L + 1) : 0);
   }
-  w.row_cycles = static_cast<uint64_t>(s.rows);
-  // The paper's unit: the IDLE cycle accepting the descriptor, its ROW and SPAN cycles.
-  w.cycles = p.RowAhead ? timing.end() - end0 : 1 + w.row_cycles + w.span_cycles;
+  w.cycles = timing.end() - end0;
   return w;
 }
 

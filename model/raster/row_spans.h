@@ -46,6 +46,8 @@ struct RowSpans {
   int32_t x0 = 0;            // span[0]'s lo: the first pixel, (x0, y0)
   std::array<int64_t, 4> a0;            // the attribute codes at the first pixel
   std::array<int64_t, 4> didx, didy;    // the plane's gradients (SetupResult::plane's), within int32_t
+  uint32_t fragments = 0;  // the pixels of the rows
+  uint32_t groups = 0;     // the unit's lane groups (SPAN cycles of the paper's unit) over the rows
   std::array<std::array<int16_t, 2>, kMaxRows> span;  // [lo, hi] of row y0 + i; lo > hi: no pixel
 };
 
@@ -56,6 +58,8 @@ struct RowSpansConfig {
   // subpixel coordinates below 2^29).
   bool applies = false;
   int S = 4, W = 0, H = 0;
+  int lane_shift = 0;        // log2 LanesPerTri
+  bool align_lanes = false;  // AlignLanes
   int64_t k_lim = 0;                 // |DDA step k| < 2^(CoordBits - 1): setup's register bound
   double guard = 0;                  // setup's guard band, px
   std::array<int, 4> frac{};         // the attributes' fraction bits

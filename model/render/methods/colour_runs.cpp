@@ -132,14 +132,44 @@ struct ColourRunLoop {
   }
 };
 
+// A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
+// walk: a run per row with a pixel, its codes at its first pixel from the plane, the steps the
+// triangle's gradients (as the walk's runs; a run of one pixel reads none).
+static_assert(RowSpans::kMaxRows <= fixed_simd::ColourRuns::kCap, "a triangle's rows in one call");
+void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs, const fixed_simd::Target& target) {
+  const RowSpans& s = *t.rows;
+  if (!t.counted) f.count(countRowSpans(*f.walker, s, f.span.streamOrNull()));
+  for (size_t k = 0; k < 3; ++k) runs.dc[k] = static_cast<int32_t>(s.didx[k]);
+  runs.dz = static_cast<uint32_t>(s.didx[3]);
+  size_t n = 0;
+  for (int32_t i = 0; i < s.rows; ++i) {
+    const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo > hi) continue;
+    fixed_simd::ColourRuns::Row& row = runs.rows[n++];
+    row.p = static_cast<size_t>(s.y0 + i) * static_cast<size_t>(f.W) + static_cast<size_t>(lo);
+    row.count = static_cast<size_t>(hi - lo + 1);
+    row.room = static_cast<size_t>(f.W - lo);
+    // exact: the plane fits int32_t at every pixel (row_spans.h)
+    row.z = static_cast<uint32_t>(s.a0[3] + s.didx[3] * (lo - s.x0) + s.didy[3] * i);
+    for (size_t k = 0; k < 3; ++k) row.c[k] = static_cast<int32_t>(s.a0[k] + s.didx[k] * (lo - s.x0) + s.didy[k] * i);
+  }
+  runs.n = n;
+  uint64_t passed = 0;
+  f.st.pixels_covered += f.colour_kernel(runs, target, f.fb.rgb.data(), passed);
+  f.st.depth_rejected += s.fragments - passed;
+  runs.n = 0;
+}
+
 // The colour units' drawing: the walk with the fragment sink and the run loop (runs: the unit's
-// buffer of the runs waiting for the vector kernel).
+// buffer of the runs waiting for the vector kernel), or a triangle's rows' spans straight to
+// the vector kernel.
 void drawColourRuns(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs) {
   Framebuffer& fb = f.fb;
   const int W = f.W;
   const PixelWriter write = f.writer(t.tag);
   const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
   runs.frac = kColourFrac;
+  if (t.rows != nullptr && f.colour_kernel != nullptr) return drawColourSpans(f, t, runs, target);
   PendingRuns pending{f.colour_kernel, target, fb.rgb.data(), f.st.pixels_covered, f.st.depth_rejected, runs};
   ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, pending};
   ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, pending};
