@@ -12,6 +12,8 @@
 #define SHD_HAVE_AVX512_KERNEL 1
 #define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd,avx512vl,avx512bw")))
 #define SHD_AVX2 __attribute__((target("avx2")))
+// The AVX2 colour kernel: PREFETCHW too (executed as a NOP by Intel CPUs before Broadwell).
+#define SHD_AVX2_PRFCHW __attribute__((target("avx2,prfchw")))
 #endif
 
 namespace shd::fixed_simd {
@@ -294,7 +296,7 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
 // 32-bit stores), the colour bytes as below.
 // The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
 // iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
-SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
+SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
   const RunLanes l = runLanes(r);
   const __m256i lanes = lanes8();
   const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
@@ -310,6 +312,11 @@ SHD_AVX2 uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* 
       int32_t* const depth = t.depth + row.p + k;
       __builtin_prefetch(depth + 2 * t.width);
       __builtin_prefetch(depth + 2 * t.width + 7);
+      // The tags and the colours there are read and written below: fetched for writing.
+      __builtin_prefetch(t.tri + row.p + k + 2 * t.width, 1);
+      __builtin_prefetch(t.tri + row.p + k + 2 * t.width + 7, 1);
+      __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width), 1);
+      __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width) + 31, 1);
       // The 8 pixels lie in the run's row: plain loads, and stores of the blend (the pixels
       // that do not pass written back as read). Masked stores (vpmaskmovd) are slow on AMD
       // (docs/performance.md); they remain for a group at the row's right end.
