@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 
 namespace shd::exact {
@@ -25,6 +26,19 @@ inline int64_t snapHalfEven(double v, int frac) {
   constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
   if (std::fabs(x) < 2251799813685248.0) return static_cast<int64_t>((x + kMagic) - kMagic);  // 2^51
   return static_cast<int64_t>(std::nearbyint(x));
+}
+
+// snapHalfEven(v, frac) given x = v 2^frac with |x| < 2^51 (the caller bounds it): x + 1.5 2^52
+// lies in [2^52, 2^53), where the doubles are the integers, so the sum is rounded half to even
+// (1.5 2^52 being even), and its bits less the constant's are the integer, without a
+// conversion instruction.
+inline int64_t snapSmall(double x) {
+  constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
+  const double y = x + kMagic;
+  int64_t yb = 0, mb = 0;
+  std::memcpy(&yb, &y, sizeof y);
+  std::memcpy(&mb, &kMagic, sizeof kMagic);
+  return yb - mb;
 }
 
 inline bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }

@@ -56,16 +56,22 @@ bool fits32(int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; }
 RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, RowSpans& o) {
   const int S = c.S;
   // Snapped as setup snaps them (snapVertices); what it refuses, setupTriangle refuses, naming it.
+  // Within these bounds |x 2^S| < 2^29 and |a 2^frac| < 2^31: snapSmall's range. The checks
+  // are summed into one test, the rare refusal being the one branch.
   std::array<int64_t, 3> X, Y;
   std::array<std::array<int64_t, 3>, 4> a;
+  bool ok = true;
+  const double pixel_scale = static_cast<double>(int64_t{1} << S);
   for (size_t i = 0; i < 3; ++i) {
-    if (!(std::fabs(v[i].x) <= c.guard && std::fabs(v[i].y) <= c.guard)) return RowSpansSetup::General;
-    X[i] = snapHalfEven(v[i].x, S);
-    Y[i] = snapHalfEven(v[i].y, S);
-    for (size_t k = 0; k < 4; ++k) {
-      if (!(std::fabs(v[i].attr[k] * c.scale[k]) <= c.lim)) return RowSpansSetup::General;
-      a[k][i] = snapHalfEven(v[i].attr[k], c.frac[k]);
-    }
+    ok &= std::fabs(v[i].x) <= c.guard;
+    ok &= std::fabs(v[i].y) <= c.guard;
+    for (size_t k = 0; k < 4; ++k) ok &= std::fabs(v[i].attr[k] * c.scale[k]) <= c.lim;
+  }
+  if (!ok) return RowSpansSetup::General;
+  for (size_t i = 0; i < 3; ++i) {
+    X[i] = snapSmall(v[i].x * pixel_scale);
+    Y[i] = snapSmall(v[i].y * pixel_scale);
+    for (size_t k = 0; k < 4; ++k) a[k][i] = snapSmall(v[i].attr[k] * c.scale[k]);
   }
   int64_t det = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]);
   if (det == 0) return RowSpansSetup::Dropped;  // zero area
