@@ -95,13 +95,6 @@ inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, co
 
 }  // namespace
 
-void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                       std::vector<PVertex>& verts) {
-  verts.assign(obj.mesh.positions.size(), PVertex{});
-  const NormalTransform to_world(obj.transform);
-  for (size_t i = 0; i < verts.size(); ++i) transformVertex(obj, basis, cam, proj, to_world, i, verts[i]);
-}
-
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                           PVertex* verts, size_t begin, size_t end) {
   const NormalTransform to_world(obj.transform);

@@ -87,12 +87,9 @@ struct ClearRect {
 ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact);
 void clearRect(Framebuffer& fb, const ClearRect& r);
 
-// Object -> camera space and the projection of the vertices in front of the near plane (their
-// colours are left to the method, render.cpp).
-void transformVertices(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                       std::vector<PVertex>& verts);
-// The same for the vertices [begin, end) of an array that holds them all (each one made anew):
-// parts of an object's vertices, on either thread of a two-thread frame (render.cpp).
+// Object -> camera space and the projection of the vertices [begin, end) in front of the near
+// plane, in an array that holds them all, each one made anew (its colour left to the method,
+// render.cpp): an object's vertices, or parts of them on either thread of a two-thread frame.
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                           PVertex* verts, size_t begin, size_t end);
 

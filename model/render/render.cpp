@@ -28,6 +28,17 @@
 
 namespace shd {
 
+// A frame's buffers kept in its result (ScratchBuffers): the current object's vertices and
+// which of them have their colour.
+struct RenderScratch {
+  std::vector<PVertex> verts;
+  std::vector<uint8_t> lit;
+};
+ScratchBuffers::ScratchBuffers() : p_(std::make_unique<RenderScratch>()) {}
+ScratchBuffers::~ScratchBuffers() = default;
+ScratchBuffers::ScratchBuffers(const ScratchBuffers&) : ScratchBuffers() {}
+ScratchBuffers& ScratchBuffers::operator=(const ScratchBuffers&) { return *this; }
+
 namespace {
 
 // The coding of a device lobe's requests for the specular unit of a material.
@@ -219,8 +230,7 @@ class BackThread {
 class SceneDrawer {
  public:
   // queue: a two-thread frame's, to which the screen triangles go (else they are drawn here).
-  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, std::vector<ScreenTriangleInfo>& triangles,
-              DrawQueue* queue = nullptr);
+  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue = nullptr);
   void drawObject(size_t oi);
   const RasterConfig& rasterConfig(bool colour_attrs) const { return colour_attrs ? rc_colour_ : rc_unit_; }
 
@@ -241,8 +251,8 @@ class SceneDrawer {
   const bool vertex_colours_;         // the method's
   RasterConfig rc_colour_, rc_unit_;  // setup of colour or normal attributes (and depth)
   std::optional<RowSpansConfig> rs_colour_, rs_unit_;  // and as rows' spans (empty: not at all)
-  std::vector<PVertex> verts_;        // the object's
-  std::vector<uint8_t> lit_;          // verts_[i].colour is computed
+  std::vector<PVertex>& verts_;       // the object's (the result's scratch)
+  std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
   Poly poly_;                         // a clipped triangle
   Fan fan_;                           // the polygon to draw
   Parts parts_;                       // its screen triangles
@@ -251,15 +261,16 @@ class SceneDrawer {
   RowSpans rows_;                     // the same as rows' spans
 };
 
-SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines,
-                         std::vector<ScreenTriangleInfo>& triangles, DrawQueue* queue)
+SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue)
     : f_(f),
       scene_(scene),
       engines_(engines),
-      triangles_(triangles),
+      triangles_(res.triangles),
       basis_(cameraBasis(scene.camera)),
       unit_(f.unit(f.opt.method)),
       vertex_colours_(traits(f.opt.method).vertex_colours),
+      verts_(res.scratch.get().verts),
+      lit_(res.scratch.get().lit),
       queue_(queue) {
   RasterConfig rc;
   rc.width = f.W;
@@ -286,10 +297,10 @@ void SceneDrawer::drawObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   lightObject(f_, scene_, engines_, oi);
   for (const auto& u : f_.units()) u.second->beginObject();
+  verts_.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
   if (queue_ == nullptr) {
-    transformVertices(obj, basis_, scene_.camera, f_.proj, verts_);
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size());
   } else {
-    verts_.resize(obj.mesh.positions.size());
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
     j.object = oi;
@@ -498,7 +509,7 @@ void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& eng
   const std::lock_guard<std::mutex> one_frame(worker.frame);
   DrawQueue& q = worker.queue;
   q.reset();
-  SceneDrawer drawer(front, scene, engines, res.triangles, &q);
+  SceneDrawer drawer(front, scene, engines, res, &q);
   const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res.fb, drawer);
   back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   const std::function<void()> back_end = [&] {
@@ -650,7 +661,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   span.beginFrame();
   if (opt.threads == 1) {
     clearRect(res.fb, clear);
-    SceneDrawer drawer(frame, scene, engines, res.triangles);
+    SceneDrawer drawer(frame, scene, engines, res);
     for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
   } else {
     renderTwoThreads(scene, span, engines, frame, clear, res);
