@@ -38,6 +38,19 @@ struct ModelEngines {
   }
 };
 
+// The first entry where two frames' colour, depth or triangle buffers differ, or "".
+std::string bufferDiff(const Framebuffer& a, const Framebuffer& b) {
+  auto first = [](const char* what, const auto& x, const auto& y) -> std::string {
+    if (x.size() != y.size()) return fmt::format("{}: {} entries against {}", what, x.size(), y.size());
+    const auto d = std::mismatch(x.begin(), x.end(), y.begin());
+    return d.first == x.end() ? "" : fmt::format("{} {} differs", what, d.first - x.begin());
+  };
+  for (const std::string& d : {first("colour byte", a.rgb, b.rgb), first("depth of pixel", a.depth, b.depth),
+                               first("triangle id of pixel", a.tri, b.tri)})
+    if (!d.empty()) return d;
+  return "";
+}
+
 RenderResult renderModel(const Scene& s, Method m, const std::string& brdf, const std::string& mode) {
   ModelEngines e(mode);
   RenderOptions o;
@@ -680,15 +693,7 @@ TEST(Render, VectorPathsEqualTheScalarPaths) {
         o.vector_kernel = false;
         const RenderResult scalar = render(s, o, e.span, e.view);
         const std::string what = scene + " " + toString(c.m) + " " + c.brdf + " " + mode;
-        // The first differing entry (-1: none).
-        auto firstDiff = [](const auto& x, const auto& y) {
-          if (x.size() != y.size()) return ptrdiff_t{0};
-          const auto d = std::mismatch(x.begin(), x.end(), y.begin());
-          return d.first == x.end() ? ptrdiff_t{-1} : d.first - x.begin();
-        };
-        ASSERT_EQ(firstDiff(vec.fb.rgb, scalar.fb.rgb), -1) << what << ": colour byte";
-        ASSERT_EQ(firstDiff(vec.fb.depth, scalar.fb.depth), -1) << what << ": depth of pixel";
-        ASSERT_EQ(firstDiff(vec.fb.tri, scalar.fb.tri), -1) << what << ": triangle id of pixel";
+        ASSERT_EQ(bufferDiff(vec.fb, scalar.fb), "") << what;
         const RenderStats &a = vec.stats, &b = scalar.stats;
         EXPECT_EQ(a.fragments, b.fragments) << what;
         EXPECT_EQ(a.pixels_covered, b.pixels_covered) << what;
@@ -741,14 +746,7 @@ TEST(Render, RowSpansEqualTheSpanWalk) {
         o.row_spans = false;
         const RenderResult walked = render(s, o, e.span, e.view);
         const std::string what = fmt::format("{} {} {} {} thread(s) {}", scene, toString(c.m), c.brdf, c.threads, mode);
-        auto firstDiff = [](const auto& x, const auto& y) {  // -1: none
-          if (x.size() != y.size()) return ptrdiff_t{0};
-          const auto d = std::mismatch(x.begin(), x.end(), y.begin());
-          return d.first == x.end() ? ptrdiff_t{-1} : d.first - x.begin();
-        };
-        ASSERT_EQ(firstDiff(rows.fb.rgb, walked.fb.rgb), -1) << what << ": colour byte";
-        ASSERT_EQ(firstDiff(rows.fb.depth, walked.fb.depth), -1) << what << ": depth of pixel";
-        ASSERT_EQ(firstDiff(rows.fb.tri, walked.fb.tri), -1) << what << ": triangle id of pixel";
+        ASSERT_EQ(bufferDiff(rows.fb, walked.fb), "") << what;
         ASSERT_EQ(rows.triangles.size(), walked.triangles.size()) << what;
         for (size_t i = 0; i < rows.triangles.size(); ++i) {
           const ScreenTriangleInfo &a = rows.triangles[i], &b = walked.triangles[i];
