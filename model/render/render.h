@@ -28,7 +28,9 @@
 //   adaptive            methods/adaptive.cpp (gouraud or phong per triangle)
 //   reference           methods/reference.cpp
 // (The vertex colours of every Gouraud-type method are computed once per vertex, and only for
-// vertices of triangles that survive back-face culling.)
+// vertices of triangles that survive back-face culling. With the model's span unit of one
+// lane-triangle, a small screen triangle is set up straight to its rows' spans,
+// raster/row_spans.h, instead of a descriptor and its walk: the same fragments and cycles.)
 #pragma once
 
 #include <array>
