@@ -16,22 +16,10 @@ namespace shd::exact {
 using i128 = __int128;
 
 
-// round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven, without its format checks: the
-// callers have bounded |v 2^frac| well below 2^62 (the guard band, the attribute range). 2^frac
-// as a double multiplier is exact, like ldexp. Below 2^51 in magnitude, adding and subtracting
-// 1.5 * 2^52 rounds to an integer half to even in IEEE double (the default rounding mode, as
-// nearbyint uses) without a libm call; larger values go through nearbyint.
-inline int64_t snapHalfEven(double v, int frac) {
-  const double x = v * static_cast<double>(int64_t{1} << frac);
-  constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
-  if (std::fabs(x) < 2251799813685248.0) return static_cast<int64_t>((x + kMagic) - kMagic);  // 2^51
-  return static_cast<int64_t>(std::nearbyint(x));
-}
-
-// snapHalfEven(v, frac) given x = v 2^frac with |x| < 2^51 (the caller bounds it): x + 1.5 2^52
-// lies in [2^52, 2^53), where the doubles are the integers, so the sum is rounded half to even
-// (1.5 2^52 being even), and its bits less the constant's are the integer, without a
-// conversion instruction.
+// round-half-even(x) for |x| < 2^51 (the caller bounds it): x + 1.5 2^52 lies in
+// [2^52, 2^53), where the doubles are the integers, so the sum is x rounded half to even (in
+// IEEE double's default rounding mode, as nearbyint uses; 1.5 2^52 is even), and its bits less
+// the constant's are that integer: no libm call and no conversion instruction.
 inline int64_t snapSmall(double x) {
   constexpr double kMagic = 6755399441055744.0;  // 1.5 * 2^52
   const double y = x + kMagic;
@@ -39,6 +27,15 @@ inline int64_t snapSmall(double x) {
   std::memcpy(&yb, &y, sizeof y);
   std::memcpy(&mb, &kMagic, sizeof kMagic);
   return yb - mb;
+}
+
+// round-half-even(v 2^frac): Fixed::fromDouble's RoundHalfEven, without its format checks: the
+// callers have bounded |v 2^frac| well below 2^62 (the guard band, the attribute range). 2^frac
+// as a double multiplier is exact, like ldexp. Below 2^51 snapSmall, larger values nearbyint.
+inline int64_t snapHalfEven(double v, int frac) {
+  const double x = v * static_cast<double>(int64_t{1} << frac);
+  if (std::fabs(x) < 2251799813685248.0) return snapSmall(x);  // 2^51
+  return static_cast<int64_t>(std::nearbyint(x));
 }
 
 inline bool fitsI64(i128 v) { return v >= INT64_MIN && v <= INT64_MAX; }

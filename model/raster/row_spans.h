@@ -49,6 +49,9 @@ struct RowSpans {
   uint32_t fragments = 0;  // the pixels of the rows
   uint32_t groups = 0;     // the unit's lane groups (SPAN cycles of the paper's unit) over the rows
   std::array<std::array<int16_t, 2>, kMaxRows> span;  // [lo, hi] of row y0 + i; lo > hi: no pixel
+  // Attribute k at pixel x of row y0 + i, a pixel of the triangle: exact, the plane fitting
+  // int32_t there.
+  int64_t at(size_t k, int64_t x, int32_t i) const { return a0[k] + didx[k] * (x - x0) + didy[k] * i; }
 };
 
 // What setupRowSpans needs of a raster configuration, once per frame.
@@ -88,7 +91,7 @@ inline void emitRowSpans(const RowSpans& s, RunSink& run) {
     const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
     if (lo > hi) continue;
     for (size_t k = 0; k < 4; ++k) {
-      a[k] = s.a0[k] + s.didx[k] * (lo - s.x0) + s.didy[k] * i;  // exact: the plane fits int32_t here
+      a[k] = s.at(k, lo, i);
       da[k] = hi > lo ? s.didx[k] : 0;
     }
     run(RowRun{static_cast<int32_t>(lo), s.y0 + i, 1, hi - lo + 1, a.data(), da.data()});

@@ -239,7 +239,7 @@ class Frame {
       return;
     }
     if (t.rows != nullptr) {
-      if (!t.counted) count(countRowSpans(*walker, *t.rows, span.streamOrNull()));
+      if (!t.counted) countRows(*t.rows);
       if constexpr (sizeof...(Runs) > 0) {
         emitRowSpans(*t.rows, runs...);
       } else {
@@ -304,6 +304,9 @@ class Frame {
     st.span_cycles += wk.cycles;
     st.fragments += wk.fragments;
   }
+  // A triangle's rows' spans counted as the model's walk counts its descriptor, on the span
+  // engine's stream.
+  void countRows(const RowSpans& s) { count(countRowSpans(*walker, s, span.streamOrNull())); }
   // The fragments of t from the span engine, in its order, into frags (counted).
   void collect(const SpanTriangle& t);
   std::vector<SpanFragment> frags;

@@ -431,7 +431,7 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   // A method walked ahead: its rows counted here, on this side, with the span engine's stream
   // (as walkAhead counts), and drawn by the back end from the rows.
   if (tr.two_threads == TwoThreads::AfterWalk) {
-    if (rows != nullptr) f_.count(countRowSpans(*f_.walker, *rows, f_.span.streamOrNull()));
+    if (rows != nullptr) f_.countRows(*rows);
     else walkAhead(*setup->desc, job->walk);
   }
   queue_->push();

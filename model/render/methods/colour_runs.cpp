@@ -138,7 +138,7 @@ struct ColourRunLoop {
 static_assert(RowSpans::kMaxRows <= fixed_simd::ColourRuns::kCap, "a triangle's rows in one call");
 void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs, const fixed_simd::Target& target) {
   const RowSpans& s = *t.rows;
-  if (!t.counted) f.count(countRowSpans(*f.walker, s, f.span.streamOrNull()));
+  if (!t.counted) f.countRows(s);
   for (size_t k = 0; k < 3; ++k) runs.dc[k] = static_cast<int32_t>(s.didx[k]);
   runs.dz = static_cast<uint32_t>(s.didx[3]);
   size_t n = 0;
@@ -149,9 +149,8 @@ void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& ru
     row.p = static_cast<size_t>(s.y0 + i) * static_cast<size_t>(f.W) + static_cast<size_t>(lo);
     row.count = static_cast<size_t>(hi - lo + 1);
     row.room = static_cast<size_t>(f.W - lo);
-    // exact: the plane fits int32_t at every pixel (row_spans.h)
-    row.z = static_cast<uint32_t>(s.a0[3] + s.didx[3] * (lo - s.x0) + s.didy[3] * i);
-    for (size_t k = 0; k < 3; ++k) row.c[k] = static_cast<int32_t>(s.a0[k] + s.didx[k] * (lo - s.x0) + s.didy[k] * i);
+    row.z = static_cast<uint32_t>(s.at(3, lo, i));
+    for (size_t k = 0; k < 3; ++k) row.c[k] = static_cast<int32_t>(s.at(k, lo, i));
   }
   runs.n = n;
   uint64_t passed = 0;
