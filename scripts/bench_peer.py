@@ -2,8 +2,8 @@
 """bench_peer.py: the model's time per frame against a peer renderer's, measured side by side.
 
   scripts/bench_peer.py --pair METHOD 'PEER COMMAND' [--pair ...] [--rounds R] [--frames N]
-                        [--threads 1,2] [--scene SCENE] [--shadesim BIN] [--peer-pattern REGEX]
-                        [--json-out FILE]
+                        [--threads 1,2] [--scene SCENE | --segments 32,64,...] [--shadesim BIN]
+                        [--peer-pattern REGEX] [--json-out FILE]
 
 Each --pair names a shadesim method (`shadesim render --method`) and a shell command that prints
 the peer's time per frame in milliseconds. Every round runs, for every pair, shadesim
@@ -14,6 +14,10 @@ a figure from another run, day or machine.
 
 --threads: the thread counts of shadesim's frames (`render --threads`), comma-separated; each
 pair runs once per count in every round, beside its own peer run (default 1).
+
+--segments: instead of one scene, builtin:sphere's scene (vectors/scenes/sphere.json) with a
+sphere of each of these segment counts (mesh "builtin:sphere(1,N)"); "{seg}" in a peer command
+stands for N, so that the peer draws the same sphere (e.g. 'PEER_SEG={seg} PEER flat').
 
 --peer-pattern: a regular expression whose first group is the peer's ms per frame, searched in
 its output; the last match counts (default: a number followed by "ms").
@@ -48,9 +52,9 @@ def run(cmd, shell=False):
     return p.stdout
 
 
-def shadesim_ms(a, method, threads, work):
+def shadesim_ms(a, scene, method, threads, work):
     js = os.path.join(work, "render.json")
-    run([a.shadesim, "render", "--scene", a.scene, "--method", method, "--bench", str(a.frames), "--quiet",
+    run([a.shadesim, "render", "--scene", scene, "--method", method, "--bench", str(a.frames), "--quiet",
          "--threads", str(threads), "-o", os.path.join(work, "render.png"), "--json", js])
     with open(js, encoding="utf-8") as f:
         return float(json.load(f)["ms"])
@@ -65,19 +69,34 @@ def peer_ms(a, cmd):
     return float(found[-1] if isinstance(found[-1], str) else found[-1][0])
 
 
+def sphere_scene(work, seg):
+    """builtin:sphere's scene with a sphere of seg segments, as a scene file in work."""
+    with open(os.path.join(ROOT, "vectors", "scenes", "sphere.json"), encoding="utf-8") as f:
+        scene = json.load(f)
+    scene["objects"][0]["mesh"] = f"builtin:sphere(1,{seg})"
+    path = os.path.join(work, f"sphere{seg}.json")
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(scene, f)
+    return path
+
+
 def measure(a):
-    results = [{"method": m, "threads": n, "peer": c, "rounds": []} for m, c in a.pair for n in a.threads]
+    sizes = a.segments or [None]
+    results = [{"method": m, "threads": n, "segments": g, "peer": c if g is None else c.replace("{seg}", str(g)),
+                "rounds": []} for g in sizes for m, c in a.pair for n in a.threads]
     with tempfile.TemporaryDirectory(prefix="bench_peer_") as work:
+        scenes = {g: a.scene if g is None else sphere_scene(work, g) for g in sizes}
         for r in range(a.rounds):
             for res in results:
                 order = ("shadesim", "peer") if r % 2 == 0 else ("peer", "shadesim")
                 t = {}
                 for who in order:
-                    t[who] = (shadesim_ms(a, res["method"], res["threads"], work) if who == "shadesim"
+                    t[who] = (shadesim_ms(a, scenes[res["segments"]], res["method"], res["threads"], work)
+                              if who == "shadesim"
                               else peer_ms(a, res["peer"]))
                 t["ratio"] = t["shadesim"] / t["peer"]
                 res["rounds"].append(t)
-                print(f"bench_peer: round {r + 1}/{a.rounds} {res['method']} ({res['threads']} thread(s)): "
+                print(f"bench_peer: round {r + 1}/{a.rounds} {label(res)}: "
                       f"shadesim {t['shadesim']:.3f} ms, "
                       f"peer {t['peer']:.3f} ms, ratio {t['ratio']:.3f}", file=sys.stderr, flush=True)
     for res in results:
@@ -87,11 +106,17 @@ def measure(a):
     return results
 
 
+def label(res):
+    seg = "" if res["segments"] is None else f", {res['segments']} segments"
+    return f"{res['method']} ({res['threads']} thread(s){seg})"
+
+
 def report(a, results):
     env = " SHD_SCALAR=1" if os.environ.get("SHD_SCALAR") else ""
-    print(f"{a.scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds; ratio = shadesim / peer")
+    scene = f"builtin:sphere of {a.segments} segments" if a.segments else a.scene
+    print(f"{scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds; ratio = shadesim / peer")
     for res in results:
-        print(f"\n{res['method']}, {res['threads']} thread(s), against: {res['peer']}")
+        print(f"\n{label(res)}, against: {res['peer']}")
         print(f"{'round':>5} {'shadesim ms':>12} {'peer ms':>10} {'ratio':>7}")
         for i, t in enumerate(res["rounds"]):
             print(f"{i + 1:>5} {t['shadesim']:>12.3f} {t['peer']:>10.3f} {t['ratio']:>7.3f}")
@@ -105,6 +130,7 @@ def main(argv):
     p.add_argument("--frames", type=int, default=200)
     p.add_argument("--threads", default="1")
     p.add_argument("--scene", default="builtin:sphere")
+    p.add_argument("--segments")
     p.add_argument("--shadesim", default=os.path.join(ROOT, "build", "sim", "shadesim"))
     p.add_argument("--peer-pattern", default=DEFAULT_PATTERN)
     p.add_argument("--json-out")
@@ -119,6 +145,14 @@ def main(argv):
             a.threads = []
         if not a.threads or any(n not in (1, 2) for n in a.threads) or len(set(a.threads)) != len(a.threads):
             raise BenchError(f"--threads '{given}': distinct thread counts, 1 or 2, comma-separated")
+        if a.segments is not None:
+            given = a.segments
+            try:
+                a.segments = [int(n) for n in given.split(",")]
+            except ValueError:
+                a.segments = []
+            if not a.segments or any(n < 4 or n > 1024 for n in a.segments) or a.scene != "builtin:sphere":
+                raise BenchError(f"--segments '{given}': segment counts 4..1024 (builtin:sphere(1,N)), comma-separated, without --scene")
         if not os.access(a.shadesim, os.X_OK):
             raise BenchError(f"{a.shadesim}: no shadesim binary (--shadesim)")
         try:
@@ -133,7 +167,7 @@ def main(argv):
     report(a, results)
     if a.json_out:
         with open(a.json_out + ".tmp", "w", encoding="utf-8") as f:
-            json.dump({"scene": a.scene, "frames": a.frames, "rounds": a.rounds, "pairs": results}, f, indent=1)
+            json.dump({"scene": a.scene, "segments": a.segments, "frames": a.frames, "rounds": a.rounds, "pairs": results}, f, indent=1)
         os.replace(a.json_out + ".tmp", a.json_out)
     return 0
 

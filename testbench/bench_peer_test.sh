@@ -1,0 +1,47 @@
+#!/usr/bin/env bash
+# bench_peer_test.sh SHADESIM WORK: scripts/bench_peer.py against a stand-in peer that prints a
+# given time (no figure is checked, only the plumbing): the ratios are shadesim's times over the
+# peer's, "{seg}" reaches the peer command with each sphere size of --segments, the JSON holds
+# every round, and bad input or a peer without a time exits 2 naming the cause.
+set -euo pipefail
+shadesim=$(realpath "$1")
+work=$2
+root=$(cd "$(dirname "$0")/.." && pwd)
+source "$(dirname "$0")/fresh_work.sh"
+fresh_work "$work"
+cd "$work"
+bench=("$root/scripts/bench_peer.py" --shadesim "$shadesim" --frames 2 --rounds 2)
+# The peer's ms per frame is the sphere's segment count: each size's own command ran.
+"${bench[@]}" --segments 6,9 --threads 1,2 --pair gouraud 'echo "frame {seg}.0 ms"' --json-out r.json > out.txt
+cat out.txt
+python3 - <<'PY'
+import json
+r = json.load(open("r.json"))
+assert r["segments"] == [6, 9], r["segments"]
+pairs = r["pairs"]
+assert sorted((p["segments"], p["threads"]) for p in pairs) == [(6, 1), (6, 2), (9, 1), (9, 2)], pairs
+for p in pairs:
+    assert p["peer"] == f'echo "frame {p["segments"]}.0 ms"', p["peer"]
+    assert len(p["rounds"]) == 2
+    for t in p["rounds"]:
+        assert t["peer"] == p["segments"] and t["shadesim"] > 0, t
+        assert abs(t["ratio"] - t["shadesim"] / t["peer"]) < 1e-12, t
+print("bench_peer json: ok")
+PY
+grep -q "^gouraud (1 thread(s), 9 segments), against: echo \"frame 9.0 ms\"" out.txt
+grep -q "^median ratio " out.txt
+expect2() {  # expect2 WHAT ARGS...: exit 2 with WHAT in stderr
+  local what=$1; shift
+  set +e
+  "${bench[@]}" "$@" > /dev/null 2> err.txt
+  local rc=$?
+  set -e
+  [ "$rc" -eq 2 ] || { echo "expected exit 2 for $*, got $rc"; exit 1; }
+  grep -q -- "$what" err.txt || { echo "expected '$what' for $*:"; cat err.txt; exit 1; }
+}
+expect2 "segment counts 4..1024" --segments 3 --pair flat 'echo 1 ms'
+expect2 "segment counts 4..1024" --segments 64 --scene builtin:torus --pair flat 'echo 1 ms'
+expect2 "distinct thread counts" --threads 1,3 --pair flat 'echo 1 ms'
+expect2 "no time per frame" --pair flat 'echo none'
+expect2 "exit 3" --pair flat 'exit 3'
+echo "bench_peer: ok"
