@@ -10,6 +10,7 @@
 #include <random>
 #include <set>
 
+#include "render/draw.h"
 #include "render/fixed_simd.h"
 #include "render/methods.h"
 #include "render/pipeline.h"
@@ -795,6 +796,21 @@ TEST(Render, AFrameOverAnotherEqualsItRenderedAfresh) {
   }
 }
 
+// Two frames alike: their buffers, triangle lists and every count (not the time).
+void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::string& what) {
+  EXPECT_EQ(a.fb.rgb, b.fb.rgb) << what;
+  EXPECT_EQ(a.fb.depth, b.fb.depth) << what;
+  EXPECT_EQ(a.fb.tri, b.fb.tri) << what;
+  ASSERT_EQ(a.triangles.size(), b.triangles.size()) << what;
+  for (size_t i = 0; i < a.triangles.size(); ++i) {
+    ASSERT_EQ(a.triangles[i].object, b.triangles[i].object) << what;
+    ASSERT_EQ(a.triangles[i].mesh_triangle, b.triangles[i].mesh_triangle) << what;
+  }
+  RenderStats sa = a.stats, sb = b.stats;  // every count: 8-byte fields, no padding
+  sa.ms = sb.ms = 0;
+  EXPECT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << what << ": the counts differ";
+}
+
 // Two threads (RenderOptions::threads, render.cpp): the same bytes and counts as one, for every
 // method that allows it, on every built-in scene (builtin:materials: several objects, each its
 // material), with the materials' own lobes and with the specular unit's quadratic lobe (at the
@@ -821,19 +837,9 @@ TEST(Render, TwoThreadsEqualOneThread) {
           RenderResult b = render(s, o, two.span, two.view);
           render(s, o, two.span, two.view, b);  // over the frame before
           EXPECT_GT(a.stats.pixels_covered, 0u) << what;
-          EXPECT_EQ(a.fb.rgb, b.fb.rgb) << what;
-          EXPECT_EQ(a.fb.depth, b.fb.depth) << what;
-          EXPECT_EQ(a.fb.tri, b.fb.tri) << what;
-          ASSERT_EQ(a.triangles.size(), b.triangles.size()) << what;
-          for (size_t i = 0; i < a.triangles.size(); ++i) {
-            ASSERT_EQ(a.triangles[i].object, b.triangles[i].object) << what;
-            ASSERT_EQ(a.triangles[i].mesh_triangle, b.triangles[i].mesh_triangle) << what;
-          }
-          RenderStats sa = a.stats, sb = b.stats;  // every count: 8-byte fields, no padding
-          sa.ms = sb.ms = 0;
-          EXPECT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << what << ": the counts differ";
+          expectSameFrames(a, b, what);
           if (std::string(brdf) == "quadratic") {
-            EXPECT_GT(sa.spec_evaluations, 0u) << what;
+            EXPECT_GT(a.stats.spec_evaluations, 0u) << what;
           }
           ++compared;
         }
@@ -868,6 +874,50 @@ TEST(Render, TwoThreadsEqualOneThread) {
   EXPECT_EQ(a.stats.spec_evaluations, b.stats.spec_evaluations);
   EXPECT_EQ(a.stats.span_cycles, b.stats.span_cycles);
   EXPECT_GT(a.stats.spec_evaluations, 0u);
+}
+
+// The rows of a triangle walked ahead, shared between a two-thread frame's sides (RowShare): each
+// row is one side's, the front end's 3 bands of 8 rows in every 64 (anyIn: whether a triangle's
+// rows hold one of a side's); and phong-fixed at runtime
+// widths (its other unit, render/methods/phong_fixed_widths.cpp), which draws them through the
+// same walk, frame over frame on two threads equals one thread, rows' spans and walks alike.
+TEST(Render, TwoThreadsShareTheRowsWalkedAhead) {
+  const RowShare all{}, front{RowShare::Side::Front}, back{RowShare::Side::Back};
+  int front_rows = 0;
+  for (int32_t y = 0; y < 4096; ++y) {
+    ASSERT_TRUE(all.mine(y));
+    ASSERT_NE(front.mine(y), back.mine(y)) << "row " << y;
+    front_rows += front.mine(y);
+    EXPECT_EQ(front.mine(y), y % 64 < 24) << "row " << y;
+  }
+  EXPECT_EQ(front_rows, 4096 * 3 / 8);
+  for (const RowShare& share : {all, front, back})
+    for (int32_t y0 = 0; y0 < 200; ++y0)
+      for (int32_t y1 = y0; y1 < y0 + 70; ++y1) {
+        bool any = false;
+        for (int32_t y = y0; y <= y1; ++y) any = any || share.mine(y);
+        ASSERT_EQ(share.anyIn(y0, y1), any) << "rows " << y0 << ".." << y1;
+      }
+  for (const char* name : {"builtin:torus", "builtin:materials"}) {
+    const Scene s = loadScene(name);
+    for (const char* mode : {"serial", "sierpinskifull"}) {
+      const std::string what = fmt::format("{} {}", name, mode);
+      ModelEngines one(mode), two(mode);
+      RenderOptions o;
+      o.method = Method::PhongFixed;
+      o.brdf = "blinn";  // builtin:materials' cubic material would need the cubic unit
+      PhongWidths w;
+      w.NormalFracBits = 20;
+      w.CosFracBits = 24;
+      o.phong_widths = w;
+      const RenderResult a = render(s, o, one.span, one.view);
+      o.threads = 2;
+      RenderResult b = render(s, o, two.span, two.view);
+      render(s, o, two.span, two.view, b);  // over the frame before
+      EXPECT_GT(a.stats.pixels_covered, 0u) << what;
+      expectSameFrames(a, b, what);
+    }
+  }
 }
 
 // What cannot run on two threads is refused, naming why; an error on either thread reaches the

@@ -83,13 +83,16 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
 SpanWalk countRowSpans(const SpanParams& p, const RowSpans& s, SpanStream* stream);
 
 // The rows' fragments as walkSpanUnit hands them to a run consumer: one RowRun per row with a
-// pixel, top to bottom, each left to right.
-template <class RunSink>
-inline void emitRowSpans(const RowSpans& s, RunSink& run) {
+// pixel, top to bottom, each left to right; only the screen rows y where keep(y) holds.
+struct AllRows {
+  bool operator()(int32_t) const { return true; }
+};
+template <class RunSink, class Keep = AllRows>
+inline void emitRowSpans(const RowSpans& s, RunSink& run, Keep keep = {}) {
   std::array<int64_t, 4> a, da;
   for (int32_t i = 0; i < s.rows; ++i) {
     const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
-    if (lo > hi) continue;
+    if (lo > hi || !keep(s.y0 + i)) continue;
     for (size_t k = 0; k < 4; ++k) {
       a[k] = s.at(k, lo, i);
       da[k] = hi > lo ? s.didx[k] : 0;

@@ -9,6 +9,7 @@
 // per screen triangle (MethodUnit::draw), none per fragment.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <memory>
@@ -40,6 +41,27 @@ struct RecordedWalk {
   std::vector<Event> events;
 };
 
+// The rows of a triangle walked ahead (TwoThreads::AfterWalk) that a two-thread frame's side
+// draws: the screen in bands of 8 rows, kBands to a period, the front end taking the first
+// kFrontBands of each period and the back end the others (All: every row, one thread). Each
+// pixel is then drawn by one side alone, in the triangles' order, as one thread draws it; each
+// side counts the pixels it draws. The front end's share is the smaller, as it also culls,
+// sets up and walks: of 0 to 4 bands in 8, 3 made phong-fixed's frame on builtin:sphere the
+// shortest on a 2-core AMD EPYC VM without AVX-512 (docs/performance.md).
+struct RowShare {
+  enum class Side : uint8_t { All, Front, Back };
+  Side side = Side::All;
+  static constexpr int kBandShift = 3, kBands = 8, kFrontBands = 3;
+  static bool front(int32_t y) { return ((y >> kBandShift) & (kBands - 1)) < kFrontBands; }
+  bool mine(int32_t y) const { return side == Side::All || (side == Side::Front) == front(y); }
+  // Whether a row of y0 .. y1 (y0 <= y1) is mine.
+  bool anyIn(int32_t y0, int32_t y1) const {
+    for (int32_t band = y0 >> kBandShift; band <= y1 >> kBandShift; ++band)
+      if (mine(std::max(y0, band << kBandShift))) return true;
+    return false;
+  }
+};
+
 // A screen triangle set up for the span unit, with the method that draws it: by setup (a span
 // descriptor) or, for a small triangle of a method whose traits allow it, as its rows' spans
 // (raster/row_spans.h: the same fragments and cycles).
@@ -52,6 +74,7 @@ struct SpanTriangle {
   uint32_t tag;  // its id: the index in RenderResult::triangles, the framebuffer's tri
   const RecordedWalk* walked = nullptr;  // its walk done ahead, or null: Frame::walk walks it
   bool counted = false;  // rows: its cycles and fragments counted by a two-thread frame's front end
+  RowShare share{};      // walked ahead or counted: the rows to draw (Frame::walk)
   // The plane's gradient of attribute k along x (SetupResult::plane.didx).
   int64_t didx(size_t k) const { return rows != nullptr ? rows->didx[k] : setup->plane.didx[k]; }
 };
@@ -235,16 +258,17 @@ class Frame {
   template <class Sink, class... Runs>
   void walk(const SpanTriangle& t, Sink& sink, Runs&... runs) {
     if (t.walked != nullptr) {
-      replay(*t.walked, sink, runs...);
+      replay(*t.walked, t.share, sink, runs...);
       return;
     }
     if (t.rows != nullptr) {
       if (!t.counted) countRows(*t.rows);
+      const auto mine = [share = t.share](int32_t y) { return share.mine(y); };
       if constexpr (sizeof...(Runs) > 0) {
-        emitRowSpans(*t.rows, runs...);
+        emitRowSpans(*t.rows, runs..., mine);
       } else {
         auto fragments = [&sink](const RowRun& r) { runFragments(r, sink); };
-        emitRowSpans(*t.rows, fragments);
+        emitRowSpans(*t.rows, fragments, mine);
       }
       return;
     }
@@ -276,11 +300,13 @@ class Frame {
     };
     walk(t, fragment);
   }
-  // A walk done ahead, to the same consumers: with no run consumer, a run's fragments one by
-  // one, which is what the walk gives such a consumer (a run is a row's fragments in order).
+  // A walk done ahead, to the same consumers, its events in the rows of `share`: with no run
+  // consumer, a run's fragments one by one, which is what the walk gives such a consumer (a run
+  // is a row's fragments in order).
   template <class Sink, class... Runs>
-  static void replay(const RecordedWalk& w, Sink& sink, Runs&... runs) {
+  static void replay(const RecordedWalk& w, RowShare share, Sink& sink, Runs&... runs) {
     for (const RecordedWalk::Event& e : w.events) {
+      if (!share.mine(e.y)) continue;
       if (!e.run) {
         sink(e.x0, e.y, static_cast<const int64_t*>(e.a0.data()));
       } else if constexpr (sizeof...(Runs) > 0) {

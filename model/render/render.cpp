@@ -112,6 +112,7 @@ struct DrawJob {
   size_t object = 0;                // BeginObject
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
   bool spans = false;               // Triangle: set up as rows' spans (else by setup)
+  bool shared = false;              // Triangle walked ahead: the front end draws its RowShare of it
   SetupResult setup;                // Triangle, unless spans
   RowSpans rows;                    // Triangle, if spans
   RecordedWalk walk;                // Triangle: the front end's walk, for a TwoThreads::AfterWalk method
@@ -229,8 +230,11 @@ class BackThread {
 // per-triangle work reused across the frame (no allocation per triangle once they have grown).
 class SceneDrawer {
  public:
-  // queue: a two-thread frame's, to which the screen triangles go (else they are drawn here).
-  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue = nullptr);
+  // queue: a two-thread frame's, to which the screen triangles go (else they are drawn here);
+  // cleared: its back end has cleared the buffers (the front end draws its share of the
+  // triangles walked ahead after that).
+  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue = nullptr,
+              const std::atomic<bool>* cleared = nullptr);
   void drawObject(size_t oi);
   const RasterConfig& rasterConfig(bool colour_attrs) const { return colour_attrs ? rc_colour_ : rc_unit_; }
 
@@ -257,11 +261,14 @@ class SceneDrawer {
   Fan fan_;                           // the polygon to draw
   Parts parts_;                       // its screen triangles
   DrawQueue* const queue_;
+  const std::atomic<bool>* const cleared_;
+  bool seen_cleared_ = false;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
   RowSpans rows_;                     // the same as rows' spans
 };
 
-SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue)
+SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue,
+                         const std::atomic<bool>* cleared)
     : f_(f),
       scene_(scene),
       engines_(engines),
@@ -271,7 +278,8 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       vertex_colours_(traits(f.opt.method).vertex_colours),
       verts_(res.scratch.get().verts),
       lit_(res.scratch.get().lit),
-      queue_(queue) {
+      queue_(queue),
+      cleared_(cleared) {
   RasterConfig rc;
   rc.width = f.W;
   rc.height = f.H;
@@ -429,12 +437,25 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   job->tag = tag;
   job->spans = rows != nullptr;
   // A method walked ahead: its rows counted here, on this side, with the span engine's stream
-  // (as walkAhead counts), and drawn by the back end from the rows.
-  if (tr.two_threads == TwoThreads::AfterWalk) {
+  // (as walkAhead counts), and drawn by the back end from the rows; without specular-unit
+  // requests (counted per triangle) the front end draws its share of the rows (RowShare).
+  const bool ahead = tr.two_threads == TwoThreads::AfterWalk;
+  if (ahead) {
     if (rows != nullptr) f_.countRows(*rows);
     else walkAhead(*setup->desc, job->walk);
   }
+  job->shared = ahead && f_.obj.spec == nullptr;
   queue_->push();
+  // The slot stays as written until this side takes it again. Rows' spans without a row of
+  // this side's are not drawn here.
+  const RowShare front{RowShare::Side::Front};
+  if (!job->shared || (rows != nullptr && !front.anyIn(rows->y0, rows->y0 + rows->rows - 1))) return;
+  if (!seen_cleared_) {
+    for (unsigned spin = 0; !cleared_->load(std::memory_order_acquire); ++spin) spinPause(spin);
+    seen_cleared_ = true;
+  }
+  part.unit->draw(SpanTriangle{part.v, part.method, setup, rows, rc, tag, rows != nullptr ? nullptr : &job->walk,
+                               rows != nullptr, front});
 }
 
 // A descriptor walked here, on the front end, for the back end to replay (Frame::replay), and
@@ -486,9 +507,12 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         // No vertices: the methods that split a frame draw from the setup alone (methods.h).
         const std::array<const PVertex*, 3> v = {nullptr, nullptr, nullptr};
         const bool ahead = traits(j->method).two_threads == TwoThreads::AfterWalk;
+        const RowShare share{j->shared ? RowShare::Side::Back : RowShare::Side::All};
+        if (j->spans && ahead && !share.anyIn(j->rows.y0, j->rows.y0 + j->rows.rows - 1)) break;  // the front end's
         f.unit(j->method).draw(SpanTriangle{v, j->method, j->spans ? nullptr : &j->setup, j->spans ? &j->rows : nullptr,
                                             j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
-                                            ahead && !j->spans ? &j->walk : nullptr, ahead && j->spans});
+                                            ahead && !j->spans ? &j->walk : nullptr, ahead && j->spans,
+                                            share});
         break;
       }
     }
@@ -498,24 +522,25 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
 
 // The frame on two threads: this one the front end (SceneDrawer with a queue), another the back
 // end (drawBackEnd with a frame of its own, on the same buffers and span engine). Every pixel
-// is written by the back end alone, in the order of one thread, after it has cleared what the
-// frame before drew (clear); each side counts in its own
+// is written by one side, the back end, or for a triangle walked ahead the side whose rows it
+// lies in (RowShare), in the order of one thread, after the back end has cleared what the frame
+// before drew (clear: the front end waits for it before it draws); each side counts in its own
 // RenderStats, summed after. The objects' specular-unit codings are made here first, so that
 // the two sides' lightObject only read the units' memo of zero codes (SpecEngine::zeroCode).
 void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
-                    const ClearRect& clear, RenderResult& res, bool& cleared) {
+                    const ClearRect& clear, RenderResult& res, std::atomic<bool>& cleared) {
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) lightObject(front, scene, engines, oi);
   BackThread& worker = BackThread::instance();
   const std::lock_guard<std::mutex> one_frame(worker.frame);
   DrawQueue& q = worker.queue;
   q.reset();
-  SceneDrawer drawer(front, scene, engines, res, &q);
+  SceneDrawer drawer(front, scene, engines, res, &q, &cleared);
   const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res.fb, drawer);
   back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   const std::function<void()> back_end = [&] {
     try {
       clearRect(res.fb, clear);  // while the front end transforms and sets up the first triangles
-      cleared = true;
+      cleared.store(true, std::memory_order_release);
       drawBackEnd(q, *back, scene, engines);
     } catch (...) {
       q.stop(std::current_exception());
@@ -543,7 +568,7 @@ void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& eng
 // leaves them, clear outside the drawn rectangle, which the next frame's clear relies on.
 void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& engines, Frame& front,
                       const ClearRect& clear, RenderResult& res) {
-  bool cleared = false;  // set by the back end; read here once it has ended, or if it never began
+  std::atomic<bool> cleared{false};  // set by the back end (the front end waits for it to draw)
   try {
     drawTwoThreads(scene, span, engines, front, clear, res, cleared);
   } catch (...) {
