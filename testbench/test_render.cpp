@@ -811,6 +811,20 @@ void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::s
   EXPECT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << what << ": the counts differ";
 }
 
+// A scene drawn with options o on one thread and on two, frame over frame: the same frames.
+// Returns the one-thread frame.
+RenderResult expectTwoThreadsEqualOne(const Scene& s, RenderOptions o, ModelEngines& one, ModelEngines& two,
+                                      const std::string& what) {
+  o.threads = 1;
+  RenderResult a = render(s, o, one.span, one.view);
+  o.threads = 2;
+  RenderResult b = render(s, o, two.span, two.view);
+  render(s, o, two.span, two.view, b);  // over the frame before
+  EXPECT_GT(a.stats.pixels_covered, 0u) << what;
+  expectSameFrames(a, b, what);
+  return a;
+}
+
 // Two threads (RenderOptions::threads, render.cpp): the same bytes and counts as one, for every
 // method that allows it, on every built-in scene (builtin:materials: several objects, each its
 // material), with the materials' own lobes and with the specular unit's quadratic lobe (at the
@@ -832,12 +846,7 @@ TEST(Render, TwoThreadsEqualOneThread) {
           RenderOptions o;
           o.method = m;
           o.brdf = brdf;
-          const RenderResult a = render(s, o, one.span, one.view);
-          o.threads = 2;
-          RenderResult b = render(s, o, two.span, two.view);
-          render(s, o, two.span, two.view, b);  // over the frame before
-          EXPECT_GT(a.stats.pixels_covered, 0u) << what;
-          expectSameFrames(a, b, what);
+          const RenderResult a = expectTwoThreadsEqualOne(s, o, one, two, what);
           if (std::string(brdf) == "quadratic") {
             EXPECT_GT(a.stats.spec_evaluations, 0u) << what;
           }
@@ -910,12 +919,7 @@ TEST(Render, TwoThreadsShareTheRowsWalkedAhead) {
       w.NormalFracBits = 20;
       w.CosFracBits = 24;
       o.phong_widths = w;
-      const RenderResult a = render(s, o, one.span, one.view);
-      o.threads = 2;
-      RenderResult b = render(s, o, two.span, two.view);
-      render(s, o, two.span, two.view, b);  // over the frame before
-      EXPECT_GT(a.stats.pixels_covered, 0u) << what;
-      expectSameFrames(a, b, what);
+      expectTwoThreadsEqualOne(s, o, one, two, what);
     }
   }
 }
