@@ -60,6 +60,8 @@ struct RowShare {
       if (mine(std::max(y0, band << kBandShift))) return true;
     return false;
   }
+  // Whether a row of a triangle's rows' spans is mine.
+  bool anyRow(const RowSpans& s) const { return anyIn(s.y0, s.y0 + s.rows - 1); }
 };
 
 // A screen triangle set up for the span unit, with the method that draws it: by setup (a span

@@ -100,6 +100,13 @@ struct SharedTransform {
   }
 };
 
+// Whether both sides of a two-thread frame draw a triangle of method m of the object o, each
+// the rows of its RowShare: a method walked ahead, and no specular-unit requests (the unit's
+// batch cycles are counted per triangle, so a device lobe's triangle is the back end's alone).
+bool rowsShared(Method m, const ObjectShading& o) {
+  return traits(m).two_threads == TwoThreads::AfterWalk && o.spec == nullptr;
+}
+
 // A screen triangle of a two-thread frame, or a mark between objects, on its way from the
 // front end (SceneDrawer on the calling thread: culling, vertex colours, clipping, setup) to the
 // back end (drawBackEnd: the method's unit walks, z-tests, shades and writes it).
@@ -112,7 +119,6 @@ struct DrawJob {
   size_t object = 0;                // BeginObject
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
   bool spans = false;               // Triangle: set up as rows' spans (else by setup)
-  bool shared = false;              // Triangle walked ahead: the front end draws its RowShare of it
   SetupResult setup;                // Triangle, unless spans
   RowSpans rows;                    // Triangle, if spans
   RecordedWalk walk;                // Triangle: the front end's walk, for a TwoThreads::AfterWalk method
@@ -262,7 +268,6 @@ class SceneDrawer {
   Parts parts_;                       // its screen triangles
   DrawQueue* const queue_;
   const std::atomic<bool>* const cleared_;
-  bool seen_cleared_ = false;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
   RowSpans rows_;                     // the same as rows' spans
 };
@@ -437,23 +442,19 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   job->tag = tag;
   job->spans = rows != nullptr;
   // A method walked ahead: its rows counted here, on this side, with the span engine's stream
-  // (as walkAhead counts), and drawn by the back end from the rows; without specular-unit
-  // requests (counted per triangle) the front end draws its share of the rows (RowShare).
+  // (as walkAhead counts), and drawn by the back end from the rows, or where rowsShared, by
+  // both sides, each its RowShare of them.
   const bool ahead = tr.two_threads == TwoThreads::AfterWalk;
   if (ahead) {
     if (rows != nullptr) f_.countRows(*rows);
     else walkAhead(*setup->desc, job->walk);
   }
-  job->shared = ahead && f_.obj.spec == nullptr;
   queue_->push();
   // The slot stays as written until this side takes it again. Rows' spans without a row of
   // this side's are not drawn here.
   const RowShare front{RowShare::Side::Front};
-  if (!job->shared || (rows != nullptr && !front.anyIn(rows->y0, rows->y0 + rows->rows - 1))) return;
-  if (!seen_cleared_) {
-    for (unsigned spin = 0; !cleared_->load(std::memory_order_acquire); ++spin) spinPause(spin);
-    seen_cleared_ = true;
-  }
+  if (!rowsShared(part.method, f_.obj) || (rows != nullptr && !front.anyRow(*rows))) return;
+  for (unsigned spin = 0; !cleared_->load(std::memory_order_acquire); ++spin) spinPause(spin);
   part.unit->draw(SpanTriangle{part.v, part.method, setup, rows, rc, tag, rows != nullptr ? nullptr : &job->walk,
                                rows != nullptr, front});
 }
@@ -507,8 +508,8 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         // No vertices: the methods that split a frame draw from the setup alone (methods.h).
         const std::array<const PVertex*, 3> v = {nullptr, nullptr, nullptr};
         const bool ahead = traits(j->method).two_threads == TwoThreads::AfterWalk;
-        const RowShare share{j->shared ? RowShare::Side::Back : RowShare::Side::All};
-        if (j->spans && ahead && !share.anyIn(j->rows.y0, j->rows.y0 + j->rows.rows - 1)) break;  // the front end's
+        const RowShare share{rowsShared(j->method, f.obj) ? RowShare::Side::Back : RowShare::Side::All};
+        if (j->spans && !share.anyRow(j->rows)) break;  // the front end's rows alone
         f.unit(j->method).draw(SpanTriangle{v, j->method, j->spans ? nullptr : &j->setup, j->spans ? &j->rows : nullptr,
                                             j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
                                             ahead && !j->spans ? &j->walk : nullptr, ahead && j->spans,
