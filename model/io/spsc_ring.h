@@ -64,14 +64,18 @@ class SpscRing {
   }
   // The writer's slot k after the current one, to prefetch (the reader may still hold it).
   const T& ahead(size_t k) const { return slots_[(head_ + k) % Slots]; }
+  // The items pushed that the reader has not yet shown done: at most Slots, at least those it
+  // still holds (it shows its progress every Batch items).
+  size_t backlog() const { return head_ - done_.load(std::memory_order_relaxed); }
   void push(bool show_now = false) {
     if (++head_ % Batch == 0 || show_now) written_.store(head_, std::memory_order_release);
   }
   // The writer's end without its last items: the reader's next() returns null.
   void abort() { aborted_.store(true, std::memory_order_release); }
 
-  // The reader: the next item (null when the writer aborted), release()d once done with.
-  const T* next() {
+  // The reader: the next item (null when the writer aborted), the reader's (to read and to
+  // write in place) until it release()s it.
+  T* next() {
     if (tail_ == written_seen_) {
       done_.store(tail_, std::memory_order_release);
       for (unsigned spin = 0; tail_ == (written_seen_ = written_.load(std::memory_order_acquire)); ++spin) {

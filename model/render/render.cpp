@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <stdexcept>
 #include <thread>
 
@@ -100,6 +101,40 @@ struct SharedTransform {
   }
 };
 
+// A screen triangle's vertices as set up: position and the renderer's 4 attributes (colour or
+// normal, and depth), in the attributes' units.
+using SetupInput = std::array<RowSpans::Vertex, 3>;
+
+// A screen triangle's setup: as its rows' spans where its method and the triangle allow
+// (raster/row_spans.h), else by the span unit's setup. The frame's configurations, of colour or
+// normal attributes; a two-thread frame's back end has a copy of the front end's.
+struct TriangleSetup {
+  RasterConfig rc_colour, rc_unit;                   // colour or normal attributes (and depth)
+  std::optional<RowSpansConfig> rs_colour, rs_unit;  // and as rows' spans (empty: not at all)
+  const RasterConfig& raster(bool colour_attrs) const { return colour_attrs ? rc_colour : rc_unit; }
+  // v of method m set up into rows (spans = true) or setup: false when dropped (no pixel centre
+  // inside). tag: the triangle's id, in setup's descriptor and its errors.
+  bool run(const SetupInput& v, Method m, bool colour_attrs, uint32_t tag, RowSpans& rows, SetupResult& setup,
+           bool& spans) const {
+    const std::optional<RowSpansConfig>& rs = colour_attrs ? rs_colour : rs_unit;
+    spans = false;
+    if (rs && traits(m).row_spans) {
+      const RowSpansSetup got = setupRowSpans(v, *rs, rows);
+      if (got == RowSpansSetup::Dropped) return false;
+      if (got == RowSpansSetup::Drawn) return spans = true;
+    }
+    std::array<SetupVertex, 3> sv;
+    for (size_t i = 0; i < 3; ++i) {
+      sv[i].x = v[i].x;
+      sv[i].y = v[i].y;
+      sv[i].attr.resizeForOverwrite(4);
+      for (size_t k = 0; k < 4; ++k) sv[i].attr[k] = v[i].attr[k];
+    }
+    setupTriangle(sv, tag, raster(colour_attrs), setup);
+    return setup.desc.has_value();
+  }
+};
+
 // Whether both sides of a two-thread frame draw a triangle of method m of the object o, each
 // the rows of its RowShare: a method walked ahead, and no specular-unit requests (the unit's
 // batch cycles are counted per triangle, so a device lobe's triangle is the back end's alone).
@@ -110,19 +145,34 @@ bool rowsShared(Method m, const ObjectShading& o) {
 // A screen triangle of a two-thread frame, or a mark between objects, on its way from the
 // front end (SceneDrawer on the calling thread: culling, vertex colours, clipping, setup) to the
 // back end (drawBackEnd: the method's unit walks, z-tests, shades and writes it).
+//
+// A triangle of a TwoThreads::AfterSetup method is recorded (its tag, RenderResult::triangles,
+// the drawn rectangle) by the back end, and may be handed to it before setup (set_up false: it
+// sets it up from `in`) while the back end is short of work (RenderOptions::hand_off_below).
+// Which side sets a triangle up changes no byte of the frame and no count: the back end counts
+// the triangles drawn, the side that set a mesh triangle up counts it if setup drops it whole.
 struct DrawJob {
   enum class Kind : uint8_t { Triangle, BeginObject, EndObject, End };
+  static constexpr uint8_t kFirstPart = 1, kLastPart = 2;
   Kind kind = Kind::End;
   Method method = Method::Gouraud;  // Triangle: of the unit that draws it
   bool colour_attrs = true;         // Triangle: set up with colour attributes (else normals)
-  uint32_t tag = 0;                 // Triangle
+  bool set_up = true;               // Triangle: set up by the front end, else handed off
+  uint8_t mesh_parts = 0;           // handed off: kFirstPart, kLastPart of its mesh triangle's parts
+  uint32_t tag = 0;                 // Triangle (AfterSetup: given by the back end)
   size_t object = 0;                // BeginObject
+  ScreenTriangleInfo info;          // Triangle, AfterSetup: for the back end to record
+  SetupInput in;                    // Triangle, handed off: what the back end sets up
   mutable SharedTransform transform;  // BeginObject: its vertices, which the back end helps with
   bool spans = false;               // Triangle: set up as rows' spans (else by setup)
   SetupResult setup;                // Triangle, unless spans
   RowSpans rows;                    // Triangle, if spans
   RecordedWalk walk;                // Triangle: the front end's walk, for a TwoThreads::AfterWalk method
 };
+
+// Thrown by a two-thread frame's front end after it has handed the back end a triangle whose
+// setup failed (SceneDrawer::queueSetUp).
+struct SetupHandedOff {};
 
 // The lines of a job's slot that setting a triangle up writes (its rows' spans where the slot's
 // last triangle had them, else the descriptor's head, planes and first lane-triangle, the
@@ -242,15 +292,15 @@ class SceneDrawer {
   SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue = nullptr,
               const std::atomic<bool>* cleared = nullptr);
   void drawObject(size_t oi);
-  const RasterConfig& rasterConfig(bool colour_attrs) const { return colour_attrs ? rc_colour_ : rc_unit_; }
+  const TriangleSetup& triangleSetup() const { return setup_config_; }
 
  private:
   void lightVertices(const std::array<uint32_t, 3>& tri);
   void walkAhead(const SpanDesc& d, RecordedWalk& w);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
-  void drawPart(const Part& part, uint32_t ti);
-  bool setUp(const Part& part, bool colour_attrs, uint32_t tag, DrawJob* job, const SetupResult*& setup,
-             const RowSpans*& rows);
+  bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
+  bool queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off);
+  SetupInput setupInput(const Part& part, bool colour_attrs) const;
 
   Frame& f_;
   const Scene& scene_;
@@ -259,8 +309,9 @@ class SceneDrawer {
   const CameraBasis basis_;
   MethodUnit& unit_;                  // the frame's method's
   const bool vertex_colours_;         // the method's
-  RasterConfig rc_colour_, rc_unit_;  // setup of colour or normal attributes (and depth)
-  std::optional<RowSpansConfig> rs_colour_, rs_unit_;  // and as rows' spans (empty: not at all)
+  // A two-thread frame of a TwoThreads::AfterSetup method: the back end records the triangles.
+  const bool back_records_;
+  TriangleSetup setup_config_;
   std::vector<PVertex>& verts_;       // the object's (the result's scratch)
   std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
   Poly poly_;                         // a clipped triangle
@@ -272,6 +323,30 @@ class SceneDrawer {
   RowSpans rows_;                     // the same as rows' spans
 };
 
+// A screen triangle that setup kept, recorded: its tag (the next index of `triangles`), where it
+// came from (object, mesh triangle ti, xy(i) its vertex i's screen position), its count, and the
+// pixels it may draw in the framebuffer's drawn rectangle.
+template <class XY>
+uint32_t recordTriangle(int object, uint32_t ti, XY xy, bool spans, std::vector<ScreenTriangleInfo>& triangles,
+                        RenderStats& st, Framebuffer& fb) {
+  const uint32_t tag = static_cast<uint32_t>(triangles.size());
+  ScreenTriangleInfo& info = triangles.emplace_back();  // filled in place: a local copied in
+  info.object = object;                                 // stalled on its own partial stores
+  info.mesh_triangle = ti;
+  for (size_t i = 0; i < 3; ++i) info.xy[i] = xy(i);
+  ++st.drawn;
+  st.row_spans += spans;
+  const auto& p = info.xy;
+  fb.markDrawn(std::min({p[0][0], p[1][0], p[2][0]}), std::min({p[0][1], p[1][1], p[2][1]}),
+               std::max({p[0][0], p[1][0], p[2][0]}), std::max({p[0][1], p[1][1], p[2][1]}));
+  return tag;
+}
+
+// Vertex i's screen position of a part (recordTriangle).
+auto partXY(const Part& part) {
+  return [&part](size_t i) { return std::array<double, 2>{part.v[i]->x, part.v[i]->y}; };
+}
+
 SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue,
                          const std::atomic<bool>* cleared)
     : f_(f),
@@ -281,6 +356,7 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       basis_(cameraBasis(scene.camera)),
       unit_(f.unit(f.opt.method)),
       vertex_colours_(traits(f.opt.method).vertex_colours),
+      back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
       verts_(res.scratch.get().verts),
       lit_(res.scratch.get().lit),
       queue_(queue),
@@ -293,16 +369,17 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
   if (rc.unit.NumAttr != 4) throw std::invalid_argument("render: the span unit must carry 4 attributes");
   rc.attr_frac_bits = {kColourFrac, kColourFrac, kColourFrac, kUnitFrac};
   rc.validate();
-  rc_colour_ = rc_unit_ = rc;
+  TriangleSetup& c = setup_config_;
+  c.rc_colour = c.rc_unit = rc;
   // The normal at phong-fixed's NormalFracBits when it runs at runtime widths; the depth as ever.
   const int normal_frac = f.opt.phong_widths ? f.opt.phong_widths->NormalFracBits : kUnitFrac;
-  rc_unit_.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
+  c.rc_unit.attr_frac_bits = {normal_frac, normal_frac, normal_frac, kUnitFrac};
   // Rows' spans need the model's walk (the RTL takes descriptors).
   if (f.opt.row_spans && f.walker != nullptr) {
-    rs_colour_.emplace(rc_colour_);
-    rs_unit_.emplace(rc_unit_);
-    if (!rs_colour_->applies) rs_colour_.reset();
-    if (!rs_unit_->applies) rs_unit_.reset();
+    c.rs_colour.emplace(c.rc_colour);
+    c.rs_unit.emplace(c.rc_unit);
+    if (!c.rs_colour->applies) c.rs_colour.reset();
+    if (!c.rs_unit->applies) c.rs_unit.reset();
   }
 }
 
@@ -369,83 +446,68 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
   unit_.parts(fan_, parts_);
-  const uint64_t drawn_before = st.drawn;
-  for (const Part& part : parts_) drawPart(part, ti);
-  if (st.drawn == drawn_before) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
+  // Handed to the back end whole, which then counts it if setup drops every part.
+  const bool hand_off = back_records_ && !parts_.empty() && queue_->backlog() < f_.opt.hand_off_below;
+  bool drawn = false;
+  for (size_t k = 0; k < parts_.size(); ++k) {
+    const uint8_t first = k == 0 ? DrawJob::kFirstPart : 0, last = k + 1 == parts_.size() ? DrawJob::kLastPart : 0;
+    drawn |= drawPart(parts_[k], ti, hand_off ? first | last : 0);
+  }
+  if (!drawn && !hand_off) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
 }
 
-// A part set up, as its rows' spans where its method and the triangle allow (raster/row_spans.h),
-// else by the span unit's setup, in the job's slot or here: false when dropped (no pixel).
-bool SceneDrawer::setUp(const Part& part, bool colour_attrs, uint32_t tag, DrawJob* job, const SetupResult*& setup,
-                        const RowSpans*& rows) {
-  auto attr = [&](const PVertex& v, size_t k) {
-    if (!colour_attrs) return k == 3 ? v.w : k == 0 ? v.n.x : k == 1 ? v.n.y : v.n.z;
-    const std::array<double, 3>& c = part.colour != nullptr ? *part.colour : v.colour;
-    return k == 3 ? v.w : std::clamp(c[k], 0.0, 255.0);
-  };
-  const std::optional<RowSpansConfig>& rs = colour_attrs ? rs_colour_ : rs_unit_;
-  if (rs && traits(part.method).row_spans) {
-    std::array<RowSpans::Vertex, 3> rv;
-    for (size_t i = 0; i < 3; ++i) {
-      rv[i].x = part.v[i]->x;
-      rv[i].y = part.v[i]->y;
-      for (size_t k = 0; k < 4; ++k) rv[i].attr[k] = attr(*part.v[i], k);
-    }
-    RowSpans& r = job != nullptr ? job->rows : rows_;
-    const RowSpansSetup got = setupRowSpans(rv, *rs, r);
-    if (got == RowSpansSetup::Dropped) return false;
-    if (got == RowSpansSetup::Drawn) {
-      rows = &r;
-      return true;
-    }
-  }
-  std::array<SetupVertex, 3> sv;
+// A part's vertices as its unit sets them up: colour (the part's own, flat's, or the vertex's,
+// clamped to 0..255) or normal, and depth.
+SetupInput SceneDrawer::setupInput(const Part& part, bool colour_attrs) const {
+  SetupInput in;
   for (size_t i = 0; i < 3; ++i) {
-    sv[i].x = part.v[i]->x;
-    sv[i].y = part.v[i]->y;
-    sv[i].attr.resizeForOverwrite(4);
-    for (size_t k = 0; k < 4; ++k) sv[i].attr[k] = attr(*part.v[i], k);
+    const PVertex& v = *part.v[i];
+    in[i].x = v.x;
+    in[i].y = v.y;
+    if (colour_attrs) {
+      const std::array<double, 3>& c = part.colour != nullptr ? *part.colour : v.colour;
+      for (size_t k = 0; k < 3; ++k) in[i].attr[k] = std::clamp(c[k], 0.0, 255.0);
+    } else {
+      in[i].attr = {v.n.x, v.n.y, v.n.z, 0};
+    }
+    in[i].attr[3] = v.w;
   }
-  SetupResult& s = job != nullptr ? job->setup : setup_;
-  setupTriangle(sv, tag, colour_attrs ? rc_colour_ : rc_unit_, s);
-  setup = &s;
-  return s.desc.has_value();
+  return in;
 }
 
-// A part set up (dropped: culled), recorded, and drawn by its unit.
-void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
+// A part set up (dropped: false), recorded, and drawn by its unit, or in a two-thread frame
+// queued for the back end (hand_off: DrawJob::mesh_parts, handed to it before setup; returns
+// true).
+bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
   const MethodTraits& tr = traits(part.method);
   const bool colour_attrs = tr.attributes == Attributes::Colour;
-  const RasterConfig& rc = colour_attrs ? rc_colour_ : rc_unit_;
-  const uint32_t tag = static_cast<uint32_t>(triangles_.size());
+  const RasterConfig& rc = setup_config_.raster(colour_attrs);
+  const SetupInput in = setupInput(part, colour_attrs);
   DrawJob* job = queue_ != nullptr ? &queue_->slot() : nullptr;
   if (job != nullptr) prefetchJobForWrite(queue_->ahead(2));
-  const SetupResult* setup = nullptr;
-  const RowSpans* rows = nullptr;
-  if (!setUp(part, colour_attrs, tag, job, setup, rows)) return;  // no pixel centre inside (drawMeshTriangle counts it culled)
-  ScreenTriangleInfo& info = triangles_.emplace_back();  // filled in place: a local copied in
-  info.object = f_.obj.index;                           // stalled on its own partial stores
-  info.mesh_triangle = ti;
-  for (size_t i = 0; i < 3; ++i) info.xy[i] = {part.v[i]->x, part.v[i]->y};
-  ++f_.st.drawn;
-  f_.st.row_spans += rows != nullptr;
-  const PVertex &v0 = *part.v[0], &v1 = *part.v[1], &v2 = *part.v[2];
-  f_.fb.markDrawn(std::min({v0.x, v1.x, v2.x}), std::min({v0.y, v1.y, v2.y}), std::max({v0.x, v1.x, v2.x}),
-                  std::max({v0.y, v1.y, v2.y}));
+  if (back_records_) return queueSetUp(part, ti, in, *job, hand_off);
+  const uint32_t tag = static_cast<uint32_t>(triangles_.size());
+  SetupResult& s = job != nullptr ? job->setup : setup_;
+  RowSpans& r = job != nullptr ? job->rows : rows_;
+  bool spans = false;
+  if (!setup_config_.run(in, part.method, colour_attrs, tag, r, s, spans)) return false;  // no pixel centre inside
+  const SetupResult* setup = spans ? nullptr : &s;
+  const RowSpans* rows = spans ? &r : nullptr;
+  recordTriangle(f_.obj.index, ti, partXY(part), spans, triangles_, f_.st, f_.fb);
   if (job == nullptr) {
     part.unit->draw(SpanTriangle{part.v, part.method, setup, rows, rc, tag});
-    return;
+    return true;
   }
   job->kind = DrawJob::Kind::Triangle;
   job->method = part.method;
   job->colour_attrs = colour_attrs;
+  job->set_up = true;
   job->tag = tag;
-  job->spans = rows != nullptr;
+  job->spans = spans;
   // A method walked ahead: its rows counted here, on this side, with the span engine's stream
   // (as walkAhead counts), and drawn by the back end from the rows, or where rowsShared, by
   // both sides, each its RowShare of them.
-  const bool ahead = tr.two_threads == TwoThreads::AfterWalk;
-  if (ahead) {
+  if (tr.two_threads == TwoThreads::AfterWalk) {
     if (rows != nullptr) f_.countRows(*rows);
     else walkAhead(*setup->desc, job->walk);
   }
@@ -453,10 +515,42 @@ void SceneDrawer::drawPart(const Part& part, uint32_t ti) {
   // The slot stays as written until this side takes it again. Rows' spans without a row of
   // this side's are not drawn here.
   const RowShare front{RowShare::Side::Front};
-  if (!rowsShared(part.method, f_.obj) || (rows != nullptr && !front.anyRow(*rows))) return;
+  if (!rowsShared(part.method, f_.obj) || (rows != nullptr && !front.anyRow(*rows))) return true;
   for (unsigned spin = 0; !cleared_->load(std::memory_order_acquire); ++spin) spinPause(spin);
   part.unit->draw(SpanTriangle{part.v, part.method, setup, rows, rc, tag, rows != nullptr ? nullptr : &job->walk,
                                rows != nullptr, front});
+  return true;
+}
+
+// A part of a TwoThreads::AfterSetup method queued for the back end, which records it: set up
+// here (false: dropped, not queued), or handed off. Setup's errors here name no tag (the back
+// end gives the tags): the part is then handed off, for the back end to fail on with its tag,
+// and SetupHandedOff thrown (drawTwoThreads).
+bool SceneDrawer::queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off) {
+  job.kind = DrawJob::Kind::Triangle;
+  job.method = part.method;
+  job.colour_attrs = traits(part.method).attributes == Attributes::Colour;
+  job.info.object = f_.obj.index;
+  job.info.mesh_triangle = ti;
+  const auto xy = partXY(part);
+  for (size_t i = 0; i < 3; ++i) job.info.xy[i] = xy(i);
+  job.set_up = hand_off == 0;
+  job.mesh_parts = hand_off;
+  if (job.set_up) {
+    try {
+      if (!setup_config_.run(in, part.method, job.colour_attrs, 0, job.rows, job.setup, job.spans)) return false;
+    } catch (const std::invalid_argument&) {
+      job.set_up = false;
+      job.mesh_parts = DrawJob::kFirstPart | DrawJob::kLastPart;
+      job.in = in;
+      queue_->push();
+      throw SetupHandedOff{};
+    }
+  } else {
+    job.in = in;
+  }
+  queue_->push();
+  return true;
 }
 
 // A descriptor walked here, on the front end, for the back end to replay (Frame::replay), and
@@ -475,14 +569,46 @@ void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w) {
   f_.count(walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull()));
 }
 
-// The back end of a two-thread frame: its own frame (its own counts) and the front end's
-// raster configurations, copied: in lines of their own, apart from what the front end writes.
+// The back end of a two-thread frame: its own frame (its own counts) and the front end's setup
+// configurations, copied: in lines of their own, apart from what the front end writes.
 struct alignas(64) BackEnd {
   RenderStats stats;
-  const RasterConfig rc_colour, rc_unit;
+  const TriangleSetup setup;
   Frame f;
-  BackEnd(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Framebuffer& fb, const SceneDrawer& front)
-      : rc_colour(front.rasterConfig(true)), rc_unit(front.rasterConfig(false)), f(scene, opt, span, fb, stats) {}
+  std::vector<ScreenTriangleInfo>& triangles;  // the result's
+  uint64_t drawn_before = 0;                   // stats.drawn before the handed-off mesh triangle
+  // A handed-off triangle set up here, not in its slot: the front end reads the slots' setup
+  // ahead (prefetchJobForWrite) while this side holds them.
+  SetupResult setup_here;
+  RowSpans rows_here;
+  BackEnd(const Scene& scene, const RenderOptions& opt, SpanEngine& span, RenderResult& res, const SceneDrawer& front)
+      : setup(front.triangleSetup()), f(scene, opt, span, res.fb, stats), triangles(res.triangles) {}
+  // A triangle to draw: its tag and its setup or rows' spans.
+  struct Drawn {
+    uint32_t tag;
+    const SetupResult* setup;
+    const RowSpans* rows;
+  };
+  // A triangle of a TwoThreads::AfterSetup method, set up here if handed off, and recorded into
+  // t: false when setup drops it.
+  bool record(DrawJob& j, Drawn& t) {
+    const uint32_t tag = static_cast<uint32_t>(triangles.size());
+    bool spans = j.spans;
+    if (!j.set_up) {
+      if (j.mesh_parts & DrawJob::kFirstPart) drawn_before = stats.drawn;
+      if (!setup.run(j.in, j.method, j.colour_attrs, tag, rows_here, setup_here, spans)) {
+        if ((j.mesh_parts & DrawJob::kLastPart) && stats.drawn == drawn_before) ++stats.culled_no_pixel;
+        return false;
+      }
+      t.setup = spans ? nullptr : &setup_here;
+      t.rows = spans ? &rows_here : nullptr;
+    } else if (!spans) {
+      j.setup.desc->tag = tag;  // set up by the front end, which knows no tag
+    }
+    t.tag = recordTriangle(j.info.object, j.info.mesh_triangle, [&j](size_t i) { return j.info.xy[i]; }, spans,
+                           triangles, stats, f.fb);
+    return true;
+  }
 };
 
 // The back end's jobs, in order, drawn by the units of its frame, until the end mark or the
@@ -490,7 +616,7 @@ struct alignas(64) BackEnd {
 void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines& engines) {
   Frame& f = b.f;
   for (;;) {
-    const DrawJob* j = q.next();
+    DrawJob* j = q.next();
     if (j == nullptr) return;
     switch (j->kind) {
       case DrawJob::Kind::End:
@@ -508,12 +634,12 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         // No vertices: the methods that split a frame draw from the setup alone (methods.h).
         const std::array<const PVertex*, 3> v = {nullptr, nullptr, nullptr};
         const bool ahead = traits(j->method).two_threads == TwoThreads::AfterWalk;
+        BackEnd::Drawn t{j->tag, j->spans ? nullptr : &j->setup, j->spans ? &j->rows : nullptr};
+        if (!ahead && !b.record(*j, t)) break;  // dropped by the back end's setup
         const RowShare share{rowsShared(j->method, f.obj) ? RowShare::Side::Back : RowShare::Side::All};
-        if (j->spans && !share.anyRow(j->rows)) break;  // the front end's rows alone
-        f.unit(j->method).draw(SpanTriangle{v, j->method, j->spans ? nullptr : &j->setup, j->spans ? &j->rows : nullptr,
-                                            j->colour_attrs ? b.rc_colour : b.rc_unit, j->tag,
-                                            ahead && !j->spans ? &j->walk : nullptr, ahead && j->spans,
-                                            share});
+        if (t.rows != nullptr && !share.anyRow(*t.rows)) break;  // the front end's rows alone
+        f.unit(j->method).draw(SpanTriangle{v, j->method, t.setup, t.rows, b.setup.raster(j->colour_attrs), t.tag,
+                                            ahead && !j->spans ? &j->walk : nullptr, ahead && j->spans, share});
         break;
       }
     }
@@ -536,7 +662,7 @@ void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& eng
   DrawQueue& q = worker.queue;
   q.reset();
   SceneDrawer drawer(front, scene, engines, res, &q, &cleared);
-  const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res.fb, drawer);
+  const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res, drawer);
   back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   const std::function<void()> back_end = [&] {
     try {
@@ -554,6 +680,15 @@ void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& eng
     q.push(true);
   } catch (const DrawQueue::ReaderStopped&) {
     // the back end's exception, below
+  } catch (const SetupHandedOff&) {
+    // The back end fails on the triangle handed off, or on one before it: its exception, below.
+    try {
+      q.slot().kind = DrawJob::Kind::End;
+      q.push(true);
+    } catch (const DrawQueue::ReaderStopped&) {
+    }
+    worker.wait();
+    if (!q.error()) throw std::logic_error("render: a setup that failed on the front end passed on the back end");
   } catch (...) {
     q.abort();
     worker.wait();
