@@ -926,49 +926,54 @@ TEST(Render, TwoThreadsShareTheRowsWalkedAhead) {
 
 // flat and gouraud on two threads, the back end setting up none, one in a while, some (the
 // default: while it is short of work) or all of the triangles (RenderOptions::hand_off_below):
-// the same frames as one thread. A setup that fails (NaN colours, of a material whose kd is
-// NaN) fails with one thread's message on either side: the back end names the triangle's tag,
-// which the front end cannot know.
+// the same frames as one thread, with the materials' lobes and with the quadratic device lobe
+// (whose vertex requests the front end counts). A setup that fails (NaN colours, of a material
+// whose kd is NaN) fails with one thread's message on either side: the back end names the
+// triangle's tag, which the front end cannot know.
 TEST(Render, TwoThreadsSetUpOnEitherSide) {
   const std::vector<size_t> shares = {0, 1, RenderOptions{}.hand_off_below, SIZE_MAX};
   for (const char* name : {"builtin:sphere", "builtin:torus", "builtin:materials"}) {
     const Scene s = loadScene(name);
     for (Method m : {Method::Flat, Method::Gouraud})
-      for (size_t below : shares) {
-        const std::string what = fmt::format("{} {} hand_off_below {}", name, toString(m), below);
-        ModelEngines one("serial"), two("serial");
-        RenderOptions o;
-        o.method = m;
-        o.brdf = "blinn";  // builtin:materials' cubic material would need the cubic unit
-        o.hand_off_below = below;
-        expectTwoThreadsEqualOne(s, o, one, two, what);
-      }
+      for (const char* brdf : {"blinn", "quadratic"})  // blinn: builtin:materials' cubic would need its unit
+        for (size_t below : shares) {
+          const std::string what = fmt::format("{} {} {} hand_off_below {}", name, toString(m), brdf, below);
+          ModelEngines one("serial"), two("serial");
+          RenderOptions o;
+          o.method = m;
+          o.brdf = brdf;
+          o.hand_off_below = below;
+          expectTwoThreadsEqualOne(s, o, one, two, what);
+        }
   }
   Scene bad = loadScene("builtin:sphere");
   bad.materials.at(0).kd = std::nan("");
   ModelEngines e("serial");
-  for (Method m : {Method::Flat, Method::Gouraud}) {
-    RenderOptions o;
-    o.method = m;
-    std::string want;
-    try {
-      render(bad, o, e.span, e.view);
-      FAIL() << toString(m) << ": rendered";
-    } catch (const std::invalid_argument& x) {
-      want = x.what();
-    }
-    EXPECT_NE(want.find("triangle 2: attribute 0 = nan"), std::string::npos) << want;  // after 2 triangles drawn
-    o.threads = 2;
-    for (size_t below : shares) {
-      o.hand_off_below = below;
+  for (Method m : {Method::Flat, Method::Gouraud})
+    for (const char* brdf : {"blinn", "quadratic"}) {
+      const std::string what = fmt::format("{} {}", toString(m), brdf);
+      RenderOptions o;
+      o.method = m;
+      o.brdf = brdf;
+      std::string want;
       try {
         render(bad, o, e.span, e.view);
-        ADD_FAILURE() << toString(m) << " hand_off_below " << below << ": rendered";
+        ADD_FAILURE() << what << ": rendered";
       } catch (const std::invalid_argument& x) {
-        EXPECT_EQ(x.what(), want) << toString(m) << " hand_off_below " << below;
+        want = x.what();
+      }
+      EXPECT_NE(want.find("triangle 2: attribute 0 = nan"), std::string::npos) << want;  // after 2 triangles drawn
+      o.threads = 2;
+      for (size_t below : shares) {
+        o.hand_off_below = below;
+        try {
+          render(bad, o, e.span, e.view);
+          ADD_FAILURE() << what << " hand_off_below " << below << ": rendered";
+        } catch (const std::invalid_argument& x) {
+          EXPECT_EQ(x.what(), want) << what << " hand_off_below " << below;
+        }
       }
     }
-  }
 }
 
 // What cannot run on two threads is refused, naming why; an error on either thread reaches the
