@@ -144,13 +144,12 @@ bool rowsShared(Method m, const ObjectShading& o) {
 
 // A screen triangle of a two-thread frame, or a mark between objects, on its way from the
 // front end (SceneDrawer on the calling thread: culling, vertex colours, clipping, setup) to the
-// back end (drawBackEnd: the method's unit walks, z-tests, shades and writes it).
-//
-// A triangle of a TwoThreads::AfterSetup method is recorded (its tag, RenderResult::triangles,
-// the drawn rectangle) by the back end, and may be handed to it before setup (set_up false: it
-// sets it up from `in`) while the back end is short of work (RenderOptions::hand_off_below).
-// Which side sets a triangle up changes no byte of the frame and no count: the back end counts
-// the triangles drawn, the side that set a mesh triangle up counts it if setup drops it whole.
+// back end (drawBackEnd: the method's unit walks, z-tests, shades and writes it). A triangle of
+// a TwoThreads::AfterSetup method is recorded (its tag, RenderResult::triangles, the drawn
+// rectangle) by the back end, and may be handed to it before setup (set_up false: it sets it up
+// from `in`) while the back end is short of work (RenderOptions::hand_off_below). Which side
+// sets a triangle up changes no byte of the frame and no count: the back end counts the
+// triangles drawn, the side that set a mesh triangle up counts it if setup drops it whole.
 struct DrawJob {
   enum class Kind : uint8_t { Triangle, BeginObject, EndObject, End };
   static constexpr uint8_t kFirstPart = 1, kLastPart = 2;
@@ -446,7 +445,8 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
   unit_.parts(fan_, parts_);
-  // Handed to the back end whole, which then counts it if setup drops every part.
+  // Every part handed to the back end before setup (it then counts the mesh triangle if setup
+  // drops them all), while fewer than hand_off_below jobs wait for it.
   const bool hand_off = back_records_ && !parts_.empty() && queue_->backlog() < f_.opt.hand_off_below;
   bool drawn = false;
   for (size_t k = 0; k < parts_.size(); ++k) {
