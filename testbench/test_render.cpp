@@ -955,23 +955,13 @@ TEST(Render, TwoThreadsSetUpOnEitherSide) {
       RenderOptions o;
       o.method = m;
       o.brdf = brdf;
-      std::string want;
-      try {
-        render(bad, o, e.span, e.view);
-        ADD_FAILURE() << what << ": rendered";
-      } catch (const std::invalid_argument& x) {
-        want = x.what();
-      }
-      EXPECT_NE(want.find("triangle 2: attribute 0 = nan"), std::string::npos) << want;  // after 2 triangles drawn
+      const auto fails = [&] { render(bad, o, e.span, e.view); };
+      const std::string want = testutil::errorOf<std::invalid_argument>(fails);
+      EXPECT_NE(want.find("triangle 2: attribute 0 = nan"), std::string::npos) << what << ": " << want;  // after 2 drawn
       o.threads = 2;
       for (size_t below : shares) {
         o.hand_off_below = below;
-        try {
-          render(bad, o, e.span, e.view);
-          ADD_FAILURE() << what << " hand_off_below " << below << ": rendered";
-        } catch (const std::invalid_argument& x) {
-          EXPECT_EQ(x.what(), want) << what << " hand_off_below " << below;
-        }
+        EXPECT_EQ(testutil::errorOf<std::invalid_argument>(fails), want) << what << " hand_off_below " << below;
       }
     }
 }

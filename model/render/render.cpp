@@ -158,7 +158,7 @@ struct DrawJob {
   bool colour_attrs = true;         // Triangle: set up with colour attributes (else normals)
   bool set_up = true;               // Triangle: set up by the front end, else handed off
   uint8_t mesh_parts = 0;           // handed off: kFirstPart, kLastPart of its mesh triangle's parts
-  uint32_t tag = 0;                 // Triangle (AfterSetup: given by the back end)
+  uint32_t tag = 0;                 // Triangle, AfterWalk (AfterSetup: the back end gives it)
   size_t object = 0;                // BeginObject
   ScreenTriangleInfo info;          // Triangle, AfterSetup: for the back end to record
   SetupInput in;                    // Triangle, handed off: what the back end sets up
@@ -484,7 +484,12 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
   const RasterConfig& rc = setup_config_.raster(colour_attrs);
   const SetupInput in = setupInput(part, colour_attrs);
   DrawJob* job = queue_ != nullptr ? &queue_->slot() : nullptr;
-  if (job != nullptr) prefetchJobForWrite(queue_->ahead(2));
+  if (job != nullptr) {
+    prefetchJobForWrite(queue_->ahead(2));
+    job->kind = DrawJob::Kind::Triangle;  // pushed only if setup keeps it
+    job->method = part.method;
+    job->colour_attrs = colour_attrs;
+  }
   if (back_records_) return queueSetUp(part, ti, in, *job, hand_off);
   const uint32_t tag = static_cast<uint32_t>(triangles_.size());
   SetupResult& s = job != nullptr ? job->setup : setup_;
@@ -498,9 +503,6 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
     part.unit->draw(SpanTriangle{part.v, part.method, setup, rows, rc, tag});
     return true;
   }
-  job->kind = DrawJob::Kind::Triangle;
-  job->method = part.method;
-  job->colour_attrs = colour_attrs;
   job->set_up = true;
   job->tag = tag;
   job->spans = spans;
@@ -527,29 +529,24 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
 // end gives the tags): the part is then handed off, for the back end to fail on with its tag,
 // and SetupHandedOff thrown (drawTwoThreads).
 bool SceneDrawer::queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off) {
-  job.kind = DrawJob::Kind::Triangle;
-  job.method = part.method;
-  job.colour_attrs = traits(part.method).attributes == Attributes::Colour;
+  bool failed = false;
+  if (hand_off == 0) {
+    try {
+      if (!setup_config_.run(in, part.method, job.colour_attrs, 0, job.rows, job.setup, job.spans)) return false;
+    } catch (const std::invalid_argument&) {
+      failed = true;
+      hand_off = DrawJob::kFirstPart | DrawJob::kLastPart;
+    }
+  }
+  job.set_up = hand_off == 0;
+  job.mesh_parts = hand_off;
+  if (!job.set_up) job.in = in;
   job.info.object = f_.obj.index;
   job.info.mesh_triangle = ti;
   const auto xy = partXY(part);
   for (size_t i = 0; i < 3; ++i) job.info.xy[i] = xy(i);
-  job.set_up = hand_off == 0;
-  job.mesh_parts = hand_off;
-  if (job.set_up) {
-    try {
-      if (!setup_config_.run(in, part.method, job.colour_attrs, 0, job.rows, job.setup, job.spans)) return false;
-    } catch (const std::invalid_argument&) {
-      job.set_up = false;
-      job.mesh_parts = DrawJob::kFirstPart | DrawJob::kLastPart;
-      job.in = in;
-      queue_->push();
-      throw SetupHandedOff{};
-    }
-  } else {
-    job.in = in;
-  }
   queue_->push();
+  if (failed) throw SetupHandedOff{};
   return true;
 }
 

@@ -174,8 +174,9 @@ struct RenderOptions {
   std::optional<PhongWidths> phong_widths;
   // 1, or 2: the frame on two threads, the same bytes and counts as on one (render.cpp): this
   // thread culls, clips and sets up the triangles (or hands some to the other before setup),
-  // another walks, shades and writes them, in order. For the methods whose traits allow it (MethodTraits::two_threads) with the model's
-  // span unit (SpanEngine::walker); otherwise std::invalid_argument.
+  // another walks, shades and writes them, in order. For the methods whose traits allow it
+  // (MethodTraits::two_threads) with the model's span unit (SpanEngine::walker); otherwise
+  // std::invalid_argument.
   int threads = 1;
   // Two threads, flat and gouraud: the back end also sets up a mesh triangle that the front end
   // culled and clipped while fewer than this many jobs wait for it (render.cpp, DrawJob); 0:
