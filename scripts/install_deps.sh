@@ -5,7 +5,7 @@
 set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config python3 python3-matplotlib
-  verilator iverilog yosys nextpnr-ice40
+  verilator iverilog yosys nextpnr-ice40 libjemalloc2
   sollya gappa clang parallel
   libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
