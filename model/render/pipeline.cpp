@@ -7,6 +7,9 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <immintrin.h>
+
+#include "render/fixed_simd.h"
 
 namespace shd {
 
@@ -93,11 +96,96 @@ inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, co
   if (v.cam.z >= cam.z_near) proj.project(v);
 }
 
+
+// Four vertices at a time in AVX2 lanes: each lane runs transformVertex's operations on one
+// vertex, the same IEEE operations in the same order (products, sums, divisions and square roots
+// correctly rounded, as the scalar ones; no FMA: target avx2 alone, and ISO C++ does not contract),
+// so every field equals transformVertex's bit for bit (test Transform.Avx2EqualsScalar).
+namespace avx2 {
+
+#define SHD_AVX2_FN __attribute__((target("avx2")))
+
+struct V3 {
+  __m256d x, y, z;
+};
+
+SHD_AVX2_FN inline __m256d dot(const Vec3& a, const V3& b) {  // Vec3 dot's order: (x + y) + z
+  return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(a.x), b.x), _mm256_mul_pd(_mm256_set1_pd(a.y), b.y)),
+                       _mm256_mul_pd(_mm256_set1_pd(a.z), b.z));
+}
+SHD_AVX2_FN inline V3 rows(const double (*m)[3], const V3& v) {  // NormalTransform's rows
+  return {dot(Vec3{m[0][0], m[0][1], m[0][2]}, v), dot(Vec3{m[1][0], m[1][1], m[1][2]}, v),
+          dot(Vec3{m[2][0], m[2][1], m[2][2]}, v)};
+}
+SHD_AVX2_FN inline V3 normalize(const V3& a) {  // vec.h's normalize: (1 / len) a, a zero vector kept
+  const __m256d len = _mm256_sqrt_pd(
+      _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(a.x, a.x), _mm256_mul_pd(a.y, a.y)), _mm256_mul_pd(a.z, a.z)));
+  const __m256d inv = _mm256_div_pd(_mm256_set1_pd(1.0), len);
+  const __m256d zero = _mm256_cmp_pd(len, _mm256_setzero_pd(), _CMP_EQ_OQ);
+  return {_mm256_blendv_pd(_mm256_mul_pd(inv, a.x), a.x, zero), _mm256_blendv_pd(_mm256_mul_pd(inv, a.y), a.y, zero),
+          _mm256_blendv_pd(_mm256_mul_pd(inv, a.z), a.z, zero)};
+}
+SHD_AVX2_FN inline V3 load(const Vec3* p) {
+  return {_mm256_set_pd(p[3].x, p[2].x, p[1].x, p[0].x), _mm256_set_pd(p[3].y, p[2].y, p[1].y, p[0].y),
+          _mm256_set_pd(p[3].z, p[2].z, p[1].z, p[0].z)};
+}
+SHD_AVX2_FN inline void store(const V3& v, double (&x)[4], double (&y)[4], double (&z)[4]) {
+  _mm256_storeu_pd(x, v.x);
+  _mm256_storeu_pd(y, v.y);
+  _mm256_storeu_pd(z, v.z);
+}
+
+SHD_AVX2_FN inline __m256d pointLessEye(const double* row, const V3& p, double eye) {  // Mat4::point's row - eye
+  return _mm256_sub_pd(_mm256_add_pd(dot(Vec3{row[0], row[1], row[2]}, p), _mm256_set1_pd(row[3])), _mm256_set1_pd(eye));
+}
+
+SHD_AVX2_FN void transform4(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+                            const NormalTransform& to_world, size_t i, PVertex* out) {
+  const double (*m)[4] = obj.transform.m;
+  const V3 p = load(&obj.mesh.positions[i]);
+  // Mat4::point: direction(p) + translation, then toCameraSpace: the basis's dots with it - eye.
+  const V3 rel{pointLessEye(m[0], p, cam.eye.x), pointLessEye(m[1], p, cam.eye.y), pointLessEye(m[2], p, cam.eye.z)};
+  const V3 c{dot(basis.right, rel), dot(basis.up, rel), dot(basis.forward, rel)};
+  // NormalTransform, then toCameraDirection and normalize.
+  V3 r = rows(to_world.c, load(&obj.mesh.normals[i]));
+  if (to_world.mirror) {
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    r = {_mm256_xor_pd(r.x, sign), _mm256_xor_pd(r.y, sign), _mm256_xor_pd(r.z, sign)};
+  }
+  const V3 w = normalize(r);
+  const V3 n = normalize(V3{dot(basis.right, w), dot(basis.up, w), dot(basis.forward, w)});
+  // Projection::project where Z >= z_near; elsewhere x, y and w stay 0.
+  const __m256d f = _mm256_set1_pd(proj.f);
+  const __m256d in = _mm256_cmp_pd(c.z, _mm256_set1_pd(cam.z_near), _CMP_GE_OQ);
+  const __m256d sx = _mm256_add_pd(_mm256_set1_pd(proj.cx), _mm256_div_pd(_mm256_mul_pd(f, c.x), c.z));
+  const __m256d sy = _mm256_sub_pd(_mm256_set1_pd(proj.cy), _mm256_div_pd(_mm256_mul_pd(f, c.y), c.z));
+  const __m256d sw = _mm256_div_pd(_mm256_set1_pd(proj.z_near), c.z);
+  double cx[4], cy[4], cz[4], nx[4], ny[4], nz[4], x[4], y[4], pw[4];
+  store(c, cx, cy, cz);
+  store(n, nx, ny, nz);
+  store(V3{_mm256_and_pd(in, sx), _mm256_and_pd(in, sy), _mm256_and_pd(in, sw)}, x, y, pw);
+  for (size_t k = 0; k < 4; ++k) {
+    PVertex& v = out[i + k];
+    v.cam = {cx[k], cy[k], cz[k]};
+    v.n = {nx[k], ny[k], nz[k]};
+    v.x = x[k];
+    v.y = y[k];
+    v.w = pw[k];
+    v.colour = {};
+  }
+}
+
+#undef SHD_AVX2_FN
+
+}  // namespace avx2
+
 }  // namespace
 
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                          PVertex* verts, size_t begin, size_t end) {
+                          PVertex* verts, size_t begin, size_t end, bool vector) {
   const NormalTransform to_world(obj.transform);
+  if (vector && fixed_simd::availableAvx2())
+    for (; begin + 4 <= end; begin += 4) avx2::transform4(obj, basis, cam, proj, to_world, begin, verts);
   for (size_t i = begin; i < end; ++i) {
     // The fields transformVertex may leave as they are reset one by one (clearing the whole
     // vertex first was a `rep stos` per vertex).

@@ -90,8 +90,10 @@ void clearRect(Framebuffer& fb, const ClearRect& r);
 // Object -> camera space and the projection of the vertices [begin, end) in front of the near
 // plane, in an array that holds them all, each one made anew (its colour left to the method,
 // render.cpp): an object's vertices, or parts of them on either thread of a two-thread frame.
+// Four at a time in AVX2 lanes where the CPU has them (fixed_simd::availableAvx2: not with
+// SHD_SCALAR) and vector holds, with the same bits as one at a time.
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                          PVertex* verts, size_t begin, size_t end);
+                          PVertex* verts, size_t begin, size_t end, bool vector = true);
 
 // Where a mesh triangle goes before it is clipped.
 struct TriangleView {

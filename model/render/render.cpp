@@ -85,6 +85,7 @@ struct SharedTransform {
   const Projection* proj = nullptr;
   PVertex* verts = nullptr;
   size_t n = 0;
+  bool vector = true;  // RenderOptions::vector_kernel
   alignas(64) std::atomic<size_t> next{0};
   alignas(64) std::atomic<size_t> done{0};
 
@@ -92,7 +93,7 @@ struct SharedTransform {
   void work() {
     for (size_t b; (b = next.fetch_add(kChunk, std::memory_order_relaxed)) < n;) {
       const size_t e = std::min(b + kChunk, n);
-      transformVertexRange(*obj, *basis, *cam, *proj, verts, b, e);
+      transformVertexRange(*obj, *basis, *cam, *proj, verts, b, e, vector);
       done.fetch_add(e - b, std::memory_order_release);
     }
   }
@@ -388,7 +389,7 @@ void SceneDrawer::drawObject(size_t oi) {
   for (const auto& u : f_.units()) u.second->beginObject();
   verts_.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
   if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size());
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.opt.vector_kernel);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -400,6 +401,7 @@ void SceneDrawer::drawObject(size_t oi) {
     t.proj = &f_.proj;
     t.verts = verts_.data();
     t.n = verts_.size();
+    t.vector = f_.opt.vector_kernel;
     t.next.store(0, std::memory_order_relaxed);
     t.done.store(0, std::memory_order_relaxed);
     queue_->push(true);  // shown to the back end at once (release)
