@@ -100,7 +100,7 @@ inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, co
 // Four vertices at a time in AVX2 lanes: each lane runs transformVertex's operations on one
 // vertex, the same IEEE operations in the same order (products, sums, divisions and square roots
 // correctly rounded, as the scalar ones; no FMA: target avx2 alone, and ISO C++ does not contract),
-// so every field equals transformVertex's bit for bit (test Transform.Avx2EqualsScalar).
+// so every field equals transformVertex's bit for bit (test RenderPipeline.VectorTransformEqualsTheScalarOne).
 namespace avx2 {
 
 #define SHD_AVX2_FN __attribute__((target("avx2")))
