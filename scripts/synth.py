@@ -124,10 +124,10 @@ library's.
 Exit status: 0 success, 1 a failed check, 2 a usage or input error, 3 yosys failed.
 """
 import argparse
-import json
-import math
 import ctypes.util
 import functools
+import json
+import math
 import os
 import re
 import shutil

@@ -6,19 +6,11 @@
 #include <stdexcept>
 
 #include "render/normalize.h"
-
-#if defined(__x86_64__) && defined(__GNUC__)
-#include <immintrin.h>
-#define SHD_HAVE_AVX512_KERNEL 1
-#define SHD_AVX512 __attribute__((target("avx512f,avx512dq,avx512cd,avx512vl,avx512bw")))
-#define SHD_AVX2 __attribute__((target("avx2")))
-// The AVX2 colour kernel: PREFETCHW too (executed as a NOP by Intel CPUs before Broadwell).
-#define SHD_AVX2_PRFCHW __attribute__((target("avx2,prfchw")))
-#endif
+#include "render/x86_targets.h"
 
 namespace shd::fixed_simd {
 
-#ifdef SHD_HAVE_AVX512_KERNEL
+#ifdef SHD_X86_KERNELS
 
 // GCC 12's AVX-512 headers pass _mm512_undefined_epi32() as the unused merge source of the
 // unmasked shift and multiply intrinsics, which -Wuninitialized reports at every use (GCC bug

@@ -7,9 +7,9 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
-#include <immintrin.h>
 
 #include "render/fixed_simd.h"
+#include "render/x86_targets.h"
 
 namespace shd {
 
@@ -96,28 +96,26 @@ inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, co
   if (v.cam.z >= cam.z_near) proj.project(v);
 }
 
-
+#ifdef SHD_X86_KERNELS
 // Four vertices at a time in AVX2 lanes: each lane runs transformVertex's operations on one
 // vertex, the same IEEE operations in the same order (products, sums, divisions and square roots
 // correctly rounded, as the scalar ones; no FMA: target avx2 alone, and ISO C++ does not contract),
 // so every field equals transformVertex's bit for bit (test RenderPipeline.VectorTransformEqualsTheScalarOne).
 namespace avx2 {
 
-#define SHD_AVX2_FN __attribute__((target("avx2")))
-
 struct V3 {
   __m256d x, y, z;
 };
 
-SHD_AVX2_FN inline __m256d dot(const Vec3& a, const V3& b) {  // Vec3 dot's order: (x + y) + z
+SHD_AVX2 inline __m256d dot(const Vec3& a, const V3& b) {  // Vec3 dot's order: (x + y) + z
   return _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(a.x), b.x), _mm256_mul_pd(_mm256_set1_pd(a.y), b.y)),
                        _mm256_mul_pd(_mm256_set1_pd(a.z), b.z));
 }
-SHD_AVX2_FN inline V3 rows(const double (*m)[3], const V3& v) {  // NormalTransform's rows
+SHD_AVX2 inline V3 rows(const double (*m)[3], const V3& v) {  // NormalTransform's rows
   return {dot(Vec3{m[0][0], m[0][1], m[0][2]}, v), dot(Vec3{m[1][0], m[1][1], m[1][2]}, v),
           dot(Vec3{m[2][0], m[2][1], m[2][2]}, v)};
 }
-SHD_AVX2_FN inline V3 normalize(const V3& a) {  // vec.h's normalize: (1 / len) a, a zero vector kept
+SHD_AVX2 inline V3 normalize(const V3& a) {  // vec.h's normalize: (1 / len) a, a zero vector kept
   const __m256d len = _mm256_sqrt_pd(
       _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(a.x, a.x), _mm256_mul_pd(a.y, a.y)), _mm256_mul_pd(a.z, a.z)));
   const __m256d inv = _mm256_div_pd(_mm256_set1_pd(1.0), len);
@@ -125,21 +123,21 @@ SHD_AVX2_FN inline V3 normalize(const V3& a) {  // vec.h's normalize: (1 / len) 
   return {_mm256_blendv_pd(_mm256_mul_pd(inv, a.x), a.x, zero), _mm256_blendv_pd(_mm256_mul_pd(inv, a.y), a.y, zero),
           _mm256_blendv_pd(_mm256_mul_pd(inv, a.z), a.z, zero)};
 }
-SHD_AVX2_FN inline V3 load(const Vec3* p) {
+SHD_AVX2 inline V3 load(const Vec3* p) {
   return {_mm256_set_pd(p[3].x, p[2].x, p[1].x, p[0].x), _mm256_set_pd(p[3].y, p[2].y, p[1].y, p[0].y),
           _mm256_set_pd(p[3].z, p[2].z, p[1].z, p[0].z)};
 }
-SHD_AVX2_FN inline void store(const V3& v, double (&x)[4], double (&y)[4], double (&z)[4]) {
+SHD_AVX2 inline void store(const V3& v, double (&x)[4], double (&y)[4], double (&z)[4]) {
   _mm256_storeu_pd(x, v.x);
   _mm256_storeu_pd(y, v.y);
   _mm256_storeu_pd(z, v.z);
 }
 
-SHD_AVX2_FN inline __m256d pointLessEye(const double* row, const V3& p, double eye) {  // Mat4::point's row - eye
+SHD_AVX2 inline __m256d pointLessEye(const double* row, const V3& p, double eye) {  // Mat4::point's row - eye
   return _mm256_sub_pd(_mm256_add_pd(dot(Vec3{row[0], row[1], row[2]}, p), _mm256_set1_pd(row[3])), _mm256_set1_pd(eye));
 }
 
-SHD_AVX2_FN void transform4(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
+SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                             const NormalTransform& to_world, size_t i, PVertex* out) {
   const double (*m)[4] = obj.transform.m;
   const V3 p = load(&obj.mesh.positions[i]);
@@ -175,17 +173,20 @@ SHD_AVX2_FN void transform4(const SceneObject& obj, const CameraBasis& basis, co
   }
 }
 
-#undef SHD_AVX2_FN
-
 }  // namespace avx2
+#endif
 
 }  // namespace
 
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                           PVertex* verts, size_t begin, size_t end, bool vector) {
   const NormalTransform to_world(obj.transform);
+#ifdef SHD_X86_KERNELS
   if (vector && fixed_simd::availableAvx2())
     for (; begin + 4 <= end; begin += 4) avx2::transform4(obj, basis, cam, proj, to_world, begin, verts);
+#else
+  (void)vector;
+#endif
   for (size_t i = begin; i < end; ++i) {
     // The fields transformVertex may leave as they are reset one by one (clearing the whole
     // vertex first was a `rep stos` per vertex).
