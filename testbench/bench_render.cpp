@@ -104,10 +104,12 @@ void BM_Setup(benchmark::State& state) {
 }
 
 // The same triangles set up straight to their rows' spans (setupRowSpans), where the renderer
-// takes them so (every one of the sphere's).
+// takes them so (every one of the sphere's); the plane in AVX2 lanes where the renderer's is
+// (SHD_SCALAR=1: the scalar plane).
 void BM_RowSpans(benchmark::State& state) {
   const SphereTriangles tris = sphereTriangles();
-  const RowSpansConfig rc(tris.rc);
+  RowSpansConfig rc(tris.rc);
+  rc.vector = fixed_simd::availableAvx2();
   std::vector<std::array<RowSpans::Vertex, 3>> v;
   for (const auto& t : tris.v) {
     std::array<RowSpans::Vertex, 3>& r = v.emplace_back();

@@ -8,6 +8,7 @@
 #include "raster/setup.h"
 #include "raster/span_walk.h"
 #include "raster/trigen.h"
+#include "render/fixed_simd.h"
 
 #include <gtest/gtest.h>
 
@@ -134,10 +135,12 @@ std::vector<std::string> singleLaneModes() {
 TEST(RowSpans, EqualSetupAndTheWalkOnGeneratorTriangles) {
   const std::vector<std::string> modes = singleLaneModes();
   ASSERT_GE(modes.size(), 8u);  // serial, evenodd, seg2, seg4, seg8, and full-rate units
-  for (const std::string& m : modes) {
+  for (size_t mi = 0; mi < modes.size(); ++mi) {
+    const std::string& m = modes[mi];
     const RasterConfig cfg = rendererConfig(m);
-    const RowSpansConfig rc(cfg);
+    RowSpansConfig rc(cfg);
     ASSERT_TRUE(rc.applies) << m;
+    rc.vector = mi % 2 == 1 && fixed_simd::availableAvx2();  // both planes, alternately
     TriangleGenerator gen(31);
     SpanStream ws, ss;
     Tally tally;
@@ -185,7 +188,8 @@ TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
   std::uniform_real_distribution<double> u(0, 1);
   for (const std::string& m : {std::string("serial"), std::string("evenodd"), std::string("seg4full")}) {
     const RasterConfig cfg = rendererConfig(m, 64, 48);
-    const RowSpansConfig rc(cfg);
+    RowSpansConfig rc(cfg);
+    rc.vector = fixed_simd::availableAvx2();  // the renderer's plane (the scalar one: the test above)
     SpanStream ws, ss;
     Tally tally;
     for (int n = 0; n < 20000; ++n) {
@@ -209,6 +213,54 @@ TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
     EXPECT_GT(tally.outcome[RowSpansSetup::Drawn], 8000) << m;
     EXPECT_GT(tally.outcome[RowSpansSetup::Dropped], 1000) << m;
   }
+}
+
+// The plane in AVX2 lanes (RowSpansConfig::vector) against the scalar one: the same outcome and
+// every field of the rows' spans, on triangles small, wide (out to the guard band) and tall (from
+// far above into the first rows: few rows, large coordinate differences), with attributes over
+// their whole range (the plane's magnitudes beyond where the vector path declines), small
+// integers (remainders of exactly half a step: the ties of round-half-even) or the renderer's.
+TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
+  if (!fixed_simd::availableAvx2()) GTEST_SKIP() << "no AVX2 (or SHD_SCALAR set)";
+  const RasterConfig cfg = rendererConfig("serial");
+  RowSpansConfig scalar(cfg), vector(cfg);
+  vector.vector = true;
+  std::mt19937_64 rng(35);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double lim[4] = {scalar.lim / scalar.scale[0], scalar.lim / scalar.scale[1], scalar.lim / scalar.scale[2],
+                         scalar.lim / scalar.scale[3]};
+  std::map<RowSpansSetup, long> outcome;
+  for (int n = 0; n < 300000; ++n) {
+    // Where: small, wide (out to the guard band on both sides) or tall (from far above into
+    // the first rows); the attributes: over their whole range, small integers, the renderer's.
+    const int where = static_cast<int>(rng() % 3), what = static_cast<int>(rng() % 3);
+    const double r = 1 + u(rng) * 30, cx = 20 + u(rng) * 470, cy = 20 + u(rng) * 470;
+    std::array<RowSpans::Vertex, 3> v;
+    for (size_t i = 0; i < 3; ++i) {
+      RowSpans::Vertex& x = v[i];
+      x.x = cx + (u(rng) * 2 - 1) * (where == 0 ? r : 8000);
+      x.y = where == 1 ? cy + (u(rng) * 2 - 1) * 30 : (where == 2 ? u(rng) * 40 : cy + (u(rng) * 2 - 1) * r);
+      if (where == 2 && i == 0) x.y = -8000 * u(rng);
+      for (size_t k = 0; k < 4; ++k) {
+        if (what == 0) x.attr[k] = (u(rng) * 2 - 1) * lim[k];
+        else if (what == 1) x.attr[k] = static_cast<double>(rng() % 7) / scalar.scale[k];
+        else x.attr[k] = (k < 3 ? u(rng) * 255 : u(rng));
+      }
+    }
+    RowSpans a, b;
+    const RowSpansSetup ga = setupRowSpans(v, scalar, a), gb = setupRowSpans(v, vector, b);
+    ++outcome[ga];
+    ASSERT_EQ(ga, gb) << "triangle " << n;
+    if (ga != RowSpansSetup::Drawn) continue;
+    ASSERT_TRUE(a.y0 == b.y0 && a.rows == b.rows && a.x0 == b.x0 && a.fragments == b.fragments && a.groups == b.groups)
+        << "triangle " << n;
+    ASSERT_EQ(a.a0, b.a0) << "triangle " << n;
+    ASSERT_EQ(a.didx, b.didx) << "triangle " << n;
+    ASSERT_EQ(a.didy, b.didy) << "triangle " << n;
+    for (int32_t i = 0; i < a.rows; ++i) ASSERT_EQ(a.span[static_cast<size_t>(i)], b.span[static_cast<size_t>(i)]);
+  }
+  EXPECT_GT(outcome[RowSpansSetup::Drawn], 100000);
+  EXPECT_GT(outcome[RowSpansSetup::General], 1000);  // the whole range: planes beyond 32 bits
 }
 
 TEST(RowSpans, DeclineWhatSetupRefusesOrTheyCannotHold) {

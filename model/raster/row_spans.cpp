@@ -5,6 +5,7 @@
 
 #include "raster/exact_int.h"
 #include "raster/span_walk.h"
+#include "render/x86_targets.h"
 
 namespace shd {
 
@@ -50,6 +51,94 @@ bool planeAt(int64_t iref, int64_t didx, int64_t didy, int64_t dx, int64_t dy, i
 }
 
 bool fits32(int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; }
+
+#ifdef SHD_X86_KERNELS
+namespace planeavx2 {
+
+// round-half-even(base + n / d) per lane, d > 0, from doubles that hold integers exactly: |n|
+// and d at most 2^51, |base| below 2^51. The correctly rounded quotient's floor is the exact
+// quotient's, m: it lies in [m, m + 1] (rounding is monotone and m, m + 1 are doubles), and it
+// reaches m + 1 only if m + 1 - n / d >= 1 / d is below half a unit in the last place of m + 1,
+// which needs (|m| + 1) d > 2^53, where here (|m| + 1) d <= |n| + d <= 2^52. So the remainder
+// n - m d is exact (|m d| <= 2^52) and in [0, d). Then roundHalfEvenFrom's rule: up when it is
+// above half of d, or half with the floor (base + m) odd.
+SHD_AVX2 inline __m256d roundDivPlus(__m256d base, __m256d n, __m256d d) {
+  const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);
+  const __m256d m = _mm256_floor_pd(_mm256_div_pd(n, d));
+  const __m256d r = _mm256_sub_pd(n, _mm256_mul_pd(m, d));
+  const __m256d q = _mm256_add_pd(m, base);
+  const __m256d rest = _mm256_sub_pd(d, r);
+  const __m256d h = _mm256_floor_pd(_mm256_mul_pd(q, half));
+  const __m256d odd = _mm256_cmp_pd(_mm256_sub_pd(q, _mm256_add_pd(h, h)), zero, _CMP_NEQ_OQ);
+  const __m256d up = _mm256_or_pd(_mm256_cmp_pd(r, rest, _CMP_GT_OQ),
+                                  _mm256_and_pd(_mm256_cmp_pd(r, rest, _CMP_EQ_OQ), odd));
+  return _mm256_add_pd(q, _mm256_and_pd(up, one));
+}
+
+SHD_AVX2 inline __m256d lanes(const std::array<std::array<int64_t, 3>, 4>& a, size_t i) {
+  return _mm256_setr_pd(static_cast<double>(a[0][i]), static_cast<double>(a[1][i]), static_cast<double>(a[2][i]),
+                        static_cast<double>(a[3][i]));
+}
+
+SHD_AVX2 inline __m256d cv(int64_t v) { return _mm256_set1_pd(static_cast<double>(v)); }
+
+// All four lanes within [lo, hi].
+SHD_AVX2 inline bool within(__m256d v, __m256d lo, __m256d hi) {
+  const __m256d in = _mm256_and_pd(_mm256_cmp_pd(v, lo, _CMP_GE_OQ), _mm256_cmp_pd(v, hi, _CMP_LE_OQ));
+  return _mm256_movemask_pd(in) == 0xF;
+}
+
+// The plane step of setupRowSpans for the 4 attributes at once, one per lane of doubles; false
+// (o untouched) unless every quantity stays where doubles hold it exactly and the plane fits,
+// the caller's scalar code then deciding. Where it returns true, o's a0, didx and didy are the
+// scalar code's: the same integers, exactly.
+//   - The codes |a| < 2^31 (RowSpansConfig::lim), so |a1 - a0| < 2^32; the coordinate
+//     differences are checked below 2^20, so the four products are below 2^52 and nx, ny exact.
+//   - sx = nx 2^S and sy (exact: a power of two), each product of num checked below 2^50 (fl of
+//     a product below 2^50 means the product is, and then fl is exact), and det below 2^50:
+//     the divisions' operands at most 2^51 (roundDivPlus above).
+//   - didx, didy checked within int32_t, as the scalar code does; then the corner values are
+//     below 2^48, exact, and checked within int32_t, and so is a0, a value at a covered pixel.
+SHD_AVX2 bool plane(const std::array<std::array<int64_t, 3>, 4>& a, int64_t dx1, int64_t dy1, int64_t dx2,
+                    int64_t dy2, int64_t dcx, int64_t dcy, int S, int64_t det, int64_t bx, int64_t by, int64_t across,
+                    int64_t down, int64_t dx0, RowSpans& o) {
+  constexpr int64_t kCoord = int64_t{1} << 20;
+  if (std::max({std::abs(dx1), std::abs(dy1), std::abs(dx2), std::abs(dy2)}) >= kCoord) return false;
+  constexpr double k50 = 1125899906842624.0;  // 2^50
+  if (static_cast<double>(det) >= k50) return false;
+  const __m256d a0 = lanes(a, 0), da1 = _mm256_sub_pd(lanes(a, 1), a0), da2 = _mm256_sub_pd(lanes(a, 2), a0);
+  const __m256d nx = _mm256_sub_pd(_mm256_mul_pd(da1, cv(dy2)), _mm256_mul_pd(da2, cv(dy1)));
+  const __m256d ny = _mm256_sub_pd(_mm256_mul_pd(cv(dx1), da2), _mm256_mul_pd(cv(dx2), da1));
+  const __m256d sign = _mm256_set1_pd(-0.0);
+  const __m256d bound = _mm256_set1_pd(k50);
+  const __m256d px = _mm256_mul_pd(_mm256_andnot_pd(sign, nx), cv(std::abs(dcx)));
+  const __m256d py = _mm256_mul_pd(_mm256_andnot_pd(sign, ny), cv(std::abs(dcy)));
+  const __m256d scale = cv(int64_t{1} << S);
+  const __m256d sx = _mm256_mul_pd(nx, scale), sy = _mm256_mul_pd(ny, scale);
+  const __m256d neg = _mm256_sub_pd(_mm256_setzero_pd(), bound);
+  if (!within(px, neg, bound) || !within(py, neg, bound) || !within(sx, neg, bound) || !within(sy, neg, bound))
+    return false;
+  const __m256d num = _mm256_add_pd(_mm256_mul_pd(nx, cv(dcx)), _mm256_mul_pd(ny, cv(dcy)));
+  const __m256d zero = _mm256_setzero_pd(), d = cv(det);
+  const __m256d didx = roundDivPlus(zero, sx, d), didy = roundDivPlus(zero, sy, d);
+  const __m256d iref = roundDivPlus(a0, num, _mm256_add_pd(d, d));
+  const __m256d lo32 = _mm256_set1_pd(-2147483648.0), hi32 = _mm256_set1_pd(2147483647.0);
+  if (!within(didx, lo32, hi32) || !within(didy, lo32, hi32)) return false;
+  const __m256d corner = _mm256_add_pd(_mm256_add_pd(iref, _mm256_mul_pd(didx, cv(bx))), _mm256_mul_pd(didy, cv(by)));
+  const __m256d right = _mm256_add_pd(corner, _mm256_mul_pd(didx, cv(across)));
+  const __m256d below = _mm256_mul_pd(didy, cv(down));
+  if (!within(corner, lo32, hi32) || !within(right, lo32, hi32) || !within(_mm256_add_pd(corner, below), lo32, hi32) ||
+      !within(_mm256_add_pd(right, below), lo32, hi32))
+    return false;
+  const __m256d first = _mm256_add_pd(corner, _mm256_mul_pd(didx, cv(dx0)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(o.a0.data()), _mm256_cvtepi32_epi64(_mm256_cvtpd_epi32(first)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(o.didx.data()), _mm256_cvtepi32_epi64(_mm256_cvtpd_epi32(didx)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(o.didy.data()), _mm256_cvtepi32_epi64(_mm256_cvtpd_epi32(didy)));
+  return true;
+}
+
+}  // namespace planeavx2
+#endif
 
 }  // namespace
 
@@ -162,6 +251,11 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
   const int64_t dcx = ((2 * xref + 1) << S) - xu[0], dcy = ((2 * yref + 1) << S) - yu[0];
   const int64_t dx1 = X[1] - X[0], dy1 = Y[1] - Y[0], dx2 = X[2] - X[0], dy2 = Y[2] - Y[0];
+#ifdef SHD_X86_KERNELS
+  if (c.vector && planeavx2::plane(a, dx1, dy1, dx2, dy2, dcx, dcy, S, det, xmin - xref, o.y0 - yref, xmax - xmin,
+                                   o.rows - 1, o.x0 - xmin, o))
+    return RowSpansSetup::Drawn;
+#endif
   for (size_t k = 0; k < 4; ++k) {
     int64_t sx = 0, sy = 0, num = 0;
     if (!planeNumerators64(a[k], dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) return RowSpansSetup::General;

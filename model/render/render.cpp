@@ -24,6 +24,7 @@
 
 #include "io/spsc_ring.h"
 #include "render/draw.h"
+#include "render/fixed_simd.h"
 #include "render/methods.h"
 #include "render/pipeline.h"
 
@@ -380,6 +381,9 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
     c.rs_unit.emplace(c.rc_unit);
     if (!c.rs_colour->applies) c.rs_colour.reset();
     if (!c.rs_unit->applies) c.rs_unit.reset();
+    const bool vector = f.opt.vector_kernel && fixed_simd::availableAvx2();
+    if (c.rs_colour) c.rs_colour->vector = vector;
+    if (c.rs_unit) c.rs_unit->vector = vector;
   }
 }
 
