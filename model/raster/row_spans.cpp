@@ -75,9 +75,26 @@ SHD_AVX2 inline __m256d roundDivPlus(__m256d base, __m256d n, __m256d d) {
   return _mm256_add_pd(q, _mm256_and_pd(up, one));
 }
 
-SHD_AVX2 inline __m256d lanes(const std::array<std::array<int64_t, 3>, 4>& a, size_t i) {
-  return _mm256_setr_pd(static_cast<double>(a[0][i]), static_cast<double>(a[1][i]), static_cast<double>(a[2][i]),
-                        static_cast<double>(a[3][i]));
+// Snapped attribute codes, a vertex's four in a row (Codes) or as doubles (CodesF: exact, the
+// codes being below 2^31).
+using Codes = std::array<std::array<int64_t, 4>, 3>;
+using CodesF = std::array<std::array<double, 4>, 3>;
+
+// The vertices' attribute codes as snapSmall snaps them, a vertex's four in the lanes, into f and
+// i; false when one is beyond setup's bound |a 2^frac| <= lim (or NaN), as the scalar check.
+SHD_AVX2 bool snapCodes(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, CodesF& f, Codes& i) {
+  const __m256d scale = _mm256_loadu_pd(c.scale.data()), lim = _mm256_set1_pd(c.lim);
+  const __m256d magic = _mm256_set1_pd(6755399441055744.0), sign = _mm256_set1_pd(-0.0);  // 1.5 2^52
+  const __m256i magic_bits = _mm256_castpd_si256(magic);
+  __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  for (size_t j = 0; j < 3; ++j) {
+    const __m256d x = _mm256_mul_pd(_mm256_loadu_pd(v[j].attr.data()), scale);
+    ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_andnot_pd(sign, x), lim, _CMP_LE_OQ));
+    const __m256d y = _mm256_add_pd(x, magic);
+    _mm256_storeu_pd(f[j].data(), _mm256_sub_pd(y, magic));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(i[j].data()), _mm256_sub_epi64(_mm256_castpd_si256(y), magic_bits));
+  }
+  return _mm256_movemask_pd(ok) == 0xF;
 }
 
 SHD_AVX2 inline __m256d cv(int64_t v) { return _mm256_set1_pd(static_cast<double>(v)); }
@@ -99,14 +116,15 @@ SHD_AVX2 inline bool within(__m256d v, __m256d lo, __m256d hi) {
 //     the divisions' operands at most 2^51 (roundDivPlus above).
 //   - didx, didy checked within int32_t, as the scalar code does; then the corner values are
 //     below 2^48, exact, and checked within int32_t, and so is a0, a value at a covered pixel.
-SHD_AVX2 bool plane(const std::array<std::array<int64_t, 3>, 4>& a, int64_t dx1, int64_t dy1, int64_t dx2,
+SHD_AVX2 bool plane(const CodesF& a, int64_t dx1, int64_t dy1, int64_t dx2,
                     int64_t dy2, int64_t dcx, int64_t dcy, int S, int64_t det, int64_t bx, int64_t by, int64_t across,
                     int64_t down, int64_t dx0, RowSpans& o) {
   constexpr int64_t kCoord = int64_t{1} << 20;
   if (std::max({std::abs(dx1), std::abs(dy1), std::abs(dx2), std::abs(dy2)}) >= kCoord) return false;
   constexpr double k50 = 1125899906842624.0;  // 2^50
   if (static_cast<double>(det) >= k50) return false;
-  const __m256d a0 = lanes(a, 0), da1 = _mm256_sub_pd(lanes(a, 1), a0), da2 = _mm256_sub_pd(lanes(a, 2), a0);
+  const __m256d a0 = _mm256_loadu_pd(a[0].data());
+  const __m256d da1 = _mm256_sub_pd(_mm256_loadu_pd(a[1].data()), a0), da2 = _mm256_sub_pd(_mm256_loadu_pd(a[2].data()), a0);
   const __m256d nx = _mm256_sub_pd(_mm256_mul_pd(da1, cv(dy2)), _mm256_mul_pd(da2, cv(dy1)));
   const __m256d ny = _mm256_sub_pd(_mm256_mul_pd(cv(dx1), da2), _mm256_mul_pd(cv(dx2), da1));
   const __m256d sign = _mm256_set1_pd(-0.0);
@@ -148,26 +166,41 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   // Within these bounds |x 2^S| < 2^29 and |a 2^frac| < 2^31: snapSmall's range. The checks
   // are summed into one test, the rare refusal being the one branch.
   std::array<int64_t, 3> X, Y;
-  std::array<std::array<int64_t, 3>, 4> a;
+  std::array<std::array<int64_t, 4>, 3> a;  // vertex i's attribute codes a[i][k]
+#ifdef SHD_X86_KERNELS
+  const bool vector = c.vector;
+#else
+  const bool vector = false;
+#endif
   bool ok = true;
   const double pixel_scale = static_cast<double>(int64_t{1} << S);
   for (size_t i = 0; i < 3; ++i) {
     ok &= std::fabs(v[i].x) <= c.guard;
     ok &= std::fabs(v[i].y) <= c.guard;
-    for (size_t k = 0; k < 4; ++k) ok &= std::fabs(v[i].attr[k] * c.scale[k]) <= c.lim;
   }
+#ifdef SHD_X86_KERNELS
+  std::array<std::array<double, 4>, 3> af;  // the same as doubles, for the AVX2 plane
+  if (vector) ok &= planeavx2::snapCodes(v, c, af, a);
+#endif
+  if (!vector)
+    for (size_t i = 0; i < 3; ++i)
+      for (size_t k = 0; k < 4; ++k) ok &= std::fabs(v[i].attr[k] * c.scale[k]) <= c.lim;
   if (!ok) return RowSpansSetup::General;
   for (size_t i = 0; i < 3; ++i) {
     X[i] = snapSmall(v[i].x * pixel_scale);
     Y[i] = snapSmall(v[i].y * pixel_scale);
-    for (size_t k = 0; k < 4; ++k) a[k][i] = snapSmall(v[i].attr[k] * c.scale[k]);
+    if (!vector)
+      for (size_t k = 0; k < 4; ++k) a[i][k] = snapSmall(v[i].attr[k] * c.scale[k]);
   }
   int64_t det = (X[1] - X[0]) * (Y[2] - Y[0]) - (X[2] - X[0]) * (Y[1] - Y[0]);
   if (det == 0) return RowSpansSetup::Dropped;  // zero area
   if (det < 0) {
     std::swap(X[1], X[2]);
     std::swap(Y[1], Y[2]);
-    for (auto& ak : a) std::swap(ak[1], ak[2]);
+    std::swap(a[1], a[2]);
+#ifdef SHD_X86_KERNELS
+    if (vector) std::swap(af[1], af[2]);
+#endif
     det = -det;
   }
   // The edge functions (setup's screenGeom), u = 2^-(S+1) px.
@@ -252,17 +285,18 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   const int64_t dcx = ((2 * xref + 1) << S) - xu[0], dcy = ((2 * yref + 1) << S) - yu[0];
   const int64_t dx1 = X[1] - X[0], dy1 = Y[1] - Y[0], dx2 = X[2] - X[0], dy2 = Y[2] - Y[0];
 #ifdef SHD_X86_KERNELS
-  if (c.vector && planeavx2::plane(a, dx1, dy1, dx2, dy2, dcx, dcy, S, det, xmin - xref, o.y0 - yref, xmax - xmin,
+  if (vector && planeavx2::plane(af, dx1, dy1, dx2, dy2, dcx, dcy, S, det, xmin - xref, o.y0 - yref, xmax - xmin,
                                    o.rows - 1, o.x0 - xmin, o))
     return RowSpansSetup::Drawn;
 #endif
   for (size_t k = 0; k < 4; ++k) {
     int64_t sx = 0, sy = 0, num = 0;
-    if (!planeNumerators64(a[k], dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) return RowSpansSetup::General;
+    const std::array<int64_t, 3> ak = {a[0][k], a[1][k], a[2][k]};
+    if (!planeNumerators64(ak, dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) return RowSpansSetup::General;
     // A constant attribute (flat's colour) has the numerators 0: no division (what it would give).
-    const bool constant = a[k][0] == a[k][1] && a[k][0] == a[k][2];
+    const bool constant = ak[0] == ak[1] && ak[0] == ak[2];
     const int64_t didx = constant ? 0 : roundDivPlus(0, sx, det), didy = constant ? 0 : roundDivPlus(0, sy, det);
-    const int64_t iref = constant ? a[k][0] : roundDivPlus(a[k][0], num, 2 * det);
+    const int64_t iref = constant ? ak[0] : roundDivPlus(ak[0], num, 2 * det);
     int64_t corner = 0;
     if (!fits32(didx) || !fits32(didy) || !planeAt(iref, didx, didy, xmin - xref, o.y0 - yref, corner))
       return RowSpansSetup::General;
