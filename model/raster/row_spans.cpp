@@ -114,11 +114,13 @@ SHD_AVX2 inline bool within(__m256d v, __m256d lo, __m256d hi) {
 //   - sx = nx 2^S and sy (exact: a power of two), each product of num checked below 2^50 (fl of
 //     a product below 2^50 means the product is, and then fl is exact), and det below 2^50:
 //     the divisions' operands at most 2^51 (roundDivPlus above).
-//   - didx, didy checked within int32_t, as the scalar code does; then the corner values are
-//     below 2^48, exact, and checked within int32_t, and so is a0, a value at a covered pixel.
-SHD_AVX2 bool plane(const CodesF& a, int64_t dx1, int64_t dy1, int64_t dx2,
-                    int64_t dy2, int64_t dcx, int64_t dcy, int S, int64_t det, int64_t bx, int64_t by, int64_t across,
-                    int64_t down, int64_t dx0, RowSpans& o) {
+//   - didx, didy checked within int32_t, as the scalar code does; then the corner values
+//     (|iref| <= 2^50 + 2^31, the box's sides below 2^15) are below 2^51, exact, and checked
+//     within int32_t, and so is a0, a value at a covered pixel.
+//   bx, by: the box's corner from the reference pixel; across, down: its sides; dx0: the first
+//   pixel from its left side.
+SHD_AVX2 bool plane(const CodesF& a, int64_t dx1, int64_t dy1, int64_t dx2, int64_t dy2, int64_t dcx, int64_t dcy,
+                    int S, int64_t det, int64_t bx, int64_t by, int64_t across, int64_t down, int64_t dx0, RowSpans& o) {
   constexpr int64_t kCoord = int64_t{1} << 20;
   if (std::max({std::abs(dx1), std::abs(dy1), std::abs(dx2), std::abs(dy2)}) >= kCoord) return false;
   constexpr double k50 = 1125899906842624.0;  // 2^50
