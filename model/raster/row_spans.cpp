@@ -52,6 +52,40 @@ bool planeAt(int64_t iref, int64_t didx, int64_t didy, int64_t dx, int64_t dy, i
 
 bool fits32(int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; }
 
+// What the plane needs of a triangle set up to its rows: the vertices' differences (subpixels),
+// the reference pixel's centre from vertex 0 (u units), the determinant, and the pixels'
+// bounding box: its corner from the reference pixel, its sides, the first pixel from its left.
+struct PlaneGeom {
+  int64_t dx1, dy1, dx2, dy2, dcx, dcy;
+  int S;
+  int64_t det, bx, by, across, down, dx0;
+};
+
+// The plane (setup's setPlane, its 64-bit path), and its values at the corners of the pixels'
+// bounding box within int32_t (then at every pixel: the plane is affine), into o's a0, didx
+// and didy; false where it does not fit (a[i][k]: vertex i's code of attribute k).
+bool planeScalar(const std::array<std::array<int64_t, 4>, 3>& a, const PlaneGeom& g, RowSpans& o) {
+  for (size_t k = 0; k < 4; ++k) {
+    int64_t sx = 0, sy = 0, num = 0;
+    const std::array<int64_t, 3> ak = {a[0][k], a[1][k], a[2][k]};
+    if (!planeNumerators64(ak, g.dx1, g.dy1, g.dx2, g.dy2, g.dcx, g.dcy, g.S, sx, sy, num)) return false;
+    // A constant attribute (flat's colour) has the numerators 0: no division (what it would give).
+    const bool constant = ak[0] == ak[1] && ak[0] == ak[2];
+    const int64_t didx = constant ? 0 : roundDivPlus(0, sx, g.det), didy = constant ? 0 : roundDivPlus(0, sy, g.det);
+    const int64_t iref = constant ? ak[0] : roundDivPlus(ak[0], num, 2 * g.det);
+    int64_t corner = 0;
+    if (!fits32(didx) || !fits32(didy) || !planeAt(iref, didx, didy, g.bx, g.by, corner)) return false;
+    // |didx|, |didy| < 2^31 and the box's sides below 2^15: exact in int64_t from its corner.
+    const int64_t across = didx * g.across, down = didy * g.down;
+    if (!fits32(corner) || !fits32(corner + across) || !fits32(corner + down) || !fits32(corner + across + down))
+      return false;
+    o.a0[k] = corner + didx * g.dx0;
+    o.didx[k] = didx;
+    o.didy[k] = didy;
+  }
+  return true;
+}
+
 #ifdef SHD_X86_KERNELS
 namespace planeavx2 {
 
@@ -105,10 +139,9 @@ SHD_AVX2 inline bool within(__m256d v, __m256d lo, __m256d hi) {
   return _mm256_movemask_pd(in) == 0xF;
 }
 
-// The plane step of setupRowSpans for the 4 attributes at once, one per lane of doubles; false
-// (o untouched) unless every quantity stays where doubles hold it exactly and the plane fits,
-// the caller's scalar code then deciding. Where it returns true, o's a0, didx and didy are the
-// scalar code's: the same integers, exactly.
+// planeScalar for the 4 attributes at once, one per lane of doubles; false (o untouched) unless
+// every quantity stays where doubles hold it exactly and the plane fits, planeScalar then
+// deciding. Where it returns true, o's a0, didx and didy are planeScalar's: the same integers.
 //   - The codes |a| < 2^31 (RowSpansConfig::lim), so |a1 - a0| < 2^32; the coordinate
 //     differences are checked below 2^20, so the four products are below 2^52 and nx, ny exact.
 //   - sx = nx 2^S and sy (exact: a power of two), each product of num checked below 2^50 (fl of
@@ -117,40 +150,37 @@ SHD_AVX2 inline bool within(__m256d v, __m256d lo, __m256d hi) {
 //   - didx, didy checked within int32_t, as the scalar code does; then the corner values
 //     (|iref| <= 2^50 + 2^31, the box's sides below 2^15) are below 2^51, exact, and checked
 //     within int32_t, and so is a0, a value at a covered pixel.
-//   bx, by: the box's corner from the reference pixel; across, down: its sides; dx0: the first
-//   pixel from its left side.
-SHD_AVX2 bool plane(const CodesF& a, int64_t dx1, int64_t dy1, int64_t dx2, int64_t dy2, int64_t dcx, int64_t dcy,
-                    int S, int64_t det, int64_t bx, int64_t by, int64_t across, int64_t down, int64_t dx0, RowSpans& o) {
+SHD_AVX2 bool plane(const CodesF& a, const PlaneGeom& g, RowSpans& o) {
   constexpr int64_t kCoord = int64_t{1} << 20;
-  if (std::max({std::abs(dx1), std::abs(dy1), std::abs(dx2), std::abs(dy2)}) >= kCoord) return false;
+  if (std::max({std::abs(g.dx1), std::abs(g.dy1), std::abs(g.dx2), std::abs(g.dy2)}) >= kCoord) return false;
   constexpr double k50 = 1125899906842624.0;  // 2^50
-  if (static_cast<double>(det) >= k50) return false;
+  if (static_cast<double>(g.det) >= k50) return false;
   const __m256d a0 = _mm256_loadu_pd(a[0].data());
   const __m256d da1 = _mm256_sub_pd(_mm256_loadu_pd(a[1].data()), a0), da2 = _mm256_sub_pd(_mm256_loadu_pd(a[2].data()), a0);
-  const __m256d nx = _mm256_sub_pd(_mm256_mul_pd(da1, cv(dy2)), _mm256_mul_pd(da2, cv(dy1)));
-  const __m256d ny = _mm256_sub_pd(_mm256_mul_pd(cv(dx1), da2), _mm256_mul_pd(cv(dx2), da1));
+  const __m256d nx = _mm256_sub_pd(_mm256_mul_pd(da1, cv(g.dy2)), _mm256_mul_pd(da2, cv(g.dy1)));
+  const __m256d ny = _mm256_sub_pd(_mm256_mul_pd(cv(g.dx1), da2), _mm256_mul_pd(cv(g.dx2), da1));
   const __m256d sign = _mm256_set1_pd(-0.0);
   const __m256d bound = _mm256_set1_pd(k50);
-  const __m256d px = _mm256_mul_pd(_mm256_andnot_pd(sign, nx), cv(std::abs(dcx)));
-  const __m256d py = _mm256_mul_pd(_mm256_andnot_pd(sign, ny), cv(std::abs(dcy)));
-  const __m256d scale = cv(int64_t{1} << S);
+  const __m256d px = _mm256_mul_pd(_mm256_andnot_pd(sign, nx), cv(std::abs(g.dcx)));
+  const __m256d py = _mm256_mul_pd(_mm256_andnot_pd(sign, ny), cv(std::abs(g.dcy)));
+  const __m256d scale = cv(int64_t{1} << g.S);
   const __m256d sx = _mm256_mul_pd(nx, scale), sy = _mm256_mul_pd(ny, scale);
   const __m256d neg = _mm256_sub_pd(_mm256_setzero_pd(), bound);
   if (!within(px, neg, bound) || !within(py, neg, bound) || !within(sx, neg, bound) || !within(sy, neg, bound))
     return false;
-  const __m256d num = _mm256_add_pd(_mm256_mul_pd(nx, cv(dcx)), _mm256_mul_pd(ny, cv(dcy)));
-  const __m256d zero = _mm256_setzero_pd(), d = cv(det);
+  const __m256d num = _mm256_add_pd(_mm256_mul_pd(nx, cv(g.dcx)), _mm256_mul_pd(ny, cv(g.dcy)));
+  const __m256d zero = _mm256_setzero_pd(), d = cv(g.det);
   const __m256d didx = roundDivPlus(zero, sx, d), didy = roundDivPlus(zero, sy, d);
   const __m256d iref = roundDivPlus(a0, num, _mm256_add_pd(d, d));
   const __m256d lo32 = _mm256_set1_pd(-2147483648.0), hi32 = _mm256_set1_pd(2147483647.0);
   if (!within(didx, lo32, hi32) || !within(didy, lo32, hi32)) return false;
-  const __m256d corner = _mm256_add_pd(_mm256_add_pd(iref, _mm256_mul_pd(didx, cv(bx))), _mm256_mul_pd(didy, cv(by)));
-  const __m256d right = _mm256_add_pd(corner, _mm256_mul_pd(didx, cv(across)));
-  const __m256d below = _mm256_mul_pd(didy, cv(down));
+  const __m256d corner = _mm256_add_pd(_mm256_add_pd(iref, _mm256_mul_pd(didx, cv(g.bx))), _mm256_mul_pd(didy, cv(g.by)));
+  const __m256d right = _mm256_add_pd(corner, _mm256_mul_pd(didx, cv(g.across)));
+  const __m256d below = _mm256_mul_pd(didy, cv(g.down));
   if (!within(corner, lo32, hi32) || !within(right, lo32, hi32) || !within(_mm256_add_pd(corner, below), lo32, hi32) ||
       !within(_mm256_add_pd(right, below), lo32, hi32))
     return false;
-  const __m256d first = _mm256_add_pd(corner, _mm256_mul_pd(didx, cv(dx0)));
+  const __m256d first = _mm256_add_pd(corner, _mm256_mul_pd(didx, cv(g.dx0)));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(o.a0.data()), _mm256_cvtepi32_epi64(_mm256_cvtpd_epi32(first)));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(o.didx.data()), _mm256_cvtepi32_epi64(_mm256_cvtpd_epi32(didx)));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(o.didy.data()), _mm256_cvtepi32_epi64(_mm256_cvtpd_epi32(didy)));
@@ -280,36 +310,16 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   o.x0 = o.span[0][0];
   o.fragments = static_cast<uint32_t>(fragments);
   o.groups = static_cast<uint32_t>(groups);
-  // The plane (setup's setPlane, its 64-bit path), and its values at the corners of the pixels'
-  // bounding box within int32_t (then at every pixel: the plane is affine).
+  // The plane, from the reference pixel (setup's setPlane).
   const int64_t xref = std::clamp<int64_t>(std::min({X[0], X[1], X[2]}) >> S, 0, c.W - 1);
   const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
-  const int64_t dcx = ((2 * xref + 1) << S) - xu[0], dcy = ((2 * yref + 1) << S) - yu[0];
-  const int64_t dx1 = X[1] - X[0], dy1 = Y[1] - Y[0], dx2 = X[2] - X[0], dy2 = Y[2] - Y[0];
+  const PlaneGeom g{X[1] - X[0], Y[1] - Y[0], X[2] - X[0], Y[2] - Y[0], ((2 * xref + 1) << S) - xu[0],
+                    ((2 * yref + 1) << S) - yu[0], S, det, xmin - xref, o.y0 - yref, xmax - xmin, o.rows - 1,
+                    o.x0 - xmin};
 #ifdef SHD_X86_KERNELS
-  if (vector && planeavx2::plane(af, dx1, dy1, dx2, dy2, dcx, dcy, S, det, xmin - xref, o.y0 - yref, xmax - xmin,
-                                   o.rows - 1, o.x0 - xmin, o))
-    return RowSpansSetup::Drawn;
+  if (vector && planeavx2::plane(af, g, o)) return RowSpansSetup::Drawn;
 #endif
-  for (size_t k = 0; k < 4; ++k) {
-    int64_t sx = 0, sy = 0, num = 0;
-    const std::array<int64_t, 3> ak = {a[0][k], a[1][k], a[2][k]};
-    if (!planeNumerators64(ak, dx1, dy1, dx2, dy2, dcx, dcy, S, sx, sy, num)) return RowSpansSetup::General;
-    // A constant attribute (flat's colour) has the numerators 0: no division (what it would give).
-    const bool constant = ak[0] == ak[1] && ak[0] == ak[2];
-    const int64_t didx = constant ? 0 : roundDivPlus(0, sx, det), didy = constant ? 0 : roundDivPlus(0, sy, det);
-    const int64_t iref = constant ? ak[0] : roundDivPlus(ak[0], num, 2 * det);
-    int64_t corner = 0;
-    if (!fits32(didx) || !fits32(didy) || !planeAt(iref, didx, didy, xmin - xref, o.y0 - yref, corner))
-      return RowSpansSetup::General;
-    // |didx|, |didy| < 2^31 and the box's sides below 2^15: exact in int64_t from its corner.
-    const int64_t across = didx * (xmax - xmin), down = didy * (o.rows - 1);
-    if (!fits32(corner) || !fits32(corner + across) || !fits32(corner + down) || !fits32(corner + across + down))
-      return RowSpansSetup::General;
-    o.a0[k] = corner + didx * (o.x0 - xmin);
-    o.didx[k] = didx;
-    o.didy[k] = didy;
-  }
+  if (!planeScalar(a, g, o)) return RowSpansSetup::General;
   return RowSpansSetup::Drawn;
 }
 
