@@ -120,8 +120,8 @@ std::string encodePng(const std::string& path, const Image& img) {
   // Fast: no row filters, zlib level 3 (libpng's simplified API). A report writes hundreds of
   // images, and libpng's default (adaptive filters, level 6) made zlib and libpng 37 % of
   // `shadesim report` on builtin:plane (perf); with this flag the report took 0.69-0.76 of the
-  // time (2 interleaved rounds), its output 25.2 MB instead of 18.3. Still lossless: the pixels read
-  // back are the same.
+  // time (2 interleaved rounds), its output 25.2 MB instead of 18.3. Still lossless: the pixels
+  // read back are the same.
   png.flags = PNG_IMAGE_FLAG_FAST;
 
   // One pass into a buffer of the documented worst-case size (uncompressed data plus zlib and

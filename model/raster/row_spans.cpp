@@ -52,6 +52,11 @@ bool planeAt(int64_t iref, int64_t didx, int64_t didy, int64_t dx, int64_t dy, i
 
 bool fits32(int64_t v) { return v >= INT32_MIN && v <= INT32_MAX; }
 
+// A triangle's attribute codes, vertex i's code of attribute k at [i][k]: as integers (the scalar
+// plane) or as doubles (the AVX2 one; exact, the codes being below 2^31).
+using Codes = std::array<std::array<int64_t, 4>, 3>;
+using CodesF = std::array<std::array<double, 4>, 3>;
+
 // What the plane needs of a triangle set up to its rows: the vertices' differences (subpixels),
 // the reference pixel's centre from vertex 0 (u units), the determinant, and the pixels'
 // bounding box: its corner from the reference pixel, its sides, the first pixel from its left.
@@ -63,8 +68,8 @@ struct PlaneGeom {
 
 // The plane (setup's setPlane, its 64-bit path), and its values at the corners of the pixels'
 // bounding box within int32_t (then at every pixel: the plane is affine), into o's a0, didx
-// and didy; false where it does not fit (a[i][k]: vertex i's code of attribute k).
-bool planeScalar(const std::array<std::array<int64_t, 4>, 3>& a, const PlaneGeom& g, RowSpans& o) {
+// and didy; false where it does not fit.
+bool planeScalar(const Codes& a, const PlaneGeom& g, RowSpans& o) {
   for (size_t k = 0; k < 4; ++k) {
     int64_t sx = 0, sy = 0, num = 0;
     const std::array<int64_t, 3> ak = {a[0][k], a[1][k], a[2][k]};
@@ -109,24 +114,16 @@ SHD_AVX2 inline __m256d roundDivPlus(__m256d base, __m256d n, __m256d d) {
   return _mm256_add_pd(q, _mm256_and_pd(up, one));
 }
 
-// Snapped attribute codes, a vertex's four in a row (Codes) or as doubles (CodesF: exact, the
-// codes being below 2^31).
-using Codes = std::array<std::array<int64_t, 4>, 3>;
-using CodesF = std::array<std::array<double, 4>, 3>;
-
-// The vertices' attribute codes as snapSmall snaps them, a vertex's four in the lanes, into f and
-// i; false when one is beyond setup's bound |a 2^frac| <= lim (or NaN), as the scalar check.
-SHD_AVX2 bool snapCodes(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, CodesF& f, Codes& i) {
+// The vertices' attribute codes as snapSmall snaps them, a vertex's four in the lanes, into f;
+// false when one is beyond setup's bound |a 2^frac| <= lim (or NaN), as the scalar check.
+SHD_AVX2 bool snapCodes(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, CodesF& f) {
   const __m256d scale = _mm256_loadu_pd(c.scale.data()), lim = _mm256_set1_pd(c.lim);
   const __m256d magic = _mm256_set1_pd(6755399441055744.0), sign = _mm256_set1_pd(-0.0);  // 1.5 2^52
-  const __m256i magic_bits = _mm256_castpd_si256(magic);
   __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
   for (size_t j = 0; j < 3; ++j) {
     const __m256d x = _mm256_mul_pd(_mm256_loadu_pd(v[j].attr.data()), scale);
     ok = _mm256_and_pd(ok, _mm256_cmp_pd(_mm256_andnot_pd(sign, x), lim, _CMP_LE_OQ));
-    const __m256d y = _mm256_add_pd(x, magic);
-    _mm256_storeu_pd(f[j].data(), _mm256_sub_pd(y, magic));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(i[j].data()), _mm256_sub_epi64(_mm256_castpd_si256(y), magic_bits));
+    _mm256_storeu_pd(f[j].data(), _mm256_sub_pd(_mm256_add_pd(x, magic), magic));
   }
   return _mm256_movemask_pd(ok) == 0xF;
 }
@@ -198,7 +195,8 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   // Within these bounds |x 2^S| < 2^29 and |a 2^frac| < 2^31: snapSmall's range. The checks
   // are summed into one test, the rare refusal being the one branch.
   std::array<int64_t, 3> X, Y;
-  std::array<std::array<int64_t, 4>, 3> a;  // vertex i's attribute codes a[i][k]
+  Codes a;   // the attribute codes: of the scalar plane
+  CodesF af;  // of the AVX2 plane (vector)
 #ifdef SHD_X86_KERNELS
   const bool vector = c.vector;
 #else
@@ -211,8 +209,7 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     ok &= std::fabs(v[i].y) <= c.guard;
   }
 #ifdef SHD_X86_KERNELS
-  std::array<std::array<double, 4>, 3> af;  // the same as doubles, for the AVX2 plane
-  if (vector) ok &= planeavx2::snapCodes(v, c, af, a);
+  if (vector) ok &= planeavx2::snapCodes(v, c, af);
 #endif
   if (!vector)
     for (size_t i = 0; i < 3; ++i)
@@ -229,10 +226,8 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   if (det < 0) {
     std::swap(X[1], X[2]);
     std::swap(Y[1], Y[2]);
-    std::swap(a[1], a[2]);
-#ifdef SHD_X86_KERNELS
     if (vector) std::swap(af[1], af[2]);
-#endif
+    else std::swap(a[1], a[2]);
     det = -det;
   }
   // The edge functions (setup's screenGeom), u = 2^-(S+1) px.
@@ -317,7 +312,11 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
                     ((2 * yref + 1) << S) - yu[0], S, det, xmin - xref, o.y0 - yref, xmax - xmin, o.rows - 1,
                     o.x0 - xmin};
 #ifdef SHD_X86_KERNELS
-  if (vector && planeavx2::plane(af, g, o)) return RowSpansSetup::Drawn;
+  if (vector) {
+    if (planeavx2::plane(af, g, o)) return RowSpansSetup::Drawn;
+    for (size_t i = 0; i < 3; ++i)
+      for (size_t k = 0; k < 4; ++k) a[i][k] = static_cast<int64_t>(af[i][k]);  // exact: below 2^31
+  }
 #endif
   if (!planeScalar(a, g, o)) return RowSpansSetup::General;
   return RowSpansSetup::Drawn;

@@ -69,7 +69,7 @@ struct RowSpansConfig {
   std::array<double, 4> scale{};     // 2^frac
   double lim = 0;                    // setup's bound of |attribute 2^frac|
   // The plane of the 4 attributes in AVX2 lanes, where the magnitudes allow (the same integers;
-  // the renderer sets it where the CPU has AVX2 and RenderOptions::vector_kernel holds).
+  // set only where the CPU has AVX2: the renderer's Frame::avx2).
   bool vector = false;
   explicit RowSpansConfig(const RasterConfig& cfg);
 };

@@ -17,7 +17,8 @@ Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Fra
       walker(span.walker()),
       vector_runs(opt.vector_kernel && fixed_simd::available() && walker != nullptr && walker->AttrBits <= 32),
       colour_kernel(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::colourKernel()
-                                                                                      : nullptr) {}
+                                                                                      : nullptr),
+      avx2(opt.vector_kernel && fixed_simd::availableAvx2()) {}
 
 Frame::~Frame() = default;
 

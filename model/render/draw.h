@@ -237,6 +237,9 @@ class Frame {
   // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
   // (fixed_simd::colourKernel); null: the scalar loop.
   const fixed_simd::ColourKernel colour_kernel;
+  // The AVX2 paths of setup: the vertex transform (transformVertexRange) and the rows' spans'
+  // plane (RowSpansConfig::vector), where the CPU has AVX2 and opt.vector_kernel holds.
+  const bool avx2;
   ObjectShading obj;
 
   // The unit drawing method m, made on first use (render/methods.cpp); the units in use.

@@ -24,7 +24,6 @@
 
 #include "io/spsc_ring.h"
 #include "render/draw.h"
-#include "render/fixed_simd.h"
 #include "render/methods.h"
 #include "render/pipeline.h"
 
@@ -86,7 +85,7 @@ struct SharedTransform {
   const Projection* proj = nullptr;
   PVertex* verts = nullptr;
   size_t n = 0;
-  bool vector = true;  // RenderOptions::vector_kernel
+  bool vector = true;  // Frame::avx2
   alignas(64) std::atomic<size_t> next{0};
   alignas(64) std::atomic<size_t> done{0};
 
@@ -381,9 +380,8 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
     c.rs_unit.emplace(c.rc_unit);
     if (!c.rs_colour->applies) c.rs_colour.reset();
     if (!c.rs_unit->applies) c.rs_unit.reset();
-    const bool vector = f.opt.vector_kernel && fixed_simd::availableAvx2();
-    if (c.rs_colour) c.rs_colour->vector = vector;
-    if (c.rs_unit) c.rs_unit->vector = vector;
+    if (c.rs_colour) c.rs_colour->vector = f.avx2;
+    if (c.rs_unit) c.rs_unit->vector = f.avx2;
   }
 }
 
@@ -393,7 +391,7 @@ void SceneDrawer::drawObject(size_t oi) {
   for (const auto& u : f_.units()) u.second->beginObject();
   verts_.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
   if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.opt.vector_kernel);
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -405,7 +403,7 @@ void SceneDrawer::drawObject(size_t oi) {
     t.proj = &f_.proj;
     t.verts = verts_.data();
     t.n = verts_.size();
-    t.vector = f_.opt.vector_kernel;
+    t.vector = f_.avx2;
     t.next.store(0, std::memory_order_relaxed);
     t.done.store(0, std::memory_order_relaxed);
     queue_->push(true);  // shown to the back end at once (release)
