@@ -1,6 +1,7 @@
 #include "render/fixed_simd.h"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
@@ -377,6 +378,29 @@ SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8
   return covered;
 }
 
+// A row's codes (z, c0, c1, c2) are adjacent: one 16-byte store of the lanes (attributes 3, 0, 1, 2).
+static_assert(offsetof(ColourRuns::Row, c) == offsetof(ColourRuns::Row, z) + 4, "z, c[0], c[1], c[2] adjacent");
+SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
+  auto lanes = [](const std::array<int64_t, 4>& v) {
+    return _mm_setr_epi32(static_cast<int32_t>(v[3]), static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1]),
+                          static_cast<int32_t>(v[2]));
+  };
+  const __m128i dx = lanes(s.didx), dy = lanes(s.didy);
+  __m128i left = lanes(s.a0);  // the codes at column x0 of row y0 + i (mod 2^32)
+  size_t n = 0, p = static_cast<size_t>(s.y0) * W;
+  for (int32_t i = 0; i < s.rows; ++i, p += W, left = _mm_add_epi32(left, dy)) {
+    const int32_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo > hi) continue;
+    ColourRuns::Row& row = r.rows[n++];
+    row.p = p + static_cast<size_t>(lo);
+    row.count = static_cast<size_t>(hi - lo + 1);
+    row.room = W - static_cast<size_t>(lo);
+    const __m128i at = _mm_add_epi32(left, _mm_mullo_epi32(dx, _mm_set1_epi32(lo - s.x0)));
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(&row) + offsetof(ColourRuns::Row, z)), at);
+  }
+  r.n = n;
+}
+
 ColourKernel colourKernel() {
   return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
 }
@@ -401,6 +425,9 @@ uint64_t colourRunsAvx512(const ColourRuns&, const Target&, uint8_t*, uint64_t&)
 }
 uint64_t colourRunsAvx2(const ColourRuns&, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourRunsAvx2: built without the vector kernels");
+}
+void spanRows(const RowSpans&, size_t, ColourRuns&) {
+  throw std::logic_error("fixed_simd::spanRows: built without the vector kernels");
 }
 ColourKernel colourKernel() { return nullptr; }
 

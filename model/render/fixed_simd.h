@@ -19,6 +19,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "raster/row_spans.h"
+
 namespace shd::fixed_simd {
 
 // The CPU runs the vector kernel (AVX-512 F, DQ, CD, VL and BW), and SHD_SCALAR is not set in the
@@ -104,6 +106,13 @@ struct ColourRuns {
   size_t n = 0;  // rows[0 .. n - 1]
   std::array<Row, kCap> rows;
 };
+
+// The runs of a triangle's rows' spans (raster/row_spans.h) into r.rows, one per row with a
+// pixel, top to bottom (W: pixels per framebuffer row), with the codes at its first pixel
+// (RowSpans::at mod 2^32, in 32-bit lanes: the same bits) and r.n their number; r's steps are
+// the caller's. For a CPU with AVX2 (every one with AVX-512 has it): where colourKernel() is
+// not null.
+void spanRows(const RowSpans& s, size_t W, ColourRuns& r);
 
 // The runs' z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
 // and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch], run after run.

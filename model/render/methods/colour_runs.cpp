@@ -133,26 +133,16 @@ struct ColourRunLoop {
 };
 
 // A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
-// walk: a run per row with a pixel, its codes at its first pixel from the plane, the steps the
-// triangle's gradients (as the walk's runs; a run of one pixel reads none).
+// walk: a run per row with a pixel, its codes at its first pixel from the plane
+// (fixed_simd::spanRows), the steps the triangle's gradients (as the walk's runs; a run of one
+// pixel reads none).
 static_assert(RowSpans::kMaxRows <= fixed_simd::ColourRuns::kCap, "a triangle's rows in one call");
 void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs, const fixed_simd::Target& target) {
   const RowSpans& s = *t.rows;
   if (!t.counted) f.countRows(s);
   for (size_t k = 0; k < 3; ++k) runs.dc[k] = static_cast<int32_t>(s.didx[k]);
   runs.dz = static_cast<uint32_t>(s.didx[3]);
-  size_t n = 0;
-  for (int32_t i = 0; i < s.rows; ++i) {
-    const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
-    if (lo > hi) continue;
-    fixed_simd::ColourRuns::Row& row = runs.rows[n++];
-    row.p = static_cast<size_t>(s.y0 + i) * static_cast<size_t>(f.W) + static_cast<size_t>(lo);
-    row.count = static_cast<size_t>(hi - lo + 1);
-    row.room = static_cast<size_t>(f.W - lo);
-    row.z = static_cast<uint32_t>(s.at(3, lo, i));
-    for (size_t k = 0; k < 3; ++k) row.c[k] = static_cast<int32_t>(s.at(k, lo, i));
-  }
-  runs.n = n;
+  fixed_simd::spanRows(s, static_cast<size_t>(f.W), runs);
   uint64_t passed = 0;
   f.st.pixels_covered += f.colour_kernel(runs, target, f.fb.rgb.data(), passed);
   f.st.depth_rejected += s.fragments - passed;
