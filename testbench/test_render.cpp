@@ -863,6 +863,58 @@ void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::s
   EXPECT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << what << ": the counts differ";
 }
 
+// The triangle buffer left out (RenderOptions::tags false) changes nothing else: for every
+// method, on one thread and on two where it allows, the same colours, depths, exact buffers,
+// triangle list and counts as with it, and no triangle buffer. With it, a pixel has a triangle
+// exactly where its depth is above 0 (Framebuffer::covered reads the depth), and those pixels
+// are the frame's pixels_covered. Frames with and without it over each other into the same
+// buffers equal the frames drawn afresh.
+TEST(Render, TagsLeftOutChangeNothingElse) {
+  const SpecUnitConfig cubic_config = specConfig("cubic");
+  ModelSpecEngine cubic(buildPromTable(PromRequest::fromContent(cubic_config.prom), cubic_config.rtl));
+  int compared = 0;
+  for (const char* name : {"builtin:sphere", "builtin:materials"}) {
+    const Scene s = loadScene(name);
+    for (Method m : allMethods()) {
+      for (int threads : {1, 2}) {
+        if (threads == 2 && traits(m).two_threads == TwoThreads::No) continue;
+        const std::string what = fmt::format("{} {} on {} thread(s)", name, toString(m), threads);
+        ModelEngines e("serial");
+        e.view.cubic = &cubic;  // builtin:materials has a cubic material
+        RenderOptions o;
+        o.method = m;
+        o.threads = threads;
+        const RenderResult with = render(s, o, e.span, e.view);
+        ASSERT_EQ(with.fb.tri.size(), with.fb.depth.size()) << what;
+        uint64_t covered = 0;
+        for (size_t p = 0; p < with.fb.depth.size(); ++p) {
+          ASSERT_EQ(with.fb.depth[p] > 0, with.fb.tri[p] >= 0) << what << " pixel " << p;
+          covered += with.fb.depth[p] > 0 ? 1 : 0;
+        }
+        EXPECT_EQ(covered, with.stats.pixels_covered) << what;
+        EXPECT_GT(covered, 0u) << what;
+        o.tags = false;
+        RenderResult over = with;  // its buffers, tags and all, then a frame without tags over them
+        const RenderResult without = render(s, o, e.span, e.view);
+        render(s, o, e.span, e.view, over);
+        for (const RenderResult* r : {&without, static_cast<const RenderResult*>(&over)}) {
+          EXPECT_TRUE(r->fb.tri.empty()) << what;
+          RenderResult as_with = *r;
+          as_with.fb.tri = with.fb.tri;
+          expectSameFrames(with, as_with, what);
+          EXPECT_EQ(r->fb.lsb, with.fb.lsb) << what;
+          EXPECT_EQ(r->fb.spec_lsb, with.fb.spec_lsb) << what;
+        }
+        o.tags = true;  // and a frame with tags over the one without
+        render(s, o, e.span, e.view, over);
+        expectSameFrames(with, over, what);
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GE(compared, 2 * static_cast<int>(allMethods().size()));
+}
+
 // A scene drawn with options o on one thread and on two, frame over frame: the same frames.
 // Returns the one-thread frame.
 RenderResult expectTwoThreadsEqualOne(const Scene& s, RenderOptions o, ModelEngines& one, ModelEngines& two,

@@ -124,13 +124,13 @@ class MethodUnit {
 struct PixelWriter {
   uint8_t* rgb;
   int32_t* depth;
-  int32_t* tri_of;
+  int32_t* tri_of;  // null: no triangle buffer (RenderOptions::tags)
   int32_t tag;
   uint64_t operator()(size_t p, int64_t w, const std::array<uint8_t, 3>& c) const {
     for (size_t k = 0; k < 3; ++k) rgb[p * 3 + k] = c[k];
     const uint64_t fresh = depth[p] == 0 ? 1 : 0;
     depth[p] = static_cast<int32_t>(w);
-    tri_of[p] = tag;
+    if (tri_of != nullptr) tri_of[p] = tag;
     return fresh;
   }
 };
@@ -251,8 +251,10 @@ class Frame {
   std::array<double, 3> shadeNow(Vec3 n, Vec3 p);
   // Fragment writes of a triangle.
   PixelWriter writer(uint32_t tag) const {
-    return PixelWriter{fb.rgb.data(), fb.depth.data(), fb.tri.data(), static_cast<int32_t>(tag)};
+    return PixelWriter{fb.rgb.data(), fb.depth.data(), tags(), static_cast<int32_t>(tag)};
   }
+  // The triangle buffer, null where the frame has none (RenderOptions::tags).
+  int32_t* tags() const { return fb.tri.empty() ? nullptr : fb.tri.data(); }
   // Whether a triangle's per-pixel device requests of method m wait for the triangle's batch
   // (the specular unit is not the model: the RTL's stream).
   bool batchesRequests(Method m) const;

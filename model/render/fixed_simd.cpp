@@ -213,13 +213,14 @@ SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_
   return packRgb(px);
 }
 
-// The z-test of the 8 fragments at depth + 0 .. 7 (those below `left`), fragment i with the
+// The z-test of the 8 fragments at pixels p + 0 .. 7 (those below `left`), fragment i with the
 // depth code zk + dz_lanes[i]: against the buffer's, and where they pass the codes and the tag
-// written (tri: the tag buffer at the same pixel). Returns the passing lanes; adds to fresh
-// those whose depth was 0. The accesses are 8 lanes wide (32 bytes): wider ones, even with
-// their lanes masked off, would overlap the next step's and stall its load behind this store.
-SHD_AVX512 inline __mmask8 zTest8(const Target& t, int32_t* depth, int32_t* tri, size_t left, uint32_t zk,
-                                  __m256i dz_lanes, uint64_t& fresh) {
+// written (where t has a tag buffer). Returns the passing lanes; adds to fresh those whose
+// depth was 0. The accesses are 8 lanes wide (32 bytes): wider ones, even with their lanes
+// masked off, would overlap the next step's and stall its load behind this store.
+SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, uint32_t zk, __m256i dz_lanes,
+                                  uint64_t& fresh) {
+  int32_t* const depth = t.depth + p;
   const __mmask8 valid = static_cast<__mmask8>((1u << std::min<size_t>(8, left)) - 1);
   const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), dz_lanes);
   // The row after next, most likely this triangle's: its depth in the cache by then.
@@ -229,7 +230,7 @@ SHD_AVX512 inline __mmask8 zTest8(const Target& t, int32_t* depth, int32_t* tri,
   const __mmask8 pass = _mm256_mask_cmpgt_epi32_mask(valid, z, old);
   fresh += static_cast<uint64_t>(__builtin_popcount(_mm256_mask_cmpeq_epi32_mask(pass, old, _mm256_setzero_si256())));
   _mm256_mask_storeu_epi32(depth, pass, z);
-  _mm256_mask_storeu_epi32(tri, pass, _mm256_set1_epi32(t.tag));
+  if (t.tri != nullptr) _mm256_mask_storeu_epi32(t.tri + p, pass, _mm256_set1_epi32(t.tag));
   return pass;
 }
 
@@ -262,8 +263,8 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   size_t n = b.n, k = first;
   uint64_t covered = 0;
   for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
-    const __mmask8 pass = zTest8(t, t.depth + r.px.p + k, t.tri + r.px.p + k, r.px.count - k,
-                                 r.px.z + static_cast<uint32_t>(k) * r.px.dz, dz_lanes, covered);
+    const __mmask8 pass =
+        zTest8(t, r.px.p + k, r.px.count - k, r.px.z + static_cast<uint32_t>(k) * r.px.dz, dz_lanes, covered);
     // Fragments k .. k + 7 in 64-bit lanes (k < 2^32).
     const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
     const __m512i sq =
@@ -306,15 +307,17 @@ SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, ui
       __builtin_prefetch(depth + 2 * t.width);
       __builtin_prefetch(depth + 2 * t.width + 7);
       // The tags and the colours there are read and written below: fetched for writing.
-      __builtin_prefetch(t.tri + row.p + k + 2 * t.width, 1);
-      __builtin_prefetch(t.tri + row.p + k + 2 * t.width + 7, 1);
+      if (t.tri != nullptr) {
+        __builtin_prefetch(t.tri + row.p + k + 2 * t.width, 1);
+        __builtin_prefetch(t.tri + row.p + k + 2 * t.width + 7, 1);
+      }
       __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width), 1);
       __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width) + 31, 1);
       // The 8 pixels lie in the run's row: plain loads, and stores of the blend (the pixels
       // that do not pass written back as read). Masked stores (vpmaskmovd) are slow on AMD
       // (docs/performance.md); they remain for a group at the row's right end.
       const bool in_row = k + 8 <= row.room;
-      int32_t* const tri = t.tri + row.p + k;
+      int32_t* const tri = t.tri != nullptr ? t.tri + row.p + k : nullptr;
       const __m256i old = in_row ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(depth))
                                  : _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
       const __m256i pass_v = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
@@ -325,11 +328,13 @@ SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, ui
         covered += static_cast<uint64_t>(__builtin_popcount(pass & fresh));
         if (in_row) {
           _mm256_storeu_si256(reinterpret_cast<__m256i*>(depth), _mm256_blendv_epi8(old, z, pass_v));
-          const __m256i tri_old = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(tri));
-          _mm256_storeu_si256(reinterpret_cast<__m256i*>(tri), _mm256_blendv_epi8(tri_old, tag, pass_v));
+          if (tri != nullptr) {
+            const __m256i tri_old = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(tri));
+            _mm256_storeu_si256(reinterpret_cast<__m256i*>(tri), _mm256_blendv_epi8(tri_old, tag, pass_v));
+          }
         } else {
           _mm256_maskstore_epi32(depth, pass_v, z);
-          _mm256_maskstore_epi32(tri, pass_v, tag);
+          if (tri != nullptr) _mm256_maskstore_epi32(tri, pass_v, tag);
         }
         // The 8 pixels' 24 bytes, in order.
         alignas(32) uint8_t bytes[32];
@@ -362,7 +367,7 @@ SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8
     const ColourRuns::Row& row = r.rows[i];
     GroupCodes g(row);
     for (size_t k = 0; k < row.count; k += 8, g.next(r)) {
-      const __mmask8 pass = zTest8(t, t.depth + row.p + k, t.tri + row.p + k, row.count - k, g.zk, l.dz, covered);
+      const __mmask8 pass = zTest8(t, row.p + k, row.count - k, g.zk, l.dz, covered);
       pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
       if (pass != 0) {
         const __m256i bytes = colourBytes8(l, g.ck);

@@ -83,7 +83,7 @@ struct Run {
 // span unit's AttrBits <= 32), as the caller checks.
 struct Target {
   int32_t* depth = nullptr;
-  int32_t* tri = nullptr;
+  int32_t* tri = nullptr;  // null: no triangle buffer to write (RenderOptions::tags)
   int32_t tag = 0;
   size_t width = 0;  // pixels per row: the row after next is prefetched
 };

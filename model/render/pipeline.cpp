@@ -43,9 +43,9 @@ void Framebuffer::markDrawn(double xmin, double ymin, double xmax, double ymax) 
   drawn_y1 = std::max(drawn_y1, hi(ymax, height));
 }
 
-ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact) {
+ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact, bool tags) {
   const size_t n = static_cast<size_t>(W) * H, n_lsb = exact ? 3 * n : 0;
-  const bool same = fb.width == W && fb.height == H && fb.rgb.size() == 3 * n && fb.tri.size() == n &&
+  const bool same = fb.width == W && fb.height == H && fb.rgb.size() == 3 * n && fb.tri.size() == (tags ? n : 0) &&
                     fb.depth.size() == n && fb.lsb.size() == n_lsb && fb.spec_lsb.size() == n_lsb;
   const ClearRect r{fb.drawn_x0, fb.drawn_y0, fb.drawn_x1, fb.drawn_y1, exact};
   fb.drawn_x0 = fb.drawn_y0 = INT_MAX;  // nothing drawn
@@ -57,8 +57,8 @@ ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact) {
   fb.height = H;
   // Depth last: every fragment reads it, so it is the buffer to find in the cache.
   fb.rgb.assign(static_cast<size_t>(W) * H * 3, 0);
-  fb.tri.resize(static_cast<size_t>(W) * H);  // all -1: every byte 0xFF (memset, where assign fills a loop)
-  std::memset(fb.tri.data(), 0xFF, fb.tri.size() * sizeof(int32_t));
+  fb.tri.resize(tags ? n : 0);  // all -1: every byte 0xFF (memset, where assign fills a loop)
+  if (tags) std::memset(fb.tri.data(), 0xFF, n * sizeof(int32_t));
   fb.depth.assign(static_cast<size_t>(W) * H, 0);
   if (exact) {
     fb.lsb.assign(static_cast<size_t>(W) * H * 3, 0.0);
@@ -76,7 +76,7 @@ void clearRect(Framebuffer& fb, const ClearRect& r) {
   for (int y = r.y0; w > 0 && y <= r.y1; ++y) {
     const size_t p = static_cast<size_t>(y) * W + static_cast<size_t>(r.x0);
     std::memset(fb.rgb.data() + 3 * p, 0, 3 * w);
-    std::memset(fb.tri.data() + p, 0xFF, w * sizeof(int32_t));
+    if (!fb.tri.empty()) std::memset(fb.tri.data() + p, 0xFF, w * sizeof(int32_t));
     std::memset(fb.depth.data() + p, 0, w * sizeof(int32_t));
     if (r.exact) {
       std::fill_n(fb.lsb.data() + 3 * p, 3 * w, 0.0);

@@ -818,7 +818,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
                                             twoThreadMethods()));
   if (opt.threads == 2 && span.walker() == nullptr)
     throw std::invalid_argument("render: two threads need the model's span unit, not the RTL's");
-  const ClearRect clear = prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact);
+  const ClearRect clear =
+      prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact, opt.tags);
   Frame frame(scene, opt, span, res.fb, res.stats);
   span.beginFrame();
   if (opt.threads == 1) {

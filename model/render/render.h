@@ -168,6 +168,11 @@ struct RenderOptions {
   // and the model's span unit allow; false: setup and the walk for every triangle (the same
   // images and counts: test Render.RowSpansEqualTheSpanWalk compares them).
   bool row_spans = true;
+  // The triangle buffer (Framebuffer::tri: which screen triangle wrote each pixel), for a report
+  // that names the triangle at a pixel (the RTL-in-the-loop check); false: left empty, neither
+  // written nor cleared, which spares a frame a third of its buffer traffic (the same image,
+  // depths and counts: test Render.TagsLeftOutChangeNothingElse).
+  bool tags = true;
   // phong-fixed only (std::invalid_argument with another method or invalid widths): absent, the
   // fixed datapath of render/fixed_shading.h with its run and vector kernels; present, the same
   // datapath at these widths, fragment by fragment (render/fixed_widths.h), the span unit
@@ -224,10 +229,12 @@ struct Framebuffer {
   int width = 0, height = 0;
   std::vector<uint8_t> rgb;    // unorm8, row-major, top row first
   std::vector<int32_t> depth;  // w code (28 fraction bits, <= 2^28) of the visible fragment, 0: none
-  std::vector<int32_t> tri;    // id of the screen triangle that wrote the pixel, -1 none
+  std::vector<int32_t> tri;    // id of the screen triangle that wrote the pixel, -1 none; empty
+                               // when the frame was drawn without RenderOptions::tags
   std::vector<double> lsb;     // reference only: the exact colour in LSBs (3 per pixel)
   std::vector<double> spec_lsb;  // reference only: the specular part (highlight masks)
-  bool covered(int x, int y) const { return tri[static_cast<size_t>(y) * width + x] >= 0; }
+  // A fragment was written there: it passed the z-test, its code above the buffer's (0 when clear).
+  bool covered(int x, int y) const { return depth[static_cast<size_t>(y) * width + x] > 0; }
   // The pixels drawn since the buffers were last cleared lie in this rectangle (x0 > x1: none):
   // the next clear of a frame of the same size and kind clears it alone (prepareClear, clearRect).
   // (A cache line of their own: a two-thread frame's front end marks them per triangle while

@@ -88,6 +88,7 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const Rend
   RenderOptions ro;
   ro.method = m;
   ro.brdf = g.brdf;
+  ro.tags = s.rtl;  // the triangle buffer: for checkRtlFrame's report of the first differing pixel
   LobeConfigs lobes = s.lobes;
   if (!g.unit.empty()) lobes.quadratic = g.unit;
   std::vector<std::string> spec_configs;

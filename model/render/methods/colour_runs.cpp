@@ -156,7 +156,7 @@ void drawColourRuns(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& run
   Framebuffer& fb = f.fb;
   const int W = f.W;
   const PixelWriter write = f.writer(t.tag);
-  const fixed_simd::Target target{fb.depth.data(), fb.tri.data(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
+  const fixed_simd::Target target{fb.depth.data(), f.tags(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
   runs.frac = kColourFrac;
   if (t.rows != nullptr && f.colour_kernel != nullptr) return drawColourSpans(f, t, runs, target);
   PendingRuns pending{f.colour_kernel, target, fb.rgb.data(), f.st.pixels_covered, f.st.depth_rejected, runs};

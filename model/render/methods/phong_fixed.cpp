@@ -39,7 +39,7 @@ struct FixedTriangle {
         W(frame.W),
         batched(frame.batchesRequests(Method::PhongFixed)),
         write(frame.writer(tri.tag)),
-        target{depth, frame.fb.tri.data(), static_cast<int32_t>(tri.tag), static_cast<size_t>(W)},
+        target{depth, frame.tags(), static_cast<int32_t>(tri.tag), static_cast<size_t>(W)},
         squared_norm(tri) {}
   Frame& f;
   FixedPointShader& shader;
