@@ -65,7 +65,9 @@ RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderRes
   c.mismatches = differingPixels(img, himg).count();
   if (auto d = firstDifference(img, himg)) {
     const size_t p = static_cast<size_t>(d->y) * img.width + d->x;
-    auto who = [&](const RenderResult& r, int32_t t) {
+    auto who = [&](const RenderResult& r, size_t pixel) {
+      if (r.fb.tri.empty()) return std::string("a triangle not recorded (drawn without RenderOptions::tags)");
+      const int32_t t = r.fb.tri[pixel];
       if (t < 0) return std::string("no triangle");
       const ScreenTriangleInfo& i = r.triangles[static_cast<size_t>(t)];
       return fmt::format("triangle {} of object '{}' (mesh triangle {}, screen ({:.2f},{:.2f}) ({:.2f},{:.2f}) "
@@ -74,8 +76,8 @@ RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderRes
                          i.xy[1][0], i.xy[1][1], i.xy[2][0], i.xy[2][1]);
     };
     c.first_mismatch = fmt::format("pixel ({}, {}): model ({}, {}, {}) written by {}; rtl ({}, {}, {}) written by {}",
-                                   d->x, d->y, d->a.r, d->a.g, d->a.b, who(res, res.fb.tri[p]), d->b.r, d->b.g,
-                                   d->b.b, who(hres, hres.fb.tri[p]));
+                                   d->x, d->y, d->a.r, d->a.g, d->a.b, who(res, p), d->b.r, d->b.g, d->b.b,
+                                   who(hres, p));
   }
   c.json = {{"ms", hres.stats.ms},
             {"span_cycles", hres.stats.span_cycles},
