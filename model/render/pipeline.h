@@ -76,10 +76,10 @@ struct Projection {
 };
 
 // The buffers of a W x H frame, cleared, in two steps: prepareClear sizes them (a new size or
-// kind cleared whole; lsb and spec_lsb only for an exact method, tri only with tags) and marks nothing drawn, and
-// returns what is left to clear: when fb already held a frame of that size and kind, the
-// rectangle that frame drew (Framebuffer::markDrawn; the rest is clear), which clearRect
-// clears (x0 > x1: nothing). A two-thread frame's back end runs clearRect (render.cpp).
+// kind cleared whole; lsb and spec_lsb only for an exact method, tri only with tags) and marks
+// nothing drawn, and returns what is left to clear: when fb already held a frame of that size
+// and kind, the rectangle that frame drew (Framebuffer::markDrawn; the rest is clear), which
+// clearRect clears (x0 > x1: nothing). A two-thread frame's back end runs clearRect (render.cpp).
 struct ClearRect {
   int x0, y0, x1, y1;
   bool exact;
