@@ -391,6 +391,8 @@ SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
                           static_cast<int32_t>(v[2]));
   };
   const __m128i dx = lanes(s.didx), dy = lanes(s.didy);
+  for (size_t k = 0; k < 3; ++k) r.dc[k] = static_cast<int32_t>(s.didx[k]);
+  r.dz = static_cast<uint32_t>(s.didx[3]);
   __m128i left = lanes(s.a0);  // the codes at column x0 of row y0 + i (mod 2^32)
   size_t n = 0, p = static_cast<size_t>(s.y0) * W;
   for (int32_t i = 0; i < s.rows; ++i, p += W, left = _mm_add_epi32(left, dy)) {

@@ -107,11 +107,11 @@ struct ColourRuns {
   std::array<Row, kCap> rows;
 };
 
-// The runs of a triangle's rows' spans (raster/row_spans.h) into r.rows, one per row with a
-// pixel, top to bottom (W: pixels per framebuffer row), with the codes at its first pixel
-// (RowSpans::at mod 2^32, in 32-bit lanes: the same bits) and r.n their number; r's steps are
-// the caller's. For a CPU with AVX2 (every one with AVX-512 has it): where colourKernel() is
-// not null.
+// The runs of a triangle's rows' spans (raster/row_spans.h) into r: one per row with a pixel,
+// top to bottom (W: pixels per framebuffer row), with the codes at its first pixel (RowSpans::at
+// mod 2^32, in 32-bit lanes: the same bits), r.n their number, and the steps the triangle's
+// gradients (as the walk's runs; a run of one pixel reads none). For a CPU with AVX2 (every one
+// with AVX-512 has it): where colourKernel() is not null.
 void spanRows(const RowSpans& s, size_t W, ColourRuns& r);
 
 // The runs' z-test, 8 pixels at a time, and where it passes the depth code and the tag written,

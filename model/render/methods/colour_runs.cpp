@@ -133,15 +133,11 @@ struct ColourRunLoop {
 };
 
 // A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
-// walk: a run per row with a pixel, its codes at its first pixel from the plane
-// (fixed_simd::spanRows), the steps the triangle's gradients (as the walk's runs; a run of one
-// pixel reads none).
+// walk: the runs fixed_simd::spanRows makes of its rows.
 static_assert(RowSpans::kMaxRows <= fixed_simd::ColourRuns::kCap, "a triangle's rows in one call");
 void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs, const fixed_simd::Target& target) {
   const RowSpans& s = *t.rows;
   if (!t.counted) f.countRows(s);
-  for (size_t k = 0; k < 3; ++k) runs.dc[k] = static_cast<int32_t>(s.didx[k]);
-  runs.dz = static_cast<uint32_t>(s.didx[3]);
   fixed_simd::spanRows(s, static_cast<size_t>(f.W), runs);
   uint64_t passed = 0;
   f.st.pixels_covered += f.colour_kernel(runs, target, f.fb.rgb.data(), passed);
