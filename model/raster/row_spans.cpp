@@ -43,6 +43,31 @@ struct RowEdge {
   bool right;
 };
 
+// What the row loop gathers besides the spans: the first and the last row with a pixel, the
+// pixels' bounding columns, the fragments and the lane groups (span_detail::firstGroup: a
+// multiple of LanesPerTri, a power of two, below a span's first column, which is >= 0 here).
+struct RowTally {
+  RowSpans* o;
+  int64_t align;
+  int lane_shift;
+  int64_t first = -1, last = -1, xmin, xmax = -1, fragments = 0, groups = 0;
+  RowTally(const RowSpansConfig& c, RowSpans& out)
+      : o(&out), align(c.align_lanes ? ~((int64_t{1} << c.lane_shift) - 1) : -1), lane_shift(c.lane_shift), xmin(c.W) {}
+  // Row i's pixels [lo, hi] (none where lo > hi), lo >= 0 and hi below the viewport's width.
+  [[gnu::always_inline]] void add(int64_t i, int64_t lo, int64_t hi) {
+    const bool any = lo <= hi;
+    o->span[static_cast<size_t>(i)] = {static_cast<int16_t>(any ? lo : 1), static_cast<int16_t>(any ? hi : 0)};
+    if (any) {
+      first = first < 0 ? i : first;
+      last = i;
+      xmin = std::min(xmin, lo);
+      xmax = std::max(xmax, hi);
+      fragments += hi - lo + 1;
+      groups += ((hi - (lo & align)) >> lane_shift) + 1;
+    }
+  }
+};
+
 // The plane at (x, y) (screen pixels), exactly; false where it leaves int64_t.
 bool planeAt(int64_t iref, int64_t didx, int64_t didy, int64_t dx, int64_t dy, int64_t& v) {
   int64_t px = 0, py = 0, s = 0;
@@ -185,6 +210,114 @@ SHD_AVX2 bool plane(const CodesF& a, const PlaneGeom& g, RowSpans& o) {
 }
 
 }  // namespace planeavx2
+
+namespace rowsavx2 {
+
+// The sum, the least and the greatest of 8 32-bit lanes.
+SHD_AVX2 inline __m256i swapHalves(__m256i v) { return _mm256_permute2x128_si256(v, v, 1); }
+SHD_AVX2 inline int64_t lane0(__m256i v) { return _mm_cvtsi128_si32(_mm256_castsi256_si128(v)); }
+SHD_AVX2 inline int64_t sum8(__m256i v) {
+  v = _mm256_add_epi32(v, swapHalves(v));
+  v = _mm256_add_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(1, 0, 3, 2)));
+  return lane0(_mm256_add_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1))));
+}
+SHD_AVX2 inline int64_t min8(__m256i v) {
+  v = _mm256_min_epi32(v, swapHalves(v));
+  v = _mm256_min_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(1, 0, 3, 2)));
+  return lane0(_mm256_min_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1))));
+}
+SHD_AVX2 inline int64_t max8(__m256i v) {
+  v = _mm256_max_epi32(v, swapHalves(v));
+  v = _mm256_max_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(1, 0, 3, 2)));
+  return lane0(_mm256_max_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1))));
+}
+
+// The scalar row loop in AVX2 lanes, in two passes.
+//   1. The edges: the left ones (x >= q) in lanes 0 and 1, the right ones (x <= -q) in lanes 2
+//      and 3, a side's single edge in both of its lanes (the same values, so the same bound).
+//      Each row the lanes' bounds pair up into max(q0, q1) and max(q2, q3), and every lane
+//      steps by the scalar DDA's integer operations. A triangle has an edge of each side: its
+//      edges' dy sum to 0 and at most one is 0 (a horizontal edge is a left bound out of
+//      reach), so the non-horizontal ones include a downward and an upward one; false (nothing
+//      done) otherwise, the scalar loop then deciding. A row's [lo, hi] is clamped to [0, W]
+//      and [-1, W - 1] (the scalar loop's [0, ...] and [..., W - 1] and, beyond them, a row as
+//      empty: lo > W - 1 >= hi or hi < 0 <= lo), so it fits 32 bits: stored as (lo, -hi).
+//   2. RowTally::add of 8 rows at a time, in 32-bit lanes.
+SHD_AVX2 bool walk(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTally& t) {
+  static_assert(RowSpans::kMaxRows % 8 == 0, "pass 2 writes the spans of whole groups of 8 rows");
+  // The edges of lanes 0 .. 3 by the triangle's right edges (bit s: edge s is one).
+  static constexpr std::array<std::array<uint8_t, 4>, 8> kLanes = {
+      {{0, 0, 0, 0}, {1, 2, 0, 0}, {0, 2, 1, 1}, {2, 2, 0, 1}, {0, 1, 2, 2}, {1, 1, 0, 2}, {0, 0, 1, 2}, {0, 0, 0, 0}}};
+  const unsigned sides = (e[0].right ? 1u : 0u) | (e[1].right ? 2u : 0u) | (e[2].right ? 4u : 0u);
+  if (sides == 0 || sides == 7) return false;
+  const std::array<uint8_t, 4>& lane = kLanes[sides];
+  const RowEdge &l0 = e[lane[0]], &l1 = e[lane[1]], &r0 = e[lane[2]], &r1 = e[lane[3]];
+  __m256i q = _mm256_set_epi64x(r1.q, r0.q, l1.q, l0.q), r = _mm256_set_epi64x(r1.r, r0.r, l1.r, l0.r);
+  const __m256i D = _mm256_set_epi64x(r1.D, r0.D, l1.D, l0.D), k = _mm256_set_epi64x(r1.k, r0.k, l1.k, l0.k);
+  const __m256i m = _mm256_set_epi64x(r1.m, r0.m, l1.m, l0.m);
+  const __m256i zero = _mm256_setzero_si256();
+  // lo within [0, W]; -hi within [1 - W, 1].
+  const __m256i low = _mm256_set_epi64x(1 - W, 1 - W, 0, 0), high = _mm256_set_epi64x(1, 1, W, W);
+  const __m256i pick = _mm256_setr_epi32(0, 4, 0, 4, 0, 4, 0, 4);  // lanes 0 and 2's low halves
+  alignas(32) std::array<int32_t, 2 * RowSpans::kMaxRows + 16> bound;  // (lo, -hi) of row i at 2 i
+  for (int64_t i = 0; i < n; ++i) {
+    const __m256i swapped = _mm256_shuffle_epi32(q, _MM_SHUFFLE(1, 0, 3, 2));  // q1 q0 q3 q2
+    __m256i most = _mm256_blendv_epi8(q, swapped, _mm256_cmpgt_epi64(swapped, q));
+    most = _mm256_blendv_epi8(most, low, _mm256_cmpgt_epi64(low, most));
+    most = _mm256_blendv_epi8(most, high, _mm256_cmpgt_epi64(most, high));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(bound.data() + 2 * i),
+                     _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(most, pick)));
+    r = _mm256_sub_epi64(r, m);
+    const __m256i borrow = _mm256_cmpgt_epi64(zero, r);  // -1 where r < 0
+    r = _mm256_add_epi64(r, _mm256_and_si256(D, borrow));
+    q = _mm256_sub_epi64(_mm256_add_epi64(q, k), borrow);
+  }
+  // The rows after the last of its group of 8: defined, and not rows (the valid lanes below).
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(bound.data() + 2 * n), zero);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(bound.data() + 2 * n + 8), zero);
+
+  const __m256i w = _mm256_set1_epi32(static_cast<int32_t>(W)), none = _mm256_set1_epi32(-1), one = _mm256_set1_epi32(1);
+  const __m256i align = _mm256_set1_epi32(static_cast<int32_t>(t.align));
+  const __m128i shift = _mm_cvtsi32_si128(t.lane_shift);
+  const __m256i rows8 = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  __m256i fragments = zero, groups = zero, xmin = w, xmax = none;
+  int64_t first = -1, last = -1;
+  for (int64_t g = 0; g < n; g += 8) {
+    const __m256 a = _mm256_load_ps(reinterpret_cast<const float*>(bound.data() + 2 * g));     // rows g .. g + 3
+    const __m256 b = _mm256_load_ps(reinterpret_cast<const float*>(bound.data() + 2 * g + 8));  // g + 4 .. g + 7
+    // Rows 0 1 4 5 | 2 3 6 7 of the group, then in order.
+    const __m256i lo = _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0))),
+                                                _MM_SHUFFLE(3, 1, 2, 0));
+    const __m256i hi = _mm256_sub_epi32(
+        zero, _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1))),
+                                       _MM_SHUFFLE(3, 1, 2, 0)));
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int32_t>(n - g)), rows8);
+    const __m256i any = _mm256_andnot_si256(_mm256_cmpgt_epi32(lo, hi), valid);
+    fragments = _mm256_add_epi32(fragments, _mm256_and_si256(any, _mm256_add_epi32(_mm256_sub_epi32(hi, lo), one)));
+    const __m256i span_groups =
+        _mm256_add_epi32(_mm256_sra_epi32(_mm256_sub_epi32(hi, _mm256_and_si256(lo, align)), shift), one);
+    groups = _mm256_add_epi32(groups, _mm256_and_si256(any, span_groups));
+    xmin = _mm256_min_epi32(xmin, _mm256_blendv_epi8(w, lo, any));
+    xmax = _mm256_max_epi32(xmax, _mm256_blendv_epi8(none, hi, any));
+    // span: (lo, hi) as int16_t, or (1, 0) without a pixel.
+    const __m256i span = _mm256_or_si256(_mm256_and_si256(lo, _mm256_set1_epi32(0xFFFF)), _mm256_slli_epi32(hi, 16));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(t.o->span.data() + g), _mm256_blendv_epi8(one, span, any));
+    const unsigned mask = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(any)));
+    if (mask != 0) {
+      first = first < 0 ? g + __builtin_ctz(mask) : first;
+      last = g + 31 - __builtin_clz(mask);
+    }
+  }
+  t.first = first;
+  t.last = last;
+  t.fragments = sum8(fragments);
+  t.groups = sum8(groups);
+  t.xmin = min8(xmin);
+  t.xmax = max8(xmax);
+  return true;
+}
+
+}  // namespace rowsavx2
 #endif
 
 }  // namespace
@@ -272,39 +405,32 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     if (k >= c.k_lim || k < -c.k_lim) return RowSpansSetup::General;
     e[s] = {q, q * D - N, D, k, -B[s] - k * D, A[s] < 0};
   }
-  // The rows' spans, with what the unit's cycles and the plane's check below need: the pixels'
-  // bounding columns, the fragments and the lane groups (span_detail::firstGroup: a multiple of
-  // LanesPerTri, a power of two, below a span's first column, which is >= 0 here).
-  int64_t first = -1, last = -1, xmin = c.W, xmax = -1, fragments = 0, groups = 0;
-  const int64_t align = c.align_lanes ? ~((int64_t{1} << c.lane_shift) - 1) : -1;
-  for (int64_t i = 0; i <= r1 - r0; ++i) {
-    int64_t lo = 0, hi = c.W - 1;
-    for (RowEdge& g : e) {
-      lo = g.right ? lo : std::max(lo, g.q);
-      hi = g.right ? std::min(hi, -g.q) : hi;
-      const int64_t r = g.r - g.m;
-      const int64_t borrow = r < 0 ? 1 : 0;  // without a branch, as the walker's stepEdge
-      g.r = r + (g.D & -borrow);
-      g.q += g.k + borrow;
+  // The rows' spans, with what the unit's cycles and the plane's check below need.
+  RowTally t(c, o);
+  const int64_t n = r1 - r0 + 1;
+#ifdef SHD_X86_KERNELS
+  if (!vector || !rowsavx2::walk(e, n, c.W, t))
+#endif
+    for (int64_t i = 0; i < n; ++i) {
+      int64_t lo = 0, hi = c.W - 1;
+      for (RowEdge& g : e) {
+        lo = g.right ? lo : std::max(lo, g.q);
+        hi = g.right ? std::min(hi, -g.q) : hi;
+        const int64_t r = g.r - g.m;
+        const int64_t borrow = r < 0 ? 1 : 0;  // without a branch, as the walker's stepEdge
+        g.r = r + (g.D & -borrow);
+        g.q += g.k + borrow;
+      }
+      t.add(i, lo, hi);
     }
-    const bool any = lo <= hi;
-    o.span[static_cast<size_t>(i)] = {static_cast<int16_t>(any ? lo : 1), static_cast<int16_t>(any ? hi : 0)};
-    if (any) {
-      first = first < 0 ? i : first;
-      last = i;
-      xmin = std::min(xmin, lo);
-      xmax = std::max(xmax, hi);
-      fragments += hi - lo + 1;
-      groups += ((hi - (lo & align)) >> c.lane_shift) + 1;
-    }
-  }
+  const int64_t first = t.first, last = t.last, xmin = t.xmin, xmax = t.xmax;
   if (first < 0) return RowSpansSetup::Dropped;  // no pixel centre inside it in the viewport
   if (first > 0) std::copy(o.span.begin() + first, o.span.begin() + last + 1, o.span.begin());
   o.y0 = static_cast<int32_t>(r0 + first);
   o.rows = static_cast<int32_t>(last - first + 1);
   o.x0 = o.span[0][0];
-  o.fragments = static_cast<uint32_t>(fragments);
-  o.groups = static_cast<uint32_t>(groups);
+  o.fragments = static_cast<uint32_t>(t.fragments);
+  o.groups = static_cast<uint32_t>(t.groups);
   // The plane, from the reference pixel (setup's setPlane).
   const int64_t xref = std::clamp<int64_t>(std::min({X[0], X[1], X[2]}) >> S, 0, c.W - 1);
   const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
