@@ -44,8 +44,9 @@ void BM_Frame(benchmark::State& state, Method method, const char* mode, const ch
     render(scene, opt, span, spec, frame);
     benchmark::DoNotOptimize(frame.fb.rgb.data());
   }
-  // phong-fixed's kernel on this CPU: the AVX-512 one, or the scalar one (SHD_SCALAR=1 forces it).
-  if (method == Method::PhongFixed) state.SetLabel(fixed_simd::available() ? "avx512 kernel" : "scalar kernel");
+  // phong-fixed's kernel on this CPU: AVX-512, AVX2, or the scalar one (SHD_SCALAR=1 forces it).
+  if (method == Method::PhongFixed)
+    state.SetLabel(fixed_simd::available() ? "avx512 kernel" : fixed_simd::availableAvx2() ? "avx2 kernel" : "scalar kernel");
   state.counters["fragments"] = static_cast<double>(frame.stats.fragments);
   state.counters["span_cycles"] = static_cast<double>(frame.stats.span_cycles);
   state.counters["frag/s"] = benchmark::Counter(static_cast<double>(frame.stats.fragments),

@@ -190,13 +190,14 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
   EXPECT_THROW(FixedPointShader(ctx, s.materials.at(0), Lobe::Quadratic, nullptr, nullptr), std::logic_error);
 }
 
-// The vector kernel (render/fixed_simd.h) against shade(), lane by lane: runs of 1 to 8
-// fragments with normals from 2^-27 to 8 in length (squared norms of every bit length up to
-// 64; codes up to 2^31), facing the light or away, for each lobe it takes, with factor codes
-// up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must make it
-// decline the group. Skipped, and said so, on a CPU without AVX-512.
-TEST(FixedSimd, LanesEqualTheScalarDatapath) {
-  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 F/DQ/CD/VL/BW here (or SHD_SCALAR set): the scalar path runs";
+// The vector kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2) against shade(), lane by lane:
+// runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms of every bit
+// length up to 64; codes up to 2^31), facing the light or away, for each lobe they take, with
+// factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
+// make a kernel decline the group. Each kernel where the CPU has its instructions; the test is
+// skipped, and says so, where it has neither.
+static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
+  SCOPED_TRACE(name);
   std::mt19937_64 rng(12);
   std::normal_distribution<double> g;
   std::uniform_real_distribution<double> u01;
@@ -213,7 +214,6 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
         FixedPointShader fixed(ctx, m, lobe, nullptr, nullptr);
         fixed.withRunKernel([&](auto kernel) {
           if constexpr (decltype(kernel)::kGroups) {
-            ASSERT_TRUE(kernel.vectorised());
             for (int t = 0; t < 3000; ++t) {
               // A run: N_j = n0 + j dn, as the span unit interpolates it.
               // 2^-27 to 8 in length: codes from a few units (squared norms below 2^8: declined)
@@ -221,6 +221,7 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
               const double len = std::ldexp(1.0, -27 + static_cast<int>(rng() % 30)) * (1 + u01(rng));
               Vec3 v{g(rng), g(rng), g(rng)};
               if (t % 2 != 0) v = normalize(normalize(v) + 3.0 * ctx.lights[0].half);
+              if (t % 10 == 1) v = ctx.lights[0].half;  // N.H at 1 and a hair either side (the clamp at 2^32)
               v = (len / length(v)) * v;
               const NormalCode c(v);
               std::array<int64_t, 3> dn{};
@@ -243,7 +244,7 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
               uint8_t* const rgb_out[3] = {rgb[0], rgb[1], rgb[2]};
               int64_t* const codes_out[3] = {codes[0], codes[1], codes[2]};
               const bool vec =
-                  kernel.shadeBatch(sq.data(), l.data(), h.data(), static_cast<size_t>(count), rgb_out, codes_out) == 0;
+                  nh(kernel.nhParams(), sq.data(), l.data(), h.data(), static_cast<size_t>(count), rgb_out, codes_out) == 0;
               ASSERT_EQ(vec, !small) << "n " << n << " " << toString(lobe);
               if (!vec) {
                 ++declined;
@@ -270,7 +271,30 @@ TEST(FixedSimd, LanesEqualTheScalarDatapath) {
   }
   EXPECT_GT(lanes, 500000u);
   EXPECT_GT(declined, 0u);
-  RecordProperty("lanes", std::to_string(lanes));
+  testing::Test::RecordProperty(std::string("lanes_") + name, std::to_string(lanes));
+}
+
+TEST(FixedSimd, LanesEqualTheScalarDatapath) {
+  if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
+  if (fixed_simd::cpuHasAvx512()) checkNhKernel("avx512", fixed_simd::shadeNh);
+  if (fixed_simd::cpuHasAvx2()) checkNhKernel("avx2", fixed_simd::shadeNhAvx2);
+}
+
+// What a renderer's run kernel shades its batches with: the vector kernel where the CPU has one
+// (and SHD_SCALAR is not set), none (every group left to the scalar datapath) where it has not.
+TEST(FixedSimd, RunKernelTakesTheCpusKernel) {
+  const Scene s = loadScene("builtin:sphere");
+  const ShadeContext ctx = makeShadeContext(s);
+  FixedPointShader fixed(ctx, s.materials.at(0), Lobe::Blinn, nullptr, nullptr);
+  fixed.withRunKernel([&](auto kernel) {
+    if constexpr (decltype(kernel)::kGroups) {
+      EXPECT_EQ(kernel.vectorised(), fixed_simd::nhKernel() != nullptr);
+      EXPECT_EQ(fixed_simd::nhKernel() != nullptr, fixed_simd::available() || fixed_simd::availableAvx2());
+      EXPECT_EQ(fixed_simd::bufferKernel() != nullptr, fixed_simd::nhKernel() != nullptr);
+    } else {
+      FAIL() << "one directional light and blinn: the vector case";
+    }
+  });
 }
 
 namespace {
@@ -322,13 +346,15 @@ bool zTestWrite(const fixed_simd::RunPixels& px, size_t k, int32_t tag, std::vec
 
 }  // namespace
 
-// fixed_simd::bufferRun against the run loop it replaces, fragment by fragment: runs of 1 to
-// 40 pixels from every start offset, over depth buffers holding codes above, below and equal
-// to the run's (and 0, not covered), with depth codes and steps that wrap mod 2^32, squared
-// norms from SquaredNormRecurrence and dot products that wrap mod 2^64, into batches filled
-// to every level (a full batch stops the run; the rest follows after the batch is emptied).
-TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
-  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR set): the scalar path runs";
+// fixed_simd::bufferRun (AVX-512, where the CPU has it) and bufferRunScalar against the run
+// loop they replace, fragment by fragment: runs of 1 to 40 pixels from every start offset,
+// over depth buffers holding codes above, below and equal to the run's (and 0, not covered),
+// with depth codes and steps that wrap mod 2^32, squared norms from SquaredNormRecurrence and
+// dot products that wrap mod 2^64, into batches filled to every level (a full batch stops the
+// run, the AVX-512 kernel's with room for fewer than 8, the scalar one's with none; the rest
+// follows after the batch is emptied).
+static void checkBufferKernel(const char* name, fixed_simd::BufferKernel buffer_run, size_t stop_room) {
+  SCOPED_TRACE(name);
   std::mt19937_64 rng(21);
   auto batch = std::make_unique<fixed_simd::Batch>();
   uint64_t fragments = 0, passed = 0, stops = 0;
@@ -364,17 +390,18 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
     const fixed_simd::Target target{depth.data(), tri.data(), 7, kRunWidth};
     batch->n = rng() % (fixed_simd::Batch::kCap + 1);
     if (batch->n > fixed_simd::Batch::kCap - 8 && t % 2 == 0) batch->n = fixed_simd::Batch::kCap - 8 - rng() % 16;
+    if (t % 4 == 1) batch->n = fixed_simd::Batch::kCap - 1 - rng() % 40;  // within a run of full
     std::vector<std::array<uint64_t, 4>> got;
     uint64_t fresh = 0;
     for (size_t k = 0;;) {
       const size_t n0_batch = batch->n;
-      const size_t next = fixed_simd::bufferRun(r, k, target, *batch, fresh);
+      const size_t next = buffer_run(r, k, target, *batch, fresh);
       ASSERT_GE(next, k);
       ASSERT_LE(next, r.px.count);
       ASSERT_LE(batch->n, fixed_simd::Batch::kCap);
       for (size_t i = n0_batch; i < batch->n; ++i) got.push_back({batch->sq[i], batch->l[i], batch->h[i], batch->pixel[i]});
       if (next == r.px.count) break;
-      ASSERT_GT(batch->n + 8, fixed_simd::Batch::kCap) << "stopped with room for 8";
+      ASSERT_GT(batch->n + stop_room, fixed_simd::Batch::kCap) << "stopped with room left";
       ++stops;
       batch->n = 0;
       k = next;
@@ -391,6 +418,11 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   EXPECT_GT(passed, fragments / 4);
   EXPECT_LT(passed, fragments * 3 / 4);
   EXPECT_GT(stops, 500u);
+}
+
+TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
+  if (fixed_simd::cpuHasAvx512()) checkBufferKernel("avx512", fixed_simd::bufferRun, 8);
+  checkBufferKernel("scalar", fixed_simd::bufferRunScalar, 1);
 }
 
 // The colour-run kernels (fixed_simd::colourRunsAvx512, colourRunsAvx2) against the flat/Gouraud

@@ -264,7 +264,7 @@ class FixedPointShader {
       ambient_ = sh.ambient_;
       table_ = sh.table_ ? sh.table_->code.data() : nullptr;
       if constexpr (kGroups) {
-        simd_ = fixed_simd::available();
+        nh_ = fixed_simd::nhKernel();
         simd_params_ = {table_, sh.table_->zero_below, ambient_, lights_[0].diffuse, lights_[0].specular};
       }
     }
@@ -277,7 +277,8 @@ class FixedPointShader {
     // Both give what shade() gives.
     static constexpr bool kGroups = C == Cosine::NH && NL == 1;
     static constexpr bool kNeedsNv = needsNv(C);
-    bool vectorised() const { return simd_; }
+    bool vectorised() const { return nh_ != nullptr; }
+    const fixed_simd::NhParams& nhParams() const { return simd_params_; }
     uint64_t dotL() const { return l_[0]; }
     uint64_t dotH() const { return h_[0]; }
     uint64_t stepL() const { return dl_[0]; }
@@ -285,7 +286,7 @@ class FixedPointShader {
     uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint8_t* const rgb[3],
                         int64_t* const codes[3] = nullptr) const {
       if constexpr (kGroups)
-        if (simd_) return fixed_simd::shadeNh(simd_params_, sq, l, h, n, rgb, codes);
+        if (nh_ != nullptr) return nh_(simd_params_, sq, l, h, n, rgb, codes);
       return fixed_simd::allGroups(n);
     }
     FixedShade shadeRaw(uint64_t sqnorm, uint64_t l, uint64_t h) {
@@ -334,7 +335,7 @@ class FixedPointShader {
     std::array<uint64_t, NL> l_{}, dl_{}, h_{}, dh_{};
     std::array<int64_t, 3> dn_{};  // the steps' normal increment
     bool have_steps_ = false;
-    bool simd_ = false;
+    fixed_simd::NhKernel nh_ = nullptr;
     fixed_simd::NhParams simd_params_;
   };
 

@@ -412,6 +412,158 @@ ColourKernel colourKernel() {
   return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
 }
 
+// ---- shadeNh in AVX2: shadeGroup's operations on 4 64-bit lanes, two per group of 8 ----
+
+namespace {
+
+// The low 64 bits of a b (any signs), from 32 x 32 products.
+SHD_AVX2 inline __m256i mulLo64(__m256i a, __m256i b) {
+  const __m256i cross = _mm256_add_epi64(_mm256_mul_epu32(_mm256_srli_epi64(a, 32), b),
+                                         _mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)));
+  return _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64(cross, 32));
+}
+// mulHiU64's operations.
+SHD_AVX2 inline __m256i mulHiU64x4(__m256i a, __m256i b) {
+  const __m256i low32 = _mm256_set1_epi64x(0xFFFFFFFF);
+  const __m256i ah = _mm256_srli_epi64(a, 32), bh = _mm256_srli_epi64(b, 32);
+  const __m256i t = _mm256_mul_epu32(a, b);
+  const __m256i u = _mm256_add_epi64(_mm256_mul_epu32(ah, b), _mm256_srli_epi64(t, 32));
+  const __m256i v = _mm256_add_epi64(_mm256_mul_epu32(a, bh), _mm256_and_si256(u, low32));
+  return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(ah, bh), _mm256_srli_epi64(u, 32)),
+                          _mm256_srli_epi64(v, 32));
+}
+// x >> S, arithmetic (0 < S < 64): the logical shift with the sign's copies shifted in.
+template <int S>
+SHD_AVX2 inline __m256i sra64(__m256i x) {
+  const __m256i sign = _mm256_cmpgt_epi64(_mm256_setzero_si256(), x);
+  return _mm256_or_si256(_mm256_srli_epi64(x, S), _mm256_slli_epi64(sign, 64 - S));
+}
+template <int S>
+SHD_AVX2 inline __m256i roundShift64(__m256i x) {
+  return sra64<S>(_mm256_add_epi64(x, _mm256_set1_epi64x(int64_t{1} << (S - 1))));
+}
+SHD_AVX2 inline __m256i max64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(b, a)); }
+SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(a, b)); }
+// scaleCosines' operations.
+SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
+  const __m256i neg = _mm256_cmpgt_epi64(_mm256_setzero_si256(), d);
+  const __m256i hi = _mm256_sub_epi64(mulHiU64x4(d, r64), _mm256_and_si256(neg, r64));
+  return _mm256_add_epi64(hi, _mm256_srli_epi64(mulLo64(d, r64), 63));
+}
+
+// shadeGroup's datapath on the 4 fragments at sq, l, h (`valid`: the lanes that are fragments),
+// up to the 12-fraction-bit codes; false when a valid lane needs the scalar path.
+SHD_AVX2 [[gnu::always_inline]] inline bool shadeLanes4(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h,
+                                 __m256i valid, __m256i (&code)[3]) {
+  const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sq));
+  const __m256i dot_l = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l));
+  const __m256i dot_h = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h));
+  // rsqrtCore<10>: the bit length (lane by lane: AVX2 has no count of leading zeros), shift.
+  auto bitsOf = [](uint64_t x) { return x == 0 ? int64_t{0} : int64_t{64 - __builtin_clzll(x)}; };
+  const __m256i bits = _mm256_set_epi64x(bitsOf(sq[3]), bitsOf(sq[2]), bitsOf(sq[1]), bitsOf(sq[0]));
+  const __m256i up = _mm256_cmpgt_epi64(_mm256_set1_epi64x(63), bits);  // bits <= 62
+  const __m256i shift = _mm256_blendv_epi8(_mm256_set1_epi64x(-1),
+                                           _mm256_srli_epi64(_mm256_sub_epi64(_mm256_set1_epi64x(62), bits), 1), up);
+  const __m256i scalar = _mm256_or_si256(_mm256_cmpgt_epi64(shift, _mm256_set1_epi64x(26)),
+                                         _mm256_cmpeq_epi64(v, _mm256_setzero_si256()));
+  if (!_mm256_testz_si256(scalar, valid)) return false;
+  const __m256i m = _mm256_blendv_epi8(_mm256_srli_epi64(v, 2), _mm256_sllv_epi64(v, _mm256_add_epi64(shift, shift)), up);
+  const __m256i mq = _mm256_srli_epi64(m, 30);
+  const __m256i y = _mm256_srli_epi64(_mm256_sub_epi64(mq, _mm256_set1_epi64x(int64_t{1} << 30)), 20);
+  const __m256i idx = _mm256_srli_epi64(_mm256_mul_epu32(y, _mm256_set1_epi64x(43691)), 17);
+  // The seed entries, gathered by the valid lanes (the others' indexes are not entries).
+  const __m128i valid32 = _mm256_castsi256_si128(_mm256_permutevar8x32_epi32(valid, _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6)));
+  const __m256i r0 = _mm256_cvtepu32_epi64(_mm256_mask_i64gather_epi32(
+      _mm_setzero_si128(), reinterpret_cast<const int*>(RsqrtSeed<kFixedSeedBits>::table.data()), idx, valid32, 4));
+  const __m256i r0sq = _mm256_mul_epu32(r0, r0);
+  const __m256i mr = _mm256_add_epi64(_mm256_mul_epu32(mq, _mm256_srli_epi64(r0sq, 32)),
+                                      _mm256_srli_epi64(_mm256_mul_epu32(mq, r0sq), 32));
+  const __m256i r = sra64<17>(mulLo64(r0, _mm256_sub_epi64(_mm256_set1_epi64x(int64_t{3} << 32), mr)));
+  const __m256i r64 = _mm256_sllv_epi64(r, _mm256_add_epi64(shift, _mm256_set1_epi64x(3)));
+
+  const __m256i nl = scaleCosines4(dot_l, r64);
+  const __m256i lit = _mm256_cmpgt_epi64(nl, _mm256_setzero_si256());
+  const __m256i nh = scaleCosines4(dot_h, r64);
+  const __m256i c = min64(max64(nh, _mm256_setzero_si256()), _mm256_set1_epi64x(int64_t{1} << 32));
+  const __m256i ti = _mm256_srli_epi64(c, 16);
+  const __m256i frac = _mm256_and_si256(c, _mm256_set1_epi64x(0xFFFF));
+  const __m256i reads = _mm256_and_si256(
+      _mm256_and_si256(valid, lit), _mm256_cmpgt_epi64(ti, _mm256_set1_epi64x(static_cast<int64_t>(p.zero_below) - 1)));
+  const __m256i pair = _mm256_mask_i64gather_epi64(_mm256_setzero_si256(), reinterpret_cast<const long long*>(p.table),
+                                                   ti, reads, 4);
+  const __m256i t0 = _mm256_and_si256(pair, _mm256_set1_epi64x(0xFFFFFFFF));
+  const __m256i t1 = _mm256_srli_epi64(pair, 32);
+  const __m256i f = _mm256_and_si256(
+      _mm256_add_epi64(t0, roundShift64<16>(mulLo64(_mm256_sub_epi64(t1, t0), frac))), _mm256_set1_epi64x(0xFFFFFFFF));
+  // The factor codes are below 2^30 and not negative (fixed_shading.cpp's factorCode), and in
+  // the lanes where they count (lit) nl > 0 (below 2^34, a Q2.32 cosine) and 0 <= f < 2^32:
+  // the products are not negative, diffuse nl is the sum of two 32 x 32 products, specular f
+  // one, and the rounding shifts are logical.
+  const __m256i nl_high = _mm256_srli_epi64(nl, 32);
+  for (size_t k = 0; k < 3; ++k) {
+    const __m256i kd = _mm256_set1_epi64x(p.diffuse[k]), ks = _mm256_set1_epi64x(p.specular[k]);
+    const __m256i dnl = _mm256_add_epi64(_mm256_mul_epu32(kd, nl), _mm256_slli_epi64(_mm256_mul_epu32(kd, nl_high), 32));
+    const __m256i diffuse = _mm256_srli_epi64(_mm256_add_epi64(dnl, _mm256_set1_epi64x(int64_t{1} << 31)), 32);
+    const __m256i specular = _mm256_srli_epi64(_mm256_add_epi64(_mm256_mul_epu32(ks, f), _mm256_set1_epi64x(1 << 23)), 24);
+    code[k] = _mm256_add_epi64(_mm256_set1_epi64x(p.ambient[k]), _mm256_and_si256(lit, _mm256_add_epi64(diffuse, specular)));
+  }
+  return true;
+}
+
+// The output byte of each channel's code (as shadeGroup's out) in the low byte of the 64-bit lanes.
+SHD_AVX2 inline __m256i outputs4(__m256i code) {
+  return _mm256_srli_epi64(
+      _mm256_add_epi64(min64(code, _mm256_set1_epi64x(int64_t{255} << 12)), _mm256_set1_epi64x(1 << 11)), 12);
+}
+
+template <bool kCodes>
+SHD_AVX2 inline bool shadeGroupAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
+                                    size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
+  const __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3);
+  __m256i a[3], b[3];
+  if (!shadeLanes4(p, sq, l, h, _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), lane), a) ||
+      !shadeLanes4(p, sq + 4, l + 4, h + 4, _mm256_cmpgt_epi64(_mm256_set1_epi64x(n - 4), lane), b))
+    return false;
+  // Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
+  const __m256i pick_a = _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
+                                          -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
+  const __m256i pick_b = _mm256_setr_epi8(-1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
+                                          -1, -1, -1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1);
+  for (size_t k = 0; k < 3; ++k) {
+    const __m256i x = _mm256_or_si256(_mm256_shuffle_epi8(outputs4(a[k]), pick_a), _mm256_shuffle_epi8(outputs4(b[k]), pick_b));
+    _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k] + i),
+                     _mm_or_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1)));
+    if constexpr (kCodes) {
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i), a[k]);
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i + 4), b[k]);
+    }
+  }
+  return true;
+}
+
+template <bool kCodes>
+SHD_AVX2 uint64_t shadeGroupsAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                                  uint8_t* const rgb[3], int64_t* const codes[3]) {
+  uint64_t declined = 0;
+  for (size_t g = 0; g * 8 < n; ++g) {
+    const size_t i = g * 8;
+    if (!shadeGroupAvx2<kCodes>(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), i, rgb, codes))
+      declined |= uint64_t{1} << g;
+  }
+  return declined;
+}
+
+}  // namespace
+
+SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                              uint8_t* const rgb[3], int64_t* const codes[3]) {
+  return codes != nullptr ? shadeGroupsAvx2<true>(p, sq, l, h, n, rgb, codes)
+                          : shadeGroupsAvx2<false>(p, sq, l, h, n, rgb, nullptr);
+}
+
+NhKernel nhKernel() { return available() ? shadeNh : availableAvx2() ? shadeNhAvx2 : nullptr; }
+BufferKernel bufferKernel() { return available() ? bufferRun : availableAvx2() ? bufferRunScalar : nullptr; }
+
 #pragma GCC diagnostic pop
 
 #else
@@ -436,8 +588,45 @@ uint64_t colourRunsAvx2(const ColourRuns&, const Target&, uint8_t*, uint64_t&) {
 void spanRows(const RowSpans&, size_t, ColourRuns&) {
   throw std::logic_error("fixed_simd::spanRows: built without the vector kernels");
 }
+uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
+                     int64_t* const[3]) {
+  return allGroups(n);
+}
 ColourKernel colourKernel() { return nullptr; }
+NhKernel nhKernel() { return nullptr; }
+BufferKernel bufferKernel() { return nullptr; }
 
 #endif
+
+// The run loop's z-test and writes, fragment by fragment, and the passing fragments' inputs
+// (the squared norm a + k two_b + k^2 c, the dot products l + k dl and h + k dh, mod 2^64).
+size_t bufferRunScalar(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+  // Locals: the stores into the batch and the buffers could otherwise alias the run's fields.
+  const Run run = r;
+  int32_t* const depth = t.depth;
+  int32_t* const tri = t.tri;
+  const int32_t tag = t.tag;
+  size_t n = b.n, k = first;
+  uint64_t covered = 0;
+  for (; k < run.px.count && n < Batch::kCap; ++k) {
+    const size_t p = run.px.p + k;
+    if (k % 8 == 0) __builtin_prefetch(depth + p + 2 * t.width);  // as zTest8
+    const int32_t z = static_cast<int32_t>(run.px.z + static_cast<uint32_t>(k) * run.px.dz);
+    const int32_t old = depth[p];
+    if (z <= old) continue;
+    covered += old == 0 ? 1 : 0;
+    depth[p] = z;
+    if (tri != nullptr) tri[p] = tag;
+    const uint64_t k64 = k;
+    b.sq[n] = run.a + k64 * run.two_b + k64 * k64 * run.c;
+    b.l[n] = run.l + k64 * run.dl;
+    b.h[n] = run.h + k64 * run.dh;
+    b.pixel[n] = static_cast<uint32_t>(p);
+    ++n;
+  }
+  b.n = n;
+  fresh += covered;
+  return k;
+}
 
 }  // namespace shd::fixed_simd

@@ -46,9 +46,19 @@ struct NhParams {
 // Returns the groups it declines (bit g: a fragment of group g needs the scalar path); their
 // outputs are untouched. The inputs hold n rounded up to a multiple of 8 readable entries
 // (those past n are read and ignored), the outputs as many writable ones.
+// Two kernels, each for a CPU with its instructions: AVX-512 (8 64-bit lanes) and AVX2 (4 lanes,
+// two per group; the 64-bit products, shifts and the bit length that AVX2 lacks made of its
+// 32 x 32 products, shifts and compares, and the scalar count of leading zeros).
 constexpr size_t kMaxBatch = 512;
 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                  uint8_t* const rgb[3], int64_t* const codes[3] = nullptr);
+uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                     uint8_t* const rgb[3], int64_t* const codes[3] = nullptr);
+// The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else null (the
+// scalar datapath).
+using NhKernel = uint64_t (*)(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t,
+                              uint8_t* const[3], int64_t* const[3]);
+NhKernel nhKernel();
 // Every group of n fragments: what shadeNh returns when it takes none.
 inline uint64_t allGroups(size_t n) { return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8); }
 
@@ -135,5 +145,11 @@ ColourKernel colourKernel();
 // when it took all); the caller shades the batch and calls again for the rest. With the
 // vector kernel only (available()).
 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
+// The same, one fragment at a time in plain C++, while the batch has room for one more (a CPU
+// without AVX-512; the scalar z-test costs little beside the datapath shadeNhAvx2 runs).
+size_t bufferRunScalar(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
+// The one that goes with nhKernel() (null where that is).
+using BufferKernel = size_t (*)(const Run&, size_t, const Target&, Batch&, uint64_t&);
+BufferKernel bufferKernel();
 
 }  // namespace shd::fixed_simd

@@ -134,8 +134,10 @@ nlohmann::json RenderCmd::statistics(const Scene& sc, const RenderOptions& ro, c
             {"metrics", toJson(c.all)},
             {"highlight_lsb_threshold", highlight_lsb_},
             {"highlight", toJson(c.highlight)}});
-  // phong-fixed: whether the AVX-512 kernel shades its one-light N.H-lobe fragments here.
-  if (ro.method == Method::PhongFixed) j["fixed_kernel"] = fixed_simd::available() ? "avx512" : "scalar";
+  // phong-fixed: the vector kernel (AVX-512 or AVX2) that shades its one-light N.H-lobe
+  // fragments here, or none.
+  if (ro.method == Method::PhongFixed)
+    j["fixed_kernel"] = fixed_simd::available() ? "avx512" : fixed_simd::availableAvx2() ? "avx2" : "scalar";
   return j;
 }
 

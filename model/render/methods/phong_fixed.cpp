@@ -40,6 +40,7 @@ struct FixedTriangle {
         batched(frame.batchesRequests(Method::PhongFixed)),
         write(frame.writer(tri.tag)),
         target{depth, frame.tags(), static_cast<int32_t>(tri.tag), static_cast<size_t>(W)},
+        buffer_run(fixed_simd::bufferKernel()),
         squared_norm(tri) {}
   Frame& f;
   FixedPointShader& shader;
@@ -51,6 +52,7 @@ struct FixedTriangle {
   bool batched;  // device requests wait for the triangle's batch (PixelRequests)
   PixelWriter write;
   fixed_simd::Target target;
+  fixed_simd::BufferKernel buffer_run;  // the batch's (where Frame::vector_runs)
   SquaredNorms squared_norm;
 };
 
@@ -164,7 +166,7 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   uint64_t newly = 0, passed = 0;
   for (size_t k = 0;;) {
     const size_t buffered = t.batch.n;
-    k = fixed_simd::bufferRun(run, k, t.target, t.batch, newly);
+    k = t.buffer_run(run, k, t.target, t.batch, newly);
     passed += t.batch.n - buffered;  // the fragments that passed the z-test
     if (k >= run.px.count) break;
     flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
