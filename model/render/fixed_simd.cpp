@@ -561,8 +561,106 @@ SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint6
                           : shadeGroupsAvx2<false>(p, sq, l, h, n, rgb, nullptr);
 }
 
+// ---- bufferRun in AVX2 ----
+
+namespace {
+
+// The lanes of a 4-bit mask packed to the front: for 64-bit lanes as 32-bit indexes of
+// _mm256_permutevar8x32_epi32, for 32-bit lanes as the bytes of _mm_shuffle_epi8 (the lanes
+// after the packed ones are don't-cares).
+struct Compress4 {
+  std::array<std::array<int32_t, 8>, 16> wide{};
+  std::array<std::array<int8_t, 16>, 16> narrow{};
+};
+constexpr Compress4 kCompress4 = [] {
+  Compress4 t{};
+  for (unsigned m = 0; m < 16; ++m) {
+    unsigned j = 0;
+    for (unsigned i = 0; i < 4; ++i)
+      if ((m >> i) & 1) {
+        t.wide[m][2 * j] = static_cast<int32_t>(2 * i);
+        t.wide[m][2 * j + 1] = static_cast<int32_t>(2 * i + 1);
+        for (unsigned b = 0; b < 4; ++b) t.narrow[m][4 * j + b] = static_cast<int8_t>(4 * i + b);
+        ++j;
+      }
+  }
+  return t;
+}();
+
+// v's lanes of mask m (4 bits), packed to the front, stored 4 wide at out.
+SHD_AVX2 inline void compressStore(uint64_t* out, __m256i v, unsigned m) {
+  const __m256i idx = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(kCompress4.wide[m].data()));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_permutevar8x32_epi32(v, idx));
+}
+SHD_AVX2 inline void compressStore(uint32_t* out, __m128i v, unsigned m) {
+  const __m128i idx = _mm_loadu_si128(reinterpret_cast<const __m128i*>(kCompress4.narrow[m].data()));
+  _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm_shuffle_epi8(v, idx));
+}
+
+// Fragments k .. k + 3 (kv, 64-bit lanes) of run r: the squared norm a + k two_b + k^2 c and the
+// dot products l + k dl, h + k dh, mod 2^64 (k < 2^32).
+struct RunInputs4 {
+  __m256i sq, l, h;
+};
+// k x mod 2^64 for k < 2^32.
+SHD_AVX2 inline __m256i times(__m256i k, uint64_t x) {
+  const __m256i xv = _mm256_set1_epi64x(static_cast<int64_t>(x));
+  return _mm256_add_epi64(_mm256_mul_epu32(k, xv), _mm256_slli_epi64(_mm256_mul_epu32(k, _mm256_srli_epi64(xv, 32)), 32));
+}
+SHD_AVX2 inline RunInputs4 runInputs4(const Run& r, __m256i kv) {
+  const __m256i k2 = _mm256_mul_epu32(kv, kv);
+  const __m256i c = _mm256_set1_epi64x(static_cast<int64_t>(r.c));
+  const __m256i sq = _mm256_add_epi64(_mm256_add_epi64(_mm256_set1_epi64x(static_cast<int64_t>(r.a)), times(kv, r.two_b)),
+                                      mulLo64(k2, c));
+  return {sq, _mm256_add_epi64(_mm256_set1_epi64x(static_cast<int64_t>(r.l)), times(kv, r.dl)),
+          _mm256_add_epi64(_mm256_set1_epi64x(static_cast<int64_t>(r.h)), times(kv, r.dh))};
+}
+
+}  // namespace
+
+// bufferRun's loop: zTest8's test and writes with masked loads and stores (AVX2's 32-bit ones),
+// and the passing fragments' inputs computed in two halves of 4 64-bit lanes, each packed by
+// a permutation (AVX2 has no compress).
+SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+  const __m256i lanes = lanes8(), dz_lanes = laneSteps(r.px.dz), tag = _mm256_set1_epi32(t.tag);
+  const __m256i lane4 = _mm256_setr_epi64x(0, 1, 2, 3);
+  size_t n = b.n, k = first;
+  uint64_t covered = 0;
+  for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
+    const size_t p = r.px.p + k;
+    int32_t* const depth = t.depth + p;
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int32_t>(std::min<size_t>(8, r.px.count - k))), lanes);
+    const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * r.px.dz)), dz_lanes);
+    __builtin_prefetch(depth + 2 * t.width);  // as zTest8
+    __builtin_prefetch(depth + 2 * t.width + 7);
+    const __m256i old = _mm256_maskload_epi32(depth, valid);
+    const __m256i pass = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
+    const unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass)));
+    if (m == 0) continue;
+    const unsigned zero = static_cast<unsigned>(
+        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, _mm256_setzero_si256()))));
+    covered += static_cast<uint64_t>(__builtin_popcount(m & zero));
+    _mm256_maskstore_epi32(depth, pass, z);
+    if (t.tri != nullptr) _mm256_maskstore_epi32(t.tri + p, pass, tag);
+    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(p)), lanes);
+    for (unsigned half = 0; half < 2; ++half) {
+      const unsigned mh = (m >> (4 * half)) & 0xF;
+      if (mh == 0) continue;
+      const RunInputs4 in = runInputs4(r, _mm256_add_epi64(_mm256_set1_epi64x(static_cast<int64_t>(k + 4 * half)), lane4));
+      compressStore(b.sq.data() + n, in.sq, mh);
+      compressStore(b.l.data() + n, in.l, mh);
+      compressStore(b.h.data() + n, in.h, mh);
+      compressStore(b.pixel.data() + n, half == 0 ? _mm256_castsi256_si128(pixel) : _mm256_extracti128_si256(pixel, 1), mh);
+      n += static_cast<size_t>(__builtin_popcount(mh));
+    }
+  }
+  b.n = n;
+  fresh += covered;
+  return std::min(k, r.px.count);
+}
+
 NhKernel nhKernel() { return available() ? shadeNh : availableAvx2() ? shadeNhAvx2 : nullptr; }
-BufferKernel bufferKernel() { return available() ? bufferRun : availableAvx2() ? bufferRunScalar : nullptr; }
+BufferKernel bufferKernel() { return available() ? bufferRun : availableAvx2() ? bufferRunAvx2 : nullptr; }
 
 #pragma GCC diagnostic pop
 
@@ -593,40 +691,13 @@ uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const ui
   return allGroups(n);
 }
 ColourKernel colourKernel() { return nullptr; }
+size_t bufferRunAvx2(const Run&, size_t, const Target&, Batch&, uint64_t&) {
+  throw std::logic_error("fixed_simd::bufferRunAvx2: built without the vector kernels");
+}
 NhKernel nhKernel() { return nullptr; }
 BufferKernel bufferKernel() { return nullptr; }
 
 #endif
 
-// The run loop's z-test and writes, fragment by fragment, and the passing fragments' inputs
-// (the squared norm a + k two_b + k^2 c, the dot products l + k dl and h + k dh, mod 2^64).
-size_t bufferRunScalar(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
-  // Locals: the stores into the batch and the buffers could otherwise alias the run's fields.
-  const Run run = r;
-  int32_t* const depth = t.depth;
-  int32_t* const tri = t.tri;
-  const int32_t tag = t.tag;
-  size_t n = b.n, k = first;
-  uint64_t covered = 0;
-  for (; k < run.px.count && n < Batch::kCap; ++k) {
-    const size_t p = run.px.p + k;
-    if (k % 8 == 0) __builtin_prefetch(depth + p + 2 * t.width);  // as zTest8
-    const int32_t z = static_cast<int32_t>(run.px.z + static_cast<uint32_t>(k) * run.px.dz);
-    const int32_t old = depth[p];
-    if (z <= old) continue;
-    covered += old == 0 ? 1 : 0;
-    depth[p] = z;
-    if (tri != nullptr) tri[p] = tag;
-    const uint64_t k64 = k;
-    b.sq[n] = run.a + k64 * run.two_b + k64 * k64 * run.c;
-    b.l[n] = run.l + k64 * run.dl;
-    b.h[n] = run.h + k64 * run.dh;
-    b.pixel[n] = static_cast<uint32_t>(p);
-    ++n;
-  }
-  b.n = n;
-  fresh += covered;
-  return k;
-}
 
 }  // namespace shd::fixed_simd

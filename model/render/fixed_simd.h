@@ -145,9 +145,8 @@ ColourKernel colourKernel();
 // when it took all); the caller shades the batch and calls again for the rest. With the
 // vector kernel only (available()).
 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
-// The same, one fragment at a time in plain C++, while the batch has room for one more (a CPU
-// without AVX-512; the scalar z-test costs little beside the datapath shadeNhAvx2 runs).
-size_t bufferRunScalar(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
+// The same in AVX2 (the kernel of a CPU without AVX-512, with shadeNhAvx2).
+size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
 // The one that goes with nhKernel() (null where that is).
 using BufferKernel = size_t (*)(const Run&, size_t, const Target&, Batch&, uint64_t&);
 BufferKernel bufferKernel();
