@@ -360,6 +360,9 @@ static void checkBufferKernel(const char* name, fixed_simd::BufferKernel buffer_
   for (int t = 0; t < 20000; ++t) {
     fixed_simd::Run r;
     r.px = randomRunPixels(rng, t);
+    // The room to the row's end (the AVX2 kernel's blends): the buffer's, the run's own, or none.
+    const size_t room_pick = rng() % 3;
+    r.room = room_pick == 0 ? kRunBuffer - r.px.p : (room_pick == 1 ? r.px.count : 0);
     std::array<int64_t, 3> n0{}, dn{};
     for (size_t k = 0; k < 3; ++k) {
       n0[k] = static_cast<int64_t>(rng() % (uint64_t{1} << 32)) - (int64_t{1} << 31);

@@ -618,8 +618,8 @@ SHD_AVX2 inline RunInputs4 runInputs4(const Run& r, __m256i kv) {
 
 }  // namespace
 
-// bufferRun's loop: zTest8's test and writes with masked loads and stores (AVX2's 32-bit ones),
-// and the passing fragments' inputs computed in two halves of 4 64-bit lanes, each packed by
+// bufferRun's loop: zTest8's test and writes (within the row blended into plain stores, else
+// with AVX2's masked 32-bit loads and stores), and the passing fragments' inputs computed in two halves of 4 64-bit lanes, each packed by
 // a permutation (AVX2 has no compress).
 SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
   const __m256i lanes = lanes8(), dz_lanes = laneSteps(r.px.dz), tag = _mm256_set1_epi32(t.tag);
@@ -633,15 +633,26 @@ SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch
     const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * r.px.dz)), dz_lanes);
     __builtin_prefetch(depth + 2 * t.width);  // as zTest8
     __builtin_prefetch(depth + 2 * t.width + 7);
-    const __m256i old = _mm256_maskload_epi32(depth, valid);
+    // Within the run's row: plain loads and stores, the failing lanes' values written back as
+    // read (AVX2's masked stores are slow on AMD; colourRunsAvx2 does the same).
+    const bool in_row = k + 8 <= r.room;
+    const __m256i old = in_row ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(depth)) : _mm256_maskload_epi32(depth, valid);
     const __m256i pass = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
     const unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass)));
     if (m == 0) continue;
     const unsigned zero = static_cast<unsigned>(
         _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, _mm256_setzero_si256()))));
     covered += static_cast<uint64_t>(__builtin_popcount(m & zero));
-    _mm256_maskstore_epi32(depth, pass, z);
-    if (t.tri != nullptr) _mm256_maskstore_epi32(t.tri + p, pass, tag);
+    if (in_row) {
+      _mm256_storeu_si256(reinterpret_cast<__m256i*>(depth), _mm256_blendv_epi8(old, z, pass));
+      if (t.tri != nullptr) {
+        __m256i* const tri = reinterpret_cast<__m256i*>(t.tri + p);
+        _mm256_storeu_si256(tri, _mm256_blendv_epi8(_mm256_loadu_si256(tri), tag, pass));
+      }
+    } else {
+      _mm256_maskstore_epi32(depth, pass, z);
+      if (t.tri != nullptr) _mm256_maskstore_epi32(t.tri + p, pass, tag);
+    }
     const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(p)), lanes);
     for (unsigned half = 0; half < 2; ++half) {
       const unsigned mh = (m >> (4 * half)) & 0xF;

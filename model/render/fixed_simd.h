@@ -86,6 +86,7 @@ struct Run {
   RunPixels px;
   uint64_t a = 0, two_b = 0, c = 0;
   uint64_t l = 0, dl = 0, h = 0, dh = 0;
+  size_t room = 0;  // pixels from the run's first to the end of its row (bufferRunAvx2's blends)
 };
 
 // The depth and triangle buffers the run's fragments are tested against and written to. The

@@ -156,6 +156,7 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   fixed_simd::Run run;
   run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(t.W) + static_cast<size_t>(r.x0),
             static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])};
+  run.room = static_cast<size_t>(t.W - r.x0);
   run.a = sq.a;
   run.two_b = sq.two_b;
   run.c = sq.c;
