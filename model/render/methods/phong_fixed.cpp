@@ -153,17 +153,17 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   }
   kernel.start(r.a0, r.da);
   const auto sq = SquaredNormRecurrence::terms({r.a0[0], r.a0[1], r.a0[2]}, {r.da[0], r.da[1], r.da[2]});
-  fixed_simd::Run run;
-  run.px = {static_cast<size_t>(r.y) * static_cast<size_t>(t.W) + static_cast<size_t>(r.x0),
-            static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])};
-  run.room = static_cast<size_t>(t.W - r.x0);
-  run.a = sq.a;
-  run.two_b = sq.two_b;
-  run.c = sq.c;
-  run.l = kernel.dotL();
-  run.dl = kernel.stepL();
-  run.h = kernel.dotH();
-  run.dh = kernel.stepH();
+  // Every member given (no zeroing of the whole object first).
+  const fixed_simd::Run run{{static_cast<size_t>(r.y) * static_cast<size_t>(t.W) + static_cast<size_t>(r.x0),
+                             static_cast<size_t>(r.count), static_cast<uint32_t>(r.a0[3]), static_cast<uint32_t>(r.da[3])},
+                            sq.a,
+                            sq.two_b,
+                            sq.c,
+                            kernel.dotL(),
+                            kernel.stepL(),
+                            kernel.dotH(),
+                            kernel.stepH(),
+                            static_cast<size_t>(t.W - r.x0)};
   uint64_t newly = 0, passed = 0;
   for (size_t k = 0;;) {
     const size_t buffered = t.batch.n;
