@@ -541,6 +541,8 @@ SHD_AVX2 inline bool shadeGroupAvx2(const NhParams& p, const uint64_t* sq, const
   return true;
 }
 
+// shadeGroups' loop, written out for the AVX2 group: a loop shared by both would have to inline
+// a group of either target, which a function of neither target cannot.
 template <bool kCodes>
 SHD_AVX2 uint64_t shadeGroupsAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                                   uint8_t* const rgb[3], int64_t* const codes[3]) {

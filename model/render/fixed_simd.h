@@ -1,6 +1,7 @@
 // Fixed-point fragment work 8 fragments at a time, in AVX-512 (F, DQ, CD, VL, BW) where the
-// CPU has it (flat and Gouraud runs also in AVX2 where it has that alone): the z-test and writes of the runs of a row (flat and Gouraud colours; phong-fixed's
-// inputs into a batch), and phong-fixed's datapath, the same integer operations as
+// CPU has it, else in AVX2 where it has that: the z-test and writes of the runs of a row (flat
+// and Gouraud colours; phong-fixed's inputs into a batch), and phong-fixed's datapath, the same
+// integer operations as
 // FixedPointShader::shade() (fixed_shading.h, normalize.h), lane by lane, so the same colours.
 // The datapath covers the common case, one directional light and a lobe of N.H from a table
 // (blinn, pow, normalized-blinn, schlick); everything else, and lanes it cannot take (a squared
@@ -12,6 +13,10 @@
 //                  products, plus the carry of adding 2^63 to the low word;
 //   idx            ((mq - 2^30) << 10) / (3 2^30) = ((mq - 2^30) >> 20) / 3, the quotient by 3 of
 //                  a number below 3072 as a multiply and shift (exact below 2^15).
+// AVX2 lacks AVX-512's 64-bit multiply, arithmetic shift, minimum and maximum, count of
+// leading zeros and compress: there the low 64 bits of a product come from three 32 x 32
+// products, the shifts and clamps from compares, the bit length from the scalar count per
+// lane, the packing from a permutation table.
 // Test FixedSimd.* compares the lanes with shade() on random and extreme inputs.
 #pragma once
 

@@ -9,11 +9,11 @@
 //              (requests batched per triangle), rows that are not runs, the RTL's span unit;
 //   runs       a whole run of a row by the shader's run kernel: the dot products stepped by
 //              constant increments (directional lights, device lobes on the unit's memo);
-//   batch      the vector kernel's case (one directional light, a lobe of N.H, AVX-512): the
-//              runs of an object's triangles z-tested and buffered (fixed_simd::bufferRun) and
-//              shaded 8 at a time (fixed_simd::shadeNh). The groups are independent, so the
-//              processor overlaps them, where one group per row of 5 or 6 pixels would wait out
-//              its own latency.
+//   batch      the vector kernels' case (one directional light, a lobe of N.H, AVX-512 or
+//              AVX2): the runs of an object's triangles z-tested and buffered
+//              (fixed_simd::bufferKernel) and shaded 8 at a time (fixed_simd::nhKernel). The
+//              groups are independent, so the processor overlaps them, where one group per
+//              row of 5 or 6 pixels would wait out its own latency.
 #include <algorithm>
 #include <cmath>
 #include <optional>
