@@ -15,7 +15,7 @@ Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Fra
       ctx(makeShadeContext(scene)),
       span(span),
       walker(span.walker()),
-      vector_runs(opt.vector_kernel && fixed_simd::nhKernel() != nullptr && walker != nullptr && walker->AttrBits <= 32),
+      buffer_run(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::bufferKernel() : nullptr),
       colour_kernel(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::colourKernel()
                                                                                       : nullptr),
       avx2(opt.vector_kernel && fixed_simd::availableAvx2()) {}

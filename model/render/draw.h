@@ -231,9 +231,10 @@ class Frame {
   const ShadeContext ctx;
   SpanEngine& span;
   const SpanParams* const walker;  // span.walker(): fragments shaded as the model's walk produces them
-  // Runs of a row to the vector kernels (fixed_simd.h): left to right, with depth codes that
-  // fit int32_t (AttrBits <= 32).
-  const bool vector_runs;
+  // phong-fixed's runs of a row to the vector kernels (fixed_simd.h): left to right, with depth
+  // codes that fit int32_t (AttrBits <= 32), z-tested into the batch by this kernel
+  // (fixed_simd::bufferKernel, AVX-512 or AVX2); null: the scalar run loop.
+  const fixed_simd::BufferKernel buffer_run;
   // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
   // (fixed_simd::colourKernel); null: the scalar loop.
   const fixed_simd::ColourKernel colour_kernel;

@@ -234,15 +234,14 @@ SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, uint32
   return pass;
 }
 
-template <bool kCodes>
-SHD_AVX512 uint64_t shadeGroups(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                                uint8_t* const rgb[3], int64_t* const codes[3]) {
+// shadeNh's loop: the groups of 8 of n fragments, group(i, count) shading fragments i .. i +
+// count - 1 (false: it declines them); returns the groups declined. Inlined into each kernel
+// with the kernel's group, a lambda with the kernel's target.
+template <class Group>
+[[gnu::always_inline]] inline uint64_t eachGroup(size_t n, Group group) {
   uint64_t declined = 0;
-  for (size_t g = 0; g * 8 < n; ++g) {
-    const size_t i = g * 8;
-    if (!shadeGroup<kCodes>(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), i, rgb, codes))
-      declined |= uint64_t{1} << g;
-  }
+  for (size_t g = 0; g * 8 < n; ++g)
+    if (!group(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)))) declined |= uint64_t{1} << g;
   return declined;
 }
 
@@ -250,7 +249,13 @@ SHD_AVX512 uint64_t shadeGroups(const NhParams& p, const uint64_t* sq, const uin
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
-  return codes != nullptr ? shadeGroups<true>(p, sq, l, h, n, rgb, codes) : shadeGroups<false>(p, sq, l, h, n, rgb, nullptr);
+  if (codes != nullptr)
+    return eachGroup(n, [&](size_t i, int count) SHD_AVX512 {
+      return shadeGroup<true>(p, sq + i, l + i, h + i, count, i, rgb, codes);
+    });
+  return eachGroup(n, [&](size_t i, int count) SHD_AVX512 {
+    return shadeGroup<false>(p, sq + i, l + i, h + i, count, i, rgb, nullptr);
+  });
 }
 
 SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
@@ -285,6 +290,37 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   return std::min(k, r.px.count);
 }
 
+// zTest8 in AVX2, with vector masks: the 8 fragments at pixels p + 0 .. 7 with the depth codes z
+// (`valid`: the lanes of the run). Within the run's row (in_row) plain loads, and stores of the
+// blend (the lanes that do not pass written back as read); masked stores (vpmaskmovd) are slow
+// on AMD (docs/performance.md), so they remain for a group at the row's right end. Returns the
+// passing lanes; adds to fresh those whose depth was 0.
+SHD_AVX2 inline __m256i zTest8Avx2(const Target& t, size_t p, bool in_row, __m256i valid, __m256i z, uint64_t& fresh) {
+  int32_t* const depth = t.depth + p;
+  __builtin_prefetch(depth + 2 * t.width);  // as zTest8
+  __builtin_prefetch(depth + 2 * t.width + 7);
+  const __m256i old = in_row ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(depth))
+                             : _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
+  const __m256i pass = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
+  const unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass)));
+  if (m == 0) return pass;
+  const unsigned zero =
+      static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, _mm256_setzero_si256()))));
+  fresh += static_cast<uint64_t>(__builtin_popcount(m & zero));
+  const __m256i tag = _mm256_set1_epi32(t.tag);
+  if (in_row) {
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(depth), _mm256_blendv_epi8(old, z, pass));
+    if (t.tri != nullptr) {
+      __m256i* const tri = reinterpret_cast<__m256i*>(t.tri + p);
+      _mm256_storeu_si256(tri, _mm256_blendv_epi8(_mm256_loadu_si256(tri), tag, pass));
+    }
+  } else {
+    _mm256_maskstore_epi32(depth, pass, z);
+    if (t.tri != nullptr) _mm256_maskstore_epi32(t.tri + p, pass, tag);
+  }
+  return pass;
+}
+
 // colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
 // the mask registers; the depth and tag blended into 32-byte stores within the row (else masked
 // 32-bit stores), the colour bytes as below.
@@ -294,7 +330,6 @@ SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, ui
   const RunLanes l = runLanes(r);
   const __m256i lanes = lanes8();
   const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
-  const __m256i tag = _mm256_set1_epi32(t.tag), zero = _mm256_setzero_si256();
   uint64_t covered = 0;
   for (size_t i = 0; i < r.n; ++i) {
     const ColourRuns::Row& row = r.rows[i];
@@ -303,39 +338,17 @@ SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, ui
       const int n = static_cast<int>(std::min<size_t>(8, row.count - k));
       const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
       const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(g.zk)), l.dz);
-      int32_t* const depth = t.depth + row.p + k;
-      __builtin_prefetch(depth + 2 * t.width);
-      __builtin_prefetch(depth + 2 * t.width + 7);
-      // The tags and the colours there are read and written below: fetched for writing.
+      // The tags and the colours of the row after next are read and written: fetched for writing.
       if (t.tri != nullptr) {
         __builtin_prefetch(t.tri + row.p + k + 2 * t.width, 1);
         __builtin_prefetch(t.tri + row.p + k + 2 * t.width + 7, 1);
       }
       __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width), 1);
       __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width) + 31, 1);
-      // The 8 pixels lie in the run's row: plain loads, and stores of the blend (the pixels
-      // that do not pass written back as read). Masked stores (vpmaskmovd) are slow on AMD
-      // (docs/performance.md); they remain for a group at the row's right end.
-      const bool in_row = k + 8 <= row.room;
-      int32_t* const tri = t.tri != nullptr ? t.tri + row.p + k : nullptr;
-      const __m256i old = in_row ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(depth))
-                                 : _mm256_maskload_epi32(depth, valid);  // 0 in the lanes past the run
-      const __m256i pass_v = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
+      const __m256i pass_v = zTest8Avx2(t, row.p + k, k + 8 <= row.room, valid, z, covered);
       const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
       if (pass != 0) {
         passed += static_cast<uint64_t>(__builtin_popcount(pass));
-        const unsigned fresh = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, zero))));
-        covered += static_cast<uint64_t>(__builtin_popcount(pass & fresh));
-        if (in_row) {
-          _mm256_storeu_si256(reinterpret_cast<__m256i*>(depth), _mm256_blendv_epi8(old, z, pass_v));
-          if (tri != nullptr) {
-            const __m256i tri_old = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(tri));
-            _mm256_storeu_si256(reinterpret_cast<__m256i*>(tri), _mm256_blendv_epi8(tri_old, tag, pass_v));
-          }
-        } else {
-          _mm256_maskstore_epi32(depth, pass_v, z);
-          if (tri != nullptr) _mm256_maskstore_epi32(tri, pass_v, tag);
-        }
         // The 8 pixels' 24 bytes, in order.
         alignas(32) uint8_t bytes[32];
         _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(l, g.ck), join));
@@ -541,26 +554,17 @@ SHD_AVX2 inline bool shadeGroupAvx2(const NhParams& p, const uint64_t* sq, const
   return true;
 }
 
-// shadeGroups' loop, written out for the AVX2 group: a loop shared by both would have to inline
-// a group of either target, which a function of neither target cannot.
-template <bool kCodes>
-SHD_AVX2 uint64_t shadeGroupsAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                                  uint8_t* const rgb[3], int64_t* const codes[3]) {
-  uint64_t declined = 0;
-  for (size_t g = 0; g * 8 < n; ++g) {
-    const size_t i = g * 8;
-    if (!shadeGroupAvx2<kCodes>(p, sq + i, l + i, h + i, static_cast<int>(std::min<size_t>(8, n - i)), i, rgb, codes))
-      declined |= uint64_t{1} << g;
-  }
-  return declined;
-}
-
 }  // namespace
 
 SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                               uint8_t* const rgb[3], int64_t* const codes[3]) {
-  return codes != nullptr ? shadeGroupsAvx2<true>(p, sq, l, h, n, rgb, codes)
-                          : shadeGroupsAvx2<false>(p, sq, l, h, n, rgb, nullptr);
+  if (codes != nullptr)
+    return eachGroup(n, [&](size_t i, int count) SHD_AVX2 {
+      return shadeGroupAvx2<true>(p, sq + i, l + i, h + i, count, i, rgb, codes);
+    });
+  return eachGroup(n, [&](size_t i, int count) SHD_AVX2 {
+    return shadeGroupAvx2<false>(p, sq + i, l + i, h + i, count, i, rgb, nullptr);
+  });
 }
 
 // ---- bufferRun in AVX2 ----
@@ -620,41 +624,20 @@ SHD_AVX2 inline RunInputs4 runInputs4(const Run& r, __m256i kv) {
 
 }  // namespace
 
-// bufferRun's loop: zTest8's test and writes (within the row blended into plain stores, else
-// with AVX2's masked 32-bit loads and stores), and the passing fragments' inputs computed in two halves of 4 64-bit lanes, each packed by
-// a permutation (AVX2 has no compress).
+// bufferRun's loop with zTest8Avx2, and the passing fragments' inputs computed in two halves of
+// 4 64-bit lanes, each packed by a permutation (AVX2 has no compress).
 SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
-  const __m256i lanes = lanes8(), dz_lanes = laneSteps(r.px.dz), tag = _mm256_set1_epi32(t.tag);
+  const __m256i lanes = lanes8(), dz_lanes = laneSteps(r.px.dz);
   const __m256i lane4 = _mm256_setr_epi64x(0, 1, 2, 3);
   size_t n = b.n, k = first;
   uint64_t covered = 0;
   for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
     const size_t p = r.px.p + k;
-    int32_t* const depth = t.depth + p;
     const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int32_t>(std::min<size_t>(8, r.px.count - k))), lanes);
     const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * r.px.dz)), dz_lanes);
-    __builtin_prefetch(depth + 2 * t.width);  // as zTest8
-    __builtin_prefetch(depth + 2 * t.width + 7);
-    // Within the run's row: plain loads and stores, the failing lanes' values written back as
-    // read (AVX2's masked stores are slow on AMD; colourRunsAvx2 does the same).
-    const bool in_row = k + 8 <= r.room;
-    const __m256i old = in_row ? _mm256_loadu_si256(reinterpret_cast<const __m256i*>(depth)) : _mm256_maskload_epi32(depth, valid);
-    const __m256i pass = _mm256_and_si256(valid, _mm256_cmpgt_epi32(z, old));
-    const unsigned m = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass)));
+    const unsigned m = static_cast<unsigned>(
+        _mm256_movemask_ps(_mm256_castsi256_ps(zTest8Avx2(t, p, k + 8 <= r.room, valid, z, covered))));
     if (m == 0) continue;
-    const unsigned zero = static_cast<unsigned>(
-        _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(old, _mm256_setzero_si256()))));
-    covered += static_cast<uint64_t>(__builtin_popcount(m & zero));
-    if (in_row) {
-      _mm256_storeu_si256(reinterpret_cast<__m256i*>(depth), _mm256_blendv_epi8(old, z, pass));
-      if (t.tri != nullptr) {
-        __m256i* const tri = reinterpret_cast<__m256i*>(t.tri + p);
-        _mm256_storeu_si256(tri, _mm256_blendv_epi8(_mm256_loadu_si256(tri), tag, pass));
-      }
-    } else {
-      _mm256_maskstore_epi32(depth, pass, z);
-      if (t.tri != nullptr) _mm256_maskstore_epi32(t.tri + p, pass, tag);
-    }
     const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(p)), lanes);
     for (unsigned half = 0; half < 2; ++half) {
       const unsigned mh = (m >> (4 * half)) & 0xF;
@@ -711,6 +694,5 @@ NhKernel nhKernel() { return nullptr; }
 BufferKernel bufferKernel() { return nullptr; }
 
 #endif
-
 
 }  // namespace shd::fixed_simd

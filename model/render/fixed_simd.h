@@ -1,8 +1,8 @@
 // Fixed-point fragment work 8 fragments at a time, in AVX-512 (F, DQ, CD, VL, BW) where the
 // CPU has it, else in AVX2 where it has that: the z-test and writes of the runs of a row (flat
 // and Gouraud colours; phong-fixed's inputs into a batch), and phong-fixed's datapath, the same
-// integer operations as
-// FixedPointShader::shade() (fixed_shading.h, normalize.h), lane by lane, so the same colours.
+// integer operations as FixedPointShader::shade() (fixed_shading.h, normalize.h), lane by lane,
+// so the same colours.
 // The datapath covers the common case, one directional light and a lobe of N.H from a table
 // (blinn, pow, normalized-blinn, schlick); everything else, and lanes it cannot take (a squared
 // norm below 2^8, see CosineScale), stays scalar.

@@ -40,7 +40,6 @@ struct FixedTriangle {
         batched(frame.batchesRequests(Method::PhongFixed)),
         write(frame.writer(tri.tag)),
         target{depth, frame.tags(), static_cast<int32_t>(tri.tag), static_cast<size_t>(W)},
-        buffer_run(fixed_simd::bufferKernel()),
         squared_norm(tri) {}
   Frame& f;
   FixedPointShader& shader;
@@ -52,7 +51,6 @@ struct FixedTriangle {
   bool batched;  // device requests wait for the triangle's batch (PixelRequests)
   PixelWriter write;
   fixed_simd::Target target;
-  fixed_simd::BufferKernel buffer_run;  // the batch's (where Frame::vector_runs)
   SquaredNorms squared_norm;
 };
 
@@ -142,11 +140,11 @@ void flushBatch(fixed_simd::Batch& b, uint8_t* const out, Kernel& kernel) {
 }
 
 // A run into the batch: z-tested, its depth codes written, its passing fragments' squared
-// norms and dot products buffered (fixed_simd::bufferRun). Other runs (see Frame::vector_runs)
+// norms and dot products buffered (Frame::buffer_run). Other runs (null buffer_run, right to left)
 // take fixedRun.
 template <class Kernel>
 void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
-  if (!t.f.vector_runs || r.dx != 1) {
+  if (t.f.buffer_run == nullptr || r.dx != 1) {
     if (t.batch.n > 0) flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
     fixedRun(t, kernel, r);
     return;
@@ -167,7 +165,7 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   uint64_t newly = 0, passed = 0;
   for (size_t k = 0;;) {
     const size_t buffered = t.batch.n;
-    k = t.buffer_run(run, k, t.target, t.batch, newly);
+    k = t.f.buffer_run(run, k, t.target, t.batch, newly);
     passed += t.batch.n - buffered;  // the fragments that passed the z-test
     if (k >= run.px.count) break;
     flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
