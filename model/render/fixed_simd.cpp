@@ -202,15 +202,20 @@ struct GroupCodes {
 
 // Fragments k .. k + 7 of a colour run whose fragment k has the codes ck: unorm8FromCode of each
 // channel's code (clamped to [0, 255 2^frac], rounded half up to an integer), packed by packRgb.
-SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_t, 3>& ck) {
+// colourBytes8 from the 8 fragments' codes, a channel's in code[ch].
+SHD_AVX2 inline __m256i colourBytesOf(const RunLanes& l, const __m256i (&code)[3]) {
   __m256i px = _mm256_setzero_si256();
   for (size_t ch = 0; ch < 3; ++ch) {
-    const __m256i code = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(ck[ch])), l.dc[ch]);
     const __m256i u8 = _mm256_srl_epi32(
-        _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code, _mm256_setzero_si256()), l.top), l.half), l.frac);
+        _mm256_add_epi32(_mm256_min_epi32(_mm256_max_epi32(code[ch], _mm256_setzero_si256()), l.top), l.half), l.frac);
     px = _mm256_or_si256(px, _mm256_slli_epi32(u8, 8 * static_cast<int>(ch)));
   }
   return packRgb(px);
+}
+SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_t, 3>& ck) {
+  __m256i code[3];
+  for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(ck[ch])), l.dc[ch]);
+  return colourBytesOf(l, code);
 }
 
 // The z-test of the 8 fragments at pixels p + 0 .. 7 (those below `left`), fragment i with the
@@ -323,21 +328,26 @@ SHD_AVX2 inline __m256i zTest8Avx2(const Target& t, size_t p, bool in_row, __m25
 
 // colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
 // the mask registers; the depth and tag blended into 32-byte stores within the row (else masked
-// 32-bit stores), the colour bytes as below.
+// 32-bit stores), the colour bytes as below. The group's codes are kept in lanes, stepped by 8
+// steps a group (GroupCodes's values, mod 2^32), and its 24 colour bytes stored from the
+// register (a copy through memory waited on the store's forwarding).
 // The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
 // iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
 SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
   const RunLanes l = runLanes(r);
   const __m256i lanes = lanes8();
   const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
+  const __m256i step_z = _mm256_set1_epi32(static_cast<int32_t>(8 * r.dz));
+  __m256i step_c[3];
+  for (size_t ch = 0; ch < 3; ++ch) step_c[ch] = _mm256_set1_epi32(static_cast<int32_t>(8 * static_cast<uint32_t>(r.dc[ch])));
   uint64_t covered = 0;
   for (size_t i = 0; i < r.n; ++i) {
     const ColourRuns::Row& row = r.rows[i];
-    GroupCodes g(row);
-    for (size_t k = 0; k < row.count; k += 8, g.next(r)) {
+    __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(row.z)), l.dz), code[3];
+    for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(_mm256_set1_epi32(row.c[ch]), l.dc[ch]);
+    for (size_t k = 0; k < row.count; k += 8) {
       const int n = static_cast<int>(std::min<size_t>(8, row.count - k));
       const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
-      const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(g.zk)), l.dz);
       // The tags and the colours of the row after next are read and written: fetched for writing.
       if (t.tri != nullptr) {
         __builtin_prefetch(t.tri + row.p + k + 2 * t.width, 1);
@@ -350,24 +360,27 @@ SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, ui
       if (pass != 0) {
         passed += static_cast<uint64_t>(__builtin_popcount(pass));
         // The 8 pixels' 24 bytes, in order.
-        alignas(32) uint8_t bytes[32];
-        _mm256_store_si256(reinterpret_cast<__m256i*>(bytes), _mm256_permutevar8x32_epi32(colourBytes8(l, g.ck), join));
+        const __m256i bytes = _mm256_permutevar8x32_epi32(colourBytesOf(l, code), join);
         uint8_t* const out = rgb + 3 * (row.p + k);
         if (pass == 0xFF) {
-          std::memcpy(out, bytes, 24);
+          _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(bytes));
+          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 16), _mm256_extracti128_si256(bytes, 1));
         } else if (k + 11 <= row.room) {  // 32 bytes = 10 2/3 pixels, all in the row
           // The passing pixels' bytes (their lanes' all-ones packed like the colours), the rest as read.
           const __m256i mask = _mm256_permutevar8x32_epi32(packRgb(pass_v), join);
           const __m256i was = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(out));
-          const __m256i now = _mm256_load_si256(reinterpret_cast<const __m256i*>(bytes));
-          _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, now, mask));
+          _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, bytes, mask));
         } else {
+          alignas(32) uint8_t b[32];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(b), bytes);
           for (unsigned m = pass; m != 0; m &= m - 1) {
-            const int b = __builtin_ctz(m);
-            std::memcpy(out + 3 * b, bytes + 3 * b, 3);
+            const int j = __builtin_ctz(m);
+            std::memcpy(out + 3 * j, b + 3 * j, 3);
           }
         }
       }
+      z = _mm256_add_epi32(z, step_z);
+      for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(code[ch], step_c[ch]);
     }
   }
   return covered;
