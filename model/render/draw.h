@@ -238,6 +238,9 @@ class Frame {
   // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
   // (fixed_simd::colourKernel); null: the scalar loop.
   const fixed_simd::ColourKernel colour_kernel;
+  // With the AVX2 colour kernel, its pass straight from the rows' spans (fixed_simd::colourSpansAvx2);
+  // null: spanRows, then colour_kernel.
+  const fixed_simd::ColourSpansKernel colour_spans;
   // The AVX2 paths of setup: the vertex transform (transformVertexRange) and the rows' spans'
   // plane (RowSpansConfig::vector), where the CPU has AVX2 and opt.vector_kernel holds.
   const bool avx2;

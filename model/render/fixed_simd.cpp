@@ -177,15 +177,16 @@ struct RunLanes {
   __m256i top, half;
   __m128i frac;
 };
-SHD_AVX2 inline RunLanes runLanes(const ColourRuns& r) {
+SHD_AVX2 inline RunLanes runLanes(uint32_t dz, const std::array<int32_t, 3>& dc, int frac) {
   RunLanes l;
-  l.dz = laneSteps(r.dz);
-  for (size_t ch = 0; ch < 3; ++ch) l.dc[ch] = laneSteps(static_cast<uint32_t>(r.dc[ch]));
-  l.top = _mm256_set1_epi32(255 << r.frac);
-  l.half = _mm256_set1_epi32(1 << (r.frac - 1));
-  l.frac = _mm_cvtsi32_si128(r.frac);
+  l.dz = laneSteps(dz);
+  for (size_t ch = 0; ch < 3; ++ch) l.dc[ch] = laneSteps(static_cast<uint32_t>(dc[ch]));
+  l.top = _mm256_set1_epi32(255 << frac);
+  l.half = _mm256_set1_epi32(1 << (frac - 1));
+  l.frac = _mm_cvtsi32_si128(frac);
   return l;
 }
+SHD_AVX2 inline RunLanes runLanes(const ColourRuns& r) { return runLanes(r.dz, r.dc, r.frac); }
 
 // A run's codes at its group of fragments k .. k + 7: the depth code zk and the colour codes ck
 // of fragment k (mod 2^32), from the run's first and stepped 8 fragments at a time.
@@ -328,61 +329,77 @@ SHD_AVX2 inline __m256i zTest8Avx2(const Target& t, size_t p, bool in_row, __m25
 
 // colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
 // the mask registers; the depth and tag blended into 32-byte stores within the row (else masked
-// 32-bit stores), the colour bytes as below. The group's codes are kept in lanes, stepped by 8
-// steps a group (GroupCodes's values, mod 2^32), and its 24 colour bytes stored from the
+// 32-bit stores), the colour bytes as below. A run's codes are kept in lanes, stepped by 8
+// steps a group (GroupCodes's values, mod 2^32), and a group's 24 colour bytes stored from the
 // register (a copy through memory waited on the store's forwarding).
 // The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
 // iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
-SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
-  const RunLanes l = runLanes(r);
-  const __m256i lanes = lanes8();
+struct RunSteps {  // a run's lanes moved 8 fragments on
+  __m256i z, c[3];
+};
+SHD_AVX2 inline RunSteps runSteps(uint32_t dz, const std::array<int32_t, 3>& dc) {
+  RunSteps s;
+  s.z = _mm256_set1_epi32(static_cast<int32_t>(8 * dz));
+  for (size_t ch = 0; ch < 3; ++ch) s.c[ch] = _mm256_set1_epi32(static_cast<int32_t>(8 * static_cast<uint32_t>(dc[ch])));
+  return s;
+}
+// The run of count fragments at pixels p, p + 1, ... (room: to the end of its row), its first
+// group's codes in z and code[ch]. Adds to covered and passed as colourRunsAvx2.
+SHD_AVX2_PRFCHW [[gnu::always_inline]] inline void colourRunAvx2(const RunLanes& l, const RunSteps& step, const Target& t,
+                                                             uint8_t* rgb, size_t p, size_t count, size_t room, __m256i z,
+                                                             __m256i (&code)[3], uint64_t& covered, uint64_t& passed) {
   const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
-  const __m256i step_z = _mm256_set1_epi32(static_cast<int32_t>(8 * r.dz));
-  __m256i step_c[3];
-  for (size_t ch = 0; ch < 3; ++ch) step_c[ch] = _mm256_set1_epi32(static_cast<int32_t>(8 * static_cast<uint32_t>(r.dc[ch])));
-  uint64_t covered = 0;
-  for (size_t i = 0; i < r.n; ++i) {
-    const ColourRuns::Row& row = r.rows[i];
-    __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(row.z)), l.dz), code[3];
-    for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(_mm256_set1_epi32(row.c[ch]), l.dc[ch]);
-    for (size_t k = 0; k < row.count; k += 8) {
-      const int n = static_cast<int>(std::min<size_t>(8, row.count - k));
-      const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes);
-      // The tags and the colours of the row after next are read and written: fetched for writing.
-      if (t.tri != nullptr) {
-        __builtin_prefetch(t.tri + row.p + k + 2 * t.width, 1);
-        __builtin_prefetch(t.tri + row.p + k + 2 * t.width + 7, 1);
-      }
-      __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width), 1);
-      __builtin_prefetch(rgb + 3 * (row.p + k + 2 * t.width) + 31, 1);
-      const __m256i pass_v = zTest8Avx2(t, row.p + k, k + 8 <= row.room, valid, z, covered);
-      const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
-      if (pass != 0) {
-        passed += static_cast<uint64_t>(__builtin_popcount(pass));
-        // The 8 pixels' 24 bytes, in order.
-        const __m256i bytes = _mm256_permutevar8x32_epi32(colourBytesOf(l, code), join);
-        uint8_t* const out = rgb + 3 * (row.p + k);
-        if (pass == 0xFF) {
-          _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(bytes));
-          _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 16), _mm256_extracti128_si256(bytes, 1));
-        } else if (k + 11 <= row.room) {  // 32 bytes = 10 2/3 pixels, all in the row
-          // The passing pixels' bytes (their lanes' all-ones packed like the colours), the rest as read.
-          const __m256i mask = _mm256_permutevar8x32_epi32(packRgb(pass_v), join);
-          const __m256i was = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(out));
-          _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, bytes, mask));
-        } else {
-          alignas(32) uint8_t b[32];
-          _mm256_store_si256(reinterpret_cast<__m256i*>(b), bytes);
-          for (unsigned m = pass; m != 0; m &= m - 1) {
-            const int j = __builtin_ctz(m);
-            std::memcpy(out + 3 * j, b + 3 * j, 3);
-          }
+  for (size_t k = 0; k < count; k += 8) {
+    const int n = static_cast<int>(std::min<size_t>(8, count - k));
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n), lanes8());
+    // The tags and the colours of the row after next are read and written: fetched for writing.
+    if (t.tri != nullptr) {
+      __builtin_prefetch(t.tri + p + k + 2 * t.width, 1);
+      __builtin_prefetch(t.tri + p + k + 2 * t.width + 7, 1);
+    }
+    __builtin_prefetch(rgb + 3 * (p + k + 2 * t.width), 1);
+    __builtin_prefetch(rgb + 3 * (p + k + 2 * t.width) + 31, 1);
+    const __m256i pass_v = zTest8Avx2(t, p + k, k + 8 <= room, valid, z, covered);
+    const unsigned pass = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(pass_v)));
+    if (pass != 0) {
+      passed += static_cast<uint64_t>(__builtin_popcount(pass));
+      // The 8 pixels' 24 bytes, in order.
+      const __m256i bytes = _mm256_permutevar8x32_epi32(colourBytesOf(l, code), join);
+      uint8_t* const out = rgb + 3 * (p + k);
+      if (pass == 0xFF) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(bytes));
+        _mm_storel_epi64(reinterpret_cast<__m128i*>(out + 16), _mm256_extracti128_si256(bytes, 1));
+      } else if (k + 11 <= room) {  // 32 bytes = 10 2/3 pixels, all in the row
+        // The passing pixels' bytes (their lanes' all-ones packed like the colours), the rest as read.
+        const __m256i mask = _mm256_permutevar8x32_epi32(packRgb(pass_v), join);
+        const __m256i was = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(out));
+        _mm256_storeu_si256(reinterpret_cast<__m256i*>(out), _mm256_blendv_epi8(was, bytes, mask));
+      } else {
+        alignas(32) uint8_t b[32];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(b), bytes);
+        for (unsigned m = pass; m != 0; m &= m - 1) {
+          const int j = __builtin_ctz(m);
+          std::memcpy(out + 3 * j, b + 3 * j, 3);
         }
       }
-      z = _mm256_add_epi32(z, step_z);
-      for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(code[ch], step_c[ch]);
     }
+    z = _mm256_add_epi32(z, step.z);
+    for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(code[ch], step.c[ch]);
   }
+}
+
+SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  const RunLanes l = runLanes(r);
+  const RunSteps step = runSteps(r.dz, r.dc);
+  uint64_t covered = 0, pass_count = 0;
+  for (size_t i = 0; i < r.n; ++i) {
+    const ColourRuns::Row& row = r.rows[i];
+    __m256i code[3];
+    for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(_mm256_set1_epi32(row.c[ch]), l.dc[ch]);
+    colourRunAvx2(l, step, t, rgb, row.p, row.count, row.room,
+                  _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(row.z)), l.dz), code, covered, pass_count);
+  }
+  passed += pass_count;
   return covered;
 }
 
@@ -433,6 +450,37 @@ SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
   }
   r.n = n;
 }
+
+SHD_AVX2_PRFCHW uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb,
+                                         uint64_t& passed) {
+  const std::array<int32_t, 3> dc = {static_cast<int32_t>(s.didx[0]), static_cast<int32_t>(s.didx[1]),
+                                     static_cast<int32_t>(s.didx[2])};
+  const RunLanes l = runLanes(static_cast<uint32_t>(s.didx[3]), dc, frac);
+  const RunSteps step = runSteps(static_cast<uint32_t>(s.didx[3]), dc);
+  // spanRows's codes: (z, c0, c1, c2) at the row's first pixel, mod 2^32.
+  auto lanes = [](const std::array<int64_t, 4>& v) {
+    return _mm_setr_epi32(static_cast<int32_t>(v[3]), static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1]),
+                          static_cast<int32_t>(v[2]));
+  };
+  const __m128i dx = lanes(s.didx), dy = lanes(s.didy);
+  __m128i left = lanes(s.a0);  // the codes at column x0 of row y0 + i
+  uint64_t covered = 0, pass_count = 0;
+  size_t p = static_cast<size_t>(s.y0) * W;
+  for (int32_t i = 0; i < s.rows; ++i, p += W, left = _mm_add_epi32(left, dy)) {
+    const int32_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo > hi) continue;
+    const __m256i at = _mm256_castsi128_si256(_mm_add_epi32(left, _mm_mullo_epi32(dx, _mm_set1_epi32(lo - s.x0))));
+    __m256i code[3];
+    for (size_t ch = 0; ch < 3; ++ch)
+      code[ch] = _mm256_add_epi32(_mm256_permutevar8x32_epi32(at, _mm256_set1_epi32(static_cast<int32_t>(ch + 1))), l.dc[ch]);
+    colourRunAvx2(l, step, t, rgb, p + static_cast<size_t>(lo), static_cast<size_t>(hi - lo + 1), W - static_cast<size_t>(lo),
+                  _mm256_add_epi32(_mm256_broadcastd_epi32(_mm256_castsi256_si128(at)), l.dz), code, covered, pass_count);
+  }
+  passed += pass_count;
+  return covered;
+}
+
+ColourSpansKernel colourSpansKernel() { return !available() && availableAvx2() ? colourSpansAvx2 : nullptr; }
 
 ColourKernel colourKernel() {
   return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
@@ -700,6 +748,10 @@ uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const ui
   return allGroups(n);
 }
 ColourKernel colourKernel() { return nullptr; }
+uint64_t colourSpansAvx2(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&) {
+  throw std::logic_error("fixed_simd::colourSpansAvx2: built without the vector kernels");
+}
+ColourSpansKernel colourSpansKernel() { return nullptr; }
 size_t bufferRunAvx2(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRunAvx2: built without the vector kernels");
 }

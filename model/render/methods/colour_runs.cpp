@@ -133,16 +133,21 @@ struct ColourRunLoop {
 };
 
 // A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
-// walk: the runs fixed_simd::spanRows makes of its rows.
+// walk: straight from the rows (Frame::colour_spans, AVX2), or the runs fixed_simd::spanRows
+// makes of them.
 static_assert(RowSpans::kMaxRows <= fixed_simd::ColourRuns::kCap, "a triangle's rows in one call");
 void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs, const fixed_simd::Target& target) {
   const RowSpans& s = *t.rows;
   if (!t.counted) f.countRows(s);
-  fixed_simd::spanRows(s, static_cast<size_t>(f.W), runs);
   uint64_t passed = 0;
-  f.st.pixels_covered += f.colour_kernel(runs, target, f.fb.rgb.data(), passed);
+  if (f.colour_spans != nullptr) {
+    f.st.pixels_covered += f.colour_spans(s, static_cast<size_t>(f.W), runs.frac, target, f.fb.rgb.data(), passed);
+  } else {
+    fixed_simd::spanRows(s, static_cast<size_t>(f.W), runs);
+    f.st.pixels_covered += f.colour_kernel(runs, target, f.fb.rgb.data(), passed);
+    runs.n = 0;
+  }
   f.st.depth_rejected += s.fragments - passed;
-  runs.n = 0;
 }
 
 // The colour units' drawing: the walk with the fragment sink and the run loop (runs: the unit's
