@@ -201,9 +201,9 @@ struct GroupCodes {
   }
 };
 
-// Fragments k .. k + 7 of a colour run whose fragment k has the codes ck: unorm8FromCode of each
-// channel's code (clamped to [0, 255 2^frac], rounded half up to an integer), packed by packRgb.
-// colourBytes8 from the 8 fragments' codes, a channel's in code[ch].
+// The colour bytes of 8 fragments whose codes are code[ch] (a channel's in its lanes):
+// unorm8FromCode of each (clamped to [0, 255 2^frac], rounded half up to an integer), packed by
+// packRgb.
 SHD_AVX2 inline __m256i colourBytesOf(const RunLanes& l, const __m256i (&code)[3]) {
   __m256i px = _mm256_setzero_si256();
   for (size_t ch = 0; ch < 3; ++ch) {
@@ -213,6 +213,7 @@ SHD_AVX2 inline __m256i colourBytesOf(const RunLanes& l, const __m256i (&code)[3
   }
   return packRgb(px);
 }
+// The same of fragments k .. k + 7 of a colour run whose fragment k has the codes ck.
 SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_t, 3>& ck) {
   __m256i code[3];
   for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(ck[ch])), l.dc[ch]);
@@ -327,14 +328,8 @@ SHD_AVX2 inline __m256i zTest8Avx2(const Target& t, size_t p, bool in_row, __m25
   return pass;
 }
 
-// colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
-// the mask registers; the depth and tag blended into 32-byte stores within the row (else masked
-// 32-bit stores), the colour bytes as below. A run's codes are kept in lanes, stepped by 8
-// steps a group (GroupCodes's values, mod 2^32), and a group's 24 colour bytes stored from the
-// register (a copy through memory waited on the store's forwarding).
-// The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
-// iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
-struct RunSteps {  // a run's lanes moved 8 fragments on
+// A run's steps in lanes over 8 fragments: what its codes move by from one group to the next.
+struct RunSteps {
   __m256i z, c[3];
 };
 SHD_AVX2 inline RunSteps runSteps(uint32_t dz, const std::array<int32_t, 3>& dc) {
@@ -343,8 +338,17 @@ SHD_AVX2 inline RunSteps runSteps(uint32_t dz, const std::array<int32_t, 3>& dc)
   for (size_t ch = 0; ch < 3; ++ch) s.c[ch] = _mm256_set1_epi32(static_cast<int32_t>(8 * static_cast<uint32_t>(dc[ch])));
   return s;
 }
-// The run of count fragments at pixels p, p + 1, ... (room: to the end of its row), its first
-// group's codes in z and code[ch]. Adds to covered and passed as colourRunsAvx2.
+
+// colourRunsAvx512 in AVX2: zTest8 and the colour of colourRunsAvx512 below with vector masks for
+// the mask registers; the depth and tag blended into 32-byte stores within the row (else masked
+// 32-bit stores), the colour bytes as below. A run's codes are kept in lanes, stepped by 8
+// steps a group (GroupCodes's values, mod 2^32), and a group's 24 colour bytes stored from the
+// register (a copy through memory waited on the store's forwarding).
+// The loops over the runs and their groups are the AVX-512 kernel's, written out in each (one
+// iterator over the groups shared by both made a Gouraud frame 1-6 % slower, 4 interleaved runs).
+// colourRunAvx2 is one run: count fragments at pixels p, p + 1, ... (room: to the end of its
+// row), its first group's codes in z and code[ch]; it adds to covered and passed as
+// colourRunsAvx2. Both AVX2 kernels (colourRunsAvx2, colourSpansAvx2) run their runs through it.
 SHD_AVX2_PRFCHW [[gnu::always_inline]] inline void colourRunAvx2(const RunLanes& l, const RunSteps& step, const Target& t,
                                                              uint8_t* rgb, size_t p, size_t count, size_t room, __m256i z,
                                                              __m256i (&code)[3], uint64_t& covered, uint64_t& passed) {
