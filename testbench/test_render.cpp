@@ -564,7 +564,8 @@ TEST(RenderPipeline, ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle)
 // The vertex transform four at a time in AVX2 lanes against one at a time: every field of every
 // vertex the same bits, on random meshes (zero, tiny and huge normals among them; vertices on
 // both sides of the near plane and at Z = 0), under a mirroring transform and others, over
-// ranges that start and end off a multiple of four.
+// ranges that start and end off a multiple of four; and without normals (flat), the same with
+// the normal left 0 both ways.
 TEST(RenderPipeline, VectorTransformEqualsTheScalarOne) {
   if (!fixed_simd::availableAvx2()) GTEST_SKIP() << "no AVX2 here (or SHD_SCALAR set): only the scalar path runs";
   std::mt19937_64 rng(20261129);
@@ -598,10 +599,21 @@ TEST(RenderPipeline, VectorTransformEqualsTheScalarOne) {
         }
         transformVertexRange(obj, basis, cam, proj, vec.data(), b, e, true);
         transformVertexRange(obj, basis, cam, proj, scalar.data(), b, e, false);
+        // Without normals (flat): the same but for the normal, left 0 both ways.
+        std::vector<PVertex> vec_nn = vec, scalar_nn = scalar;
+        for (size_t i = 0; i < n; ++i) vec_nn[i].n = scalar_nn[i].n = {5, 5, 5};
+        transformVertexRange(obj, basis, cam, proj, vec_nn.data(), b, e, true, false);
+        transformVertexRange(obj, basis, cam, proj, scalar_nn.data(), b, e, false, false);
         for (size_t i = b; i < e; ++i) {
           ASSERT_EQ(std::memcmp(&vec[i], &scalar[i], sizeof(PVertex)), 0)
               << "vertex " << i << " of [" << b << ", " << e << "): cam " << vec[i].cam.x << " " << scalar[i].cam.x
               << ", n " << vec[i].n.x << " " << scalar[i].n.x << ", x " << vec[i].x << " " << scalar[i].x;
+          for (PVertex* v : {&vec_nn[i], &scalar_nn[i]}) {
+            ASSERT_TRUE(v->n.x == 0 && v->n.y == 0 && v->n.z == 0) << "vertex " << i << ": a normal without normals";
+            PVertex with = *v;
+            with.n = scalar[i].n;
+            ASSERT_EQ(std::memcmp(&with, &scalar[i], sizeof(PVertex)), 0) << "vertex " << i << " without normals";
+          }
           behind += scalar[i].cam.z < cam.z_near;
           projected += scalar[i].w != 0;
           zero_normals += scalar[i].n.x == 0 && scalar[i].n.y == 0 && scalar[i].n.z == 0;

@@ -34,6 +34,9 @@ struct MethodTraits {
   // Shades the Gouraud vertex colours (each vertex once, and only vertices of triangles that
   // survive back-face culling).
   bool vertex_colours;
+  // Reads the vertices' normals (PVertex::n): every method but flat, which lights each polygon
+  // by its face normal. Without, the transform leaves them 0 (transformVertexRange).
+  bool vertex_normals;
   // Evaluates the lobe per pixel: device lobes make specular-unit requests per pixel, batched
   // per triangle when the unit is not the model (Frame::batchesRequests).
   bool pixel_lobe;

@@ -90,9 +90,9 @@ namespace {
 // Vertex i of obj in camera space and, in front of the near plane, projected (v as PVertex{}
 // leaves it: the colour is the method's).
 inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                            const NormalTransform& to_world, size_t i, PVertex& v) {
+                            const NormalTransform& to_world, size_t i, bool normals, PVertex& v) {
   v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
-  v.n = normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
+  v.n = normals ? normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i]))) : Vec3{0, 0, 0};
   if (v.cam.z >= cam.z_near) proj.project(v);
 }
 
@@ -137,6 +137,7 @@ SHD_AVX2 inline __m256d pointLessEye(const double* row, const V3& p, double eye)
   return _mm256_sub_pd(_mm256_add_pd(dot(Vec3{row[0], row[1], row[2]}, p), _mm256_set1_pd(row[3])), _mm256_set1_pd(eye));
 }
 
+template <bool kNormals>
 SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                             const NormalTransform& to_world, size_t i, PVertex* out) {
   const double (*m)[4] = obj.transform.m;
@@ -144,14 +145,17 @@ SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const
   // Mat4::point: direction(p) + translation, then toCameraSpace: the basis's dots with it - eye.
   const V3 rel{pointLessEye(m[0], p, cam.eye.x), pointLessEye(m[1], p, cam.eye.y), pointLessEye(m[2], p, cam.eye.z)};
   const V3 c{dot(basis.right, rel), dot(basis.up, rel), dot(basis.forward, rel)};
-  // NormalTransform, then toCameraDirection and normalize.
-  V3 r = rows(to_world.c, load(&obj.mesh.normals[i]));
-  if (to_world.mirror) {
-    const __m256d sign = _mm256_set1_pd(-0.0);
-    r = {_mm256_xor_pd(r.x, sign), _mm256_xor_pd(r.y, sign), _mm256_xor_pd(r.z, sign)};
+  // NormalTransform, then toCameraDirection and normalize (without kNormals, 0).
+  V3 n{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
+  if constexpr (kNormals) {
+    V3 r = rows(to_world.c, load(&obj.mesh.normals[i]));
+    if (to_world.mirror) {
+      const __m256d sign = _mm256_set1_pd(-0.0);
+      r = {_mm256_xor_pd(r.x, sign), _mm256_xor_pd(r.y, sign), _mm256_xor_pd(r.z, sign)};
+    }
+    const V3 w = normalize(r);
+    n = normalize(V3{dot(basis.right, w), dot(basis.up, w), dot(basis.forward, w)});
   }
-  const V3 w = normalize(r);
-  const V3 n = normalize(V3{dot(basis.right, w), dot(basis.up, w), dot(basis.forward, w)});
   // Projection::project where Z >= z_near; elsewhere x, y and w stay 0.
   const __m256d f = _mm256_set1_pd(proj.f);
   const __m256d in = _mm256_cmp_pd(c.z, _mm256_set1_pd(cam.z_near), _CMP_GE_OQ);
@@ -179,11 +183,15 @@ SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const
 }  // namespace
 
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                          PVertex* verts, size_t begin, size_t end, bool vector) {
+                          PVertex* verts, size_t begin, size_t end, bool vector, bool normals) {
   const NormalTransform to_world(obj.transform);
 #ifdef SHD_X86_KERNELS
-  if (vector && fixed_simd::availableAvx2())
-    for (; begin + 4 <= end; begin += 4) avx2::transform4(obj, basis, cam, proj, to_world, begin, verts);
+  if (vector && fixed_simd::availableAvx2()) {
+    if (normals)
+      for (; begin + 4 <= end; begin += 4) avx2::transform4<true>(obj, basis, cam, proj, to_world, begin, verts);
+    else
+      for (; begin + 4 <= end; begin += 4) avx2::transform4<false>(obj, basis, cam, proj, to_world, begin, verts);
+  }
 #else
   (void)vector;
 #endif
@@ -193,7 +201,7 @@ void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, cons
     PVertex& v = verts[i];
     v.x = v.y = v.w = 0;
     v.colour = {};
-    transformVertex(obj, basis, cam, proj, to_world, i, v);
+    transformVertex(obj, basis, cam, proj, to_world, i, normals, v);
   }
 }
 

@@ -91,9 +91,10 @@ void clearRect(Framebuffer& fb, const ClearRect& r);
 // plane, in an array that holds them all, each one made anew (its colour left to the method,
 // render.cpp): an object's vertices, or parts of them on either thread of a two-thread frame.
 // Four at a time in AVX2 lanes where the CPU has them (fixed_simd::availableAvx2: not with
-// SHD_SCALAR) and vector holds, with the same bits as one at a time.
+// SHD_SCALAR) and vector holds, with the same bits as one at a time. Without normals (a method
+// that reads none, MethodTraits::vertex_normals) each vertex's normal is left 0.
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
-                          PVertex* verts, size_t begin, size_t end, bool vector = true);
+                          PVertex* verts, size_t begin, size_t end, bool vector = true, bool normals = true);
 
 // Where a mesh triangle goes before it is clipped.
 struct TriangleView {

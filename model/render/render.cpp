@@ -86,6 +86,7 @@ struct SharedTransform {
   PVertex* verts = nullptr;
   size_t n = 0;
   bool vector = true;  // Frame::avx2
+  bool normals = true;  // MethodTraits::vertex_normals
   alignas(64) std::atomic<size_t> next{0};
   alignas(64) std::atomic<size_t> done{0};
 
@@ -93,7 +94,7 @@ struct SharedTransform {
   void work() {
     for (size_t b; (b = next.fetch_add(kChunk, std::memory_order_relaxed)) < n;) {
       const size_t e = std::min(b + kChunk, n);
-      transformVertexRange(*obj, *basis, *cam, *proj, verts, b, e, vector);
+      transformVertexRange(*obj, *basis, *cam, *proj, verts, b, e, vector, normals);
       done.fetch_add(e - b, std::memory_order_release);
     }
   }
@@ -309,6 +310,7 @@ class SceneDrawer {
   const CameraBasis basis_;
   MethodUnit& unit_;                  // the frame's method's
   const bool vertex_colours_;         // the method's
+  const bool vertex_normals_;         // the method's
   // A two-thread frame of a TwoThreads::AfterSetup method: the back end records the triangles.
   const bool back_records_;
   TriangleSetup setup_config_;
@@ -356,6 +358,7 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       basis_(cameraBasis(scene.camera)),
       unit_(f.unit(f.opt.method)),
       vertex_colours_(traits(f.opt.method).vertex_colours),
+      vertex_normals_(traits(f.opt.method).vertex_normals),
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
       verts_(res.scratch.get().verts),
       lit_(res.scratch.get().lit),
@@ -391,7 +394,7 @@ void SceneDrawer::drawObject(size_t oi) {
   for (const auto& u : f_.units()) u.second->beginObject();
   verts_.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
   if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2);
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, vertex_normals_);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -404,6 +407,7 @@ void SceneDrawer::drawObject(size_t oi) {
     t.verts = verts_.data();
     t.n = verts_.size();
     t.vector = f_.avx2;
+    t.normals = vertex_normals_;
     t.next.store(0, std::memory_order_relaxed);
     t.done.store(0, std::memory_order_relaxed);
     queue_->push(true);  // shown to the back end at once (release)
