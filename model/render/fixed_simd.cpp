@@ -432,26 +432,38 @@ SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8
 
 // A row's codes (z, c0, c1, c2) are adjacent: one 16-byte store of the lanes (attributes 3, 0, 1, 2).
 static_assert(offsetof(ColourRuns::Row, c) == offsetof(ColourRuns::Row, z) + 4, "z, c[0], c[1], c[2] adjacent");
-SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
+// The rows of s with a pixel, top to bottom: row(p, count, room, at) with the pixel index p of
+// its first pixel, its pixel count, the pixels from p to the end of its row, and the codes
+// there (RowSpans::at mod 2^32) as (z, c0, c1, c2) in 32-bit lanes (W: pixels per framebuffer
+// row). One 4-lane multiply-add per row from the row's left (x0) codes.
+template <class Row>
+SHD_AVX2 [[gnu::always_inline]] inline void eachSpanRow(const RowSpans& s, size_t W, Row row) {
   auto lanes = [](const std::array<int64_t, 4>& v) {
     return _mm_setr_epi32(static_cast<int32_t>(v[3]), static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1]),
                           static_cast<int32_t>(v[2]));
   };
   const __m128i dx = lanes(s.didx), dy = lanes(s.didy);
-  for (size_t k = 0; k < 3; ++k) r.dc[k] = static_cast<int32_t>(s.didx[k]);
-  r.dz = static_cast<uint32_t>(s.didx[3]);
   __m128i left = lanes(s.a0);  // the codes at column x0 of row y0 + i (mod 2^32)
-  size_t n = 0, p = static_cast<size_t>(s.y0) * W;
+  size_t p = static_cast<size_t>(s.y0) * W;
   for (int32_t i = 0; i < s.rows; ++i, p += W, left = _mm_add_epi32(left, dy)) {
     const int32_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
     if (lo > hi) continue;
-    ColourRuns::Row& row = r.rows[n++];
-    row.p = p + static_cast<size_t>(lo);
-    row.count = static_cast<size_t>(hi - lo + 1);
-    row.room = W - static_cast<size_t>(lo);
-    const __m128i at = _mm_add_epi32(left, _mm_mullo_epi32(dx, _mm_set1_epi32(lo - s.x0)));
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(&row) + offsetof(ColourRuns::Row, z)), at);
+    row(p + static_cast<size_t>(lo), static_cast<size_t>(hi - lo + 1), W - static_cast<size_t>(lo),
+        _mm_add_epi32(left, _mm_mullo_epi32(dx, _mm_set1_epi32(lo - s.x0))));
   }
+}
+
+SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
+  for (size_t k = 0; k < 3; ++k) r.dc[k] = static_cast<int32_t>(s.didx[k]);
+  r.dz = static_cast<uint32_t>(s.didx[3]);
+  size_t n = 0;
+  eachSpanRow(s, W, [&](size_t p, size_t count, size_t room, __m128i at) SHD_AVX2 {
+    ColourRuns::Row& row = r.rows[n++];
+    row.p = p;
+    row.count = count;
+    row.room = room;
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(&row) + offsetof(ColourRuns::Row, z)), at);
+  });
   r.n = n;
 }
 
@@ -461,30 +473,18 @@ SHD_AVX2_PRFCHW uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, 
                                      static_cast<int32_t>(s.didx[2])};
   const RunLanes l = runLanes(static_cast<uint32_t>(s.didx[3]), dc, frac);
   const RunSteps step = runSteps(static_cast<uint32_t>(s.didx[3]), dc);
-  // spanRows's codes: (z, c0, c1, c2) at the row's first pixel, mod 2^32.
-  auto lanes = [](const std::array<int64_t, 4>& v) {
-    return _mm_setr_epi32(static_cast<int32_t>(v[3]), static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1]),
-                          static_cast<int32_t>(v[2]));
-  };
-  const __m128i dx = lanes(s.didx), dy = lanes(s.didy);
-  __m128i left = lanes(s.a0);  // the codes at column x0 of row y0 + i
   uint64_t covered = 0, pass_count = 0;
-  size_t p = static_cast<size_t>(s.y0) * W;
-  for (int32_t i = 0; i < s.rows; ++i, p += W, left = _mm_add_epi32(left, dy)) {
-    const int32_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
-    if (lo > hi) continue;
-    const __m256i at = _mm256_castsi128_si256(_mm_add_epi32(left, _mm_mullo_epi32(dx, _mm_set1_epi32(lo - s.x0))));
+  eachSpanRow(s, W, [&](size_t p, size_t count, size_t room, __m128i at4) SHD_AVX2_PRFCHW {
+    const __m256i at = _mm256_castsi128_si256(at4);
     __m256i code[3];
     for (size_t ch = 0; ch < 3; ++ch)
       code[ch] = _mm256_add_epi32(_mm256_permutevar8x32_epi32(at, _mm256_set1_epi32(static_cast<int32_t>(ch + 1))), l.dc[ch]);
-    colourRunAvx2(l, step, t, rgb, p + static_cast<size_t>(lo), static_cast<size_t>(hi - lo + 1), W - static_cast<size_t>(lo),
-                  _mm256_add_epi32(_mm256_broadcastd_epi32(_mm256_castsi256_si128(at)), l.dz), code, covered, pass_count);
-  }
+    colourRunAvx2(l, step, t, rgb, p, count, room, _mm256_add_epi32(_mm256_broadcastd_epi32(at4), l.dz), code, covered,
+                  pass_count);
+  });
   passed += pass_count;
   return covered;
 }
-
-ColourSpansKernel colourSpansKernel() { return !available() && availableAvx2() ? colourSpansAvx2 : nullptr; }
 
 ColourKernel colourKernel() {
   return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
@@ -755,7 +755,6 @@ ColourKernel colourKernel() { return nullptr; }
 uint64_t colourSpansAvx2(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourSpansAvx2: built without the vector kernels");
 }
-ColourSpansKernel colourSpansKernel() { return nullptr; }
 size_t bufferRunAvx2(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRunAvx2: built without the vector kernels");
 }

@@ -147,11 +147,9 @@ ColourKernel colourKernel();
 // spanRows and colourRunsAvx2 in one pass: a triangle's rows' spans z-tested and coloured row by
 // row, without their runs in between (the same codes, mod 2^32, and the same operations; frac:
 // the colour codes' fraction bits, as ColourRuns::frac). Returns and adds to passed as the
-// colour kernels. The kernel to use: this one where colourKernel() is colourRunsAvx2, else null
-// (spanRows and colourKernel()).
+// colour kernels. For where colourKernel() is colourRunsAvx2 (Frame::colour_spans).
 uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
 using ColourSpansKernel = uint64_t (*)(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&);
-ColourSpansKernel colourSpansKernel();
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
 // the z-test (the fragment's code above the buffer's), and where it passes the code and the
