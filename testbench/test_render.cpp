@@ -483,7 +483,7 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
   Fan fan;
   auto clip = [&](const std::array<PVertex, 3>& t, RenderStats& st) {
     verts.assign(t.begin(), t.end());
-    const TriangleView tv = viewTriangle(verts, {0, 1, 2}, cam.z_near);
+    const TriangleView tv = viewTriangle(verts.data(), {0, 1, 2}, cam.z_near);
     if (culledEarly(tv)) {
       ++st.culled_back;
       return false;
@@ -944,6 +944,8 @@ RenderResult expectTwoThreadsEqualOne(const Scene& s, RenderOptions o, ModelEngi
 // material), with the materials' own lobes and with the specular unit's quadratic lobe (at the
 // vertices of gouraud, per polygon in flat, per pixel in phong-fixed), in the paper's serial
 // unit and the full-rate Sierpinski unit, and again frame over frame into the same buffers.
+// With the materials' lobes, flat's polygons are lit ahead on one thread (a pass over each
+// object's triangles, MethodTraits::face_colours) and as they are drawn on two.
 TEST(Render, TwoThreadsEqualOneThread) {
   const SpecUnitConfig cubic_config = specConfig("cubic");
   ModelSpecEngine cubic(buildPromTable(PromRequest::fromContent(cubic_config.prom), cubic_config.rtl));

@@ -44,6 +44,13 @@ std::array<double, 3> Frame::shadeNow(Vec3 n, Vec3 p) {
   return s.lsb;
 }
 
+std::array<double, 3> Frame::faceColour(const PVertex& a, const PVertex& b, const PVertex& c) {
+  Vec3 fn = normalize(cross(b.cam - a.cam, c.cam - a.cam));
+  if (dot(fn, ctx.view) < 0) fn = -fn;  // toward the viewer
+  const Vec3 centroid = (1.0 / 3) * (a.cam + b.cam + c.cam);
+  return shadeNow(fn, centroid);
+}
+
 bool Frame::batchesRequests(Method m) const {
   return traits(m).pixel_lobe && obj.direct == nullptr && isDeviceLobe(obj.lobe);
 }

@@ -253,6 +253,12 @@ class Frame {
   // A point's shade, with its device-lobe evaluations done by the specular unit right away
   // (vertices, polygons, split points: few; pixels are batched per triangle, PixelRequests).
   std::array<double, 3> shadeNow(Vec3 n, Vec3 p);
+  // A polygon's colour by its face normal (toward the viewer) at the centroid of its vertices
+  // a, b, c (MethodTraits::face_colours).
+  std::array<double, 3> faceColour(const PVertex& a, const PVertex& b, const PVertex& c);
+  // The colour of the polygon being drawn when the drawer lit it ahead (faceColour, in a pass
+  // over the object's triangles: SceneDrawer::lightFaces), else null.
+  const std::array<double, 3>* face_colour = nullptr;
   // Fragment writes of a triangle.
   PixelWriter writer(uint32_t tag) const {
     return PixelWriter{fb.rgb.data(), fb.depth.data(), tags(), static_cast<int32_t>(tag)};

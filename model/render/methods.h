@@ -37,6 +37,12 @@ struct MethodTraits {
   // Reads the vertices' normals (PVertex::n): every method but flat, which lights each polygon
   // by its face normal. Without, the transform leaves them 0 (transformVertexRange).
   bool vertex_normals;
+  // Lights each polygon by its face normal (flat: Frame::faceColour). Where no specular unit
+  // counts the lighting, the drawer lights the polygons of an object's triangles that are not
+  // culled early in a pass of their own before it draws them (SceneDrawer::lightFaces): their
+  // square roots, divisions and pow overlap there, where one polygon's waited out its own
+  // latency before its setup.
+  bool face_colours;
   // Evaluates the lobe per pixel: device lobes make specular-unit requests per pixel, batched
   // per triangle when the unit is not the model (Frame::batchesRequests).
   bool pixel_lobe;

@@ -29,11 +29,12 @@
 
 namespace shd {
 
-// A frame's buffers kept in its result (ScratchBuffers): the current object's vertices and
-// which of them have their colour.
+// A frame's buffers kept in its result (ScratchBuffers): the current object's vertices, which
+// of them have their colour, and its triangles' face colours (lightFaces).
 struct RenderScratch {
   std::vector<PVertex> verts;
   std::vector<uint8_t> lit;
+  std::vector<std::array<double, 3>> faces;
 };
 ScratchBuffers::ScratchBuffers() : p_(std::make_unique<RenderScratch>()) {}
 ScratchBuffers::~ScratchBuffers() = default;
@@ -71,6 +72,17 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
   o.coding = codingFor(o.spec, mat);
   o.shader.emplace(f.ctx, mat, o.lobe, &o.coding);
   o.direct = o.spec != nullptr ? o.spec->model() : nullptr;
+}
+
+// The face colours (Frame::faceColour) of the triangles [b, e) of an object whose vertices are
+// transformed, those wholly in front of the near plane and not culled early: the polygons the
+// drawer will draw as the triangles themselves, unless the guard band clips them.
+void lightFaces(Frame& f, const PVertex* verts, const std::vector<std::array<uint32_t, 3>>& tris,
+                std::array<double, 3>* faces, size_t b, size_t e) {
+  for (size_t i = b; i < e; ++i) {
+    const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
+    if (tv.all_in && !culledEarly(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
+  }
 }
 
 // An object's vertices transformed by both threads of a two-thread frame: each claims chunks
@@ -311,11 +323,14 @@ class SceneDrawer {
   MethodUnit& unit_;                  // the frame's method's
   const bool vertex_colours_;         // the method's
   const bool vertex_normals_;         // the method's
+  const bool face_colours_;           // the method's
   // A two-thread frame of a TwoThreads::AfterSetup method: the back end records the triangles.
   const bool back_records_;
   TriangleSetup setup_config_;
   std::vector<PVertex>& verts_;       // the object's (the result's scratch)
   std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
+  std::vector<std::array<double, 3>>& faces_;  // the face colours lit ahead (the result's scratch)
+  bool faces_lit_ = false;            // this object's faces_ (MethodTraits::face_colours)
   Poly poly_;                         // a clipped triangle
   Fan fan_;                           // the polygon to draw
   Parts parts_;                       // its screen triangles
@@ -359,9 +374,11 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       unit_(f.unit(f.opt.method)),
       vertex_colours_(traits(f.opt.method).vertex_colours),
       vertex_normals_(traits(f.opt.method).vertex_normals),
+      face_colours_(traits(f.opt.method).face_colours),
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
       verts_(res.scratch.get().verts),
       lit_(res.scratch.get().lit),
+      faces_(res.scratch.get().faces),
       queue_(queue),
       cleared_(cleared) {
   RasterConfig rc;
@@ -393,8 +410,14 @@ void SceneDrawer::drawObject(size_t oi) {
   lightObject(f_, scene_, engines_, oi);
   for (const auto& u : f_.units()) u.second->beginObject();
   verts_.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
+  // On one thread, where no specular unit counts the lighting (Frame::shadeNow). (On two, the
+  // pass delays the back end's first triangles: flat's frame took 1.03-1.06 times as long with
+  // it, the pass shared between both threads, docs/performance.md.)
+  faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
+  if (faces_lit_) faces_.resize(obj.mesh.triangles.size());  // only those lit are read
   if (queue_ == nullptr) {
     transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, vertex_normals_);
+    if (faces_lit_) lightFaces(f_, verts_.data(), obj.mesh.triangles, faces_.data(), 0, faces_.size());
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -442,13 +465,15 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
 void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
   RenderStats& st = f_.st;
   ++st.triangles;
-  const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
+  const TriangleView tv = viewTriangle(verts_.data(), tri, f_.proj.z_near);
   if (culledEarly(tv)) {
     ++st.culled_back;
     return;
   }
   if (vertex_colours_) lightVertices(tri);
   if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
+  // Lit ahead: a triangle drawn as itself (a clipped one's fan points into poly_).
+  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
   // The screen triangles to draw (a fan of the polygon), each with the unit that draws it:
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();

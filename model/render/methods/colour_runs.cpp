@@ -180,13 +180,10 @@ class GouraudUnit final : public MethodUnit {
 class FlatUnit final : public MethodUnit {
  public:
   explicit FlatUnit(Frame& f) : MethodUnit(Method::Flat), f_(f) {}
-  // The polygon's colour: its face normal (toward the viewer) at the centroid of its first
-  // three vertices, the colour attributes of all its triangles.
+  // The polygon's colour, lit by its first three vertices (Frame::faceColour, or by the drawer
+  // ahead): the colour attributes of all its triangles.
   void parts(const Fan& fan, Parts& out) override {
-    Vec3 fn = normalize(cross(fan[1]->cam - fan[0]->cam, fan[2]->cam - fan[0]->cam));
-    if (dot(fn, f_.ctx.view) < 0) fn = -fn;  // toward the viewer
-    const Vec3 centroid = (1.0 / 3) * (fan[0]->cam + fan[1]->cam + fan[2]->cam);
-    colour_ = f_.shadeNow(fn, centroid);
+    colour_ = f_.face_colour != nullptr ? *f_.face_colour : f_.faceColour(*fan[0], *fan[1], *fan[2]);
     for (size_t k = 1; k + 1 < fan.size(); ++k) out.push_back({{fan[0], fan[k], fan[k + 1]}, this, method(), &colour_});
   }
   void draw(const SpanTriangle& t) override { drawColourRuns(f_, t, runs_); }
