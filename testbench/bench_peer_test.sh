@@ -26,10 +26,14 @@ for p in pairs:
     for t in p["rounds"]:
         assert t["peer"] == p["segments"] and t["shadesim"] > 0, t
         assert abs(t["ratio"] - t["shadesim"] / t["peer"]) < 1e-12, t
+    fastest = min(t["shadesim"] for t in p["rounds"])
+    assert p["shadesim_fastest"] == fastest and p["peer_fastest"] == p["segments"], p
+    assert abs(p["ratio_fastest"] - fastest / p["segments"]) < 1e-12, p
 print("bench_peer json: ok")
 PY
 grep -q "^gouraud (1 thread(s), 9 segments), against: echo \"frame 9.0 ms\"" out.txt
 grep -q "^median ratio " out.txt
+grep -q "^fastest rounds: shadesim [0-9.]* ms, peer 9.000 ms, ratio " out.txt
 expect2() {  # expect2 WHAT ARGS...: exit 2 with WHAT in stderr
   local what=$1; shift
   set +e
