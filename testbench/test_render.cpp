@@ -483,7 +483,7 @@ TEST(RenderPipeline, ClipToFanCutsAtTheNearPlaneAndTheGuardBand) {
   Fan fan;
   auto clip = [&](const std::array<PVertex, 3>& t, RenderStats& st) {
     verts.assign(t.begin(), t.end());
-    const TriangleView tv = viewTriangle(verts.data(), {0, 1, 2}, cam.z_near);
+    const TriangleView tv = viewTriangle(verts, {0, 1, 2}, cam.z_near);
     if (culledEarly(tv)) {
       ++st.culled_back;
       return false;

@@ -101,7 +101,7 @@ struct TriangleView {
   const PVertex *v0, *v1, *v2;
   bool all_in;  // all three vertices in front of the near plane (so projected)
 };
-inline TriangleView viewTriangle(const PVertex* verts, const std::array<uint32_t, 3>& tri, double z_near) {
+inline TriangleView viewTriangle(const std::vector<PVertex>& verts, const std::array<uint32_t, 3>& tri, double z_near) {
   const PVertex &v0 = verts[tri[0]], &v1 = verts[tri[1]], &v2 = verts[tri[2]];
   return {&v0, &v1, &v2, v0.cam.z >= z_near && v1.cam.z >= z_near && v2.cam.z >= z_near};
 }

@@ -74,12 +74,13 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
   o.direct = o.spec != nullptr ? o.spec->model() : nullptr;
 }
 
-// The face colours (Frame::faceColour) of the triangles [b, e) of an object whose vertices are
-// transformed, those wholly in front of the near plane and not culled early: the polygons the
-// drawer will draw as the triangles themselves, unless the guard band clips them.
-void lightFaces(Frame& f, const PVertex* verts, const std::vector<std::array<uint32_t, 3>>& tris,
-                std::array<double, 3>* faces, size_t b, size_t e) {
-  for (size_t i = b; i < e; ++i) {
+// The face colours (Frame::faceColour) of an object's triangles, its vertices transformed: of
+// those wholly in front of the near plane and not culled early, the polygons the drawer will
+// draw as the triangles themselves unless the guard band clips them (the others' are not set).
+void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris,
+                std::vector<std::array<double, 3>>& faces) {
+  faces.resize(tris.size());
+  for (size_t i = 0; i < tris.size(); ++i) {
     const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
     if (tv.all_in && !culledEarly(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
   }
@@ -414,10 +415,9 @@ void SceneDrawer::drawObject(size_t oi) {
   // pass delays the back end's first triangles: flat's frame took 1.03-1.06 times as long with
   // it, the pass shared between both threads, docs/performance.md.)
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
-  if (faces_lit_) faces_.resize(obj.mesh.triangles.size());  // only those lit are read
   if (queue_ == nullptr) {
     transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, vertex_normals_);
-    if (faces_lit_) lightFaces(f_, verts_.data(), obj.mesh.triangles, faces_.data(), 0, faces_.size());
+    if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, faces_);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -465,7 +465,7 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
 void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
   RenderStats& st = f_.st;
   ++st.triangles;
-  const TriangleView tv = viewTriangle(verts_.data(), tri, f_.proj.z_near);
+  const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
   if (culledEarly(tv)) {
     ++st.culled_back;
     return;
