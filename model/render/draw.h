@@ -257,7 +257,7 @@ class Frame {
   // a, b, c (MethodTraits::face_colours).
   std::array<double, 3> faceColour(const PVertex& a, const PVertex& b, const PVertex& c);
   // The colour of the polygon being drawn when the drawer lit it ahead (faceColour, in a pass
-  // over the object's triangles: SceneDrawer::lightFaces), else null.
+  // over the object's triangles: lightFaces in render.cpp), else null.
   const std::array<double, 3>* face_colour = nullptr;
   // Fragment writes of a triangle.
   PixelWriter writer(uint32_t tag) const {

@@ -39,7 +39,7 @@ struct MethodTraits {
   bool vertex_normals;
   // Lights each polygon by its face normal (flat: Frame::faceColour). Where no specular unit
   // counts the lighting, the drawer lights the polygons of an object's triangles that are not
-  // culled early in a pass of their own before it draws them (SceneDrawer::lightFaces): their
+  // culled early in a pass of their own before it draws them (lightFaces, render.cpp): their
   // square roots, divisions and pow overlap there, where one polygon's waited out its own
   // latency before its setup.
   bool face_colours;
