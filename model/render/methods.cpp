@@ -35,18 +35,18 @@ constexpr TwoThreads No = TwoThreads::No, Setup = TwoThreads::AfterSetup, Walk =
 // modified-gouraud and adaptive draw their parts with the gouraud and phong units (their own
 // attributes are never set up).
 constexpr MethodTraits kMethodTable[] = {
-    // method                  name                 attr vertex normals faces  pixel  exact  2 threads rows  unit
-    {Method::Flat,             "flat",              C, false, false,  true,   false, false, Setup,  true,  makeFlatUnit},
-    {Method::Gouraud,          "gouraud",           C, true,  true,   false,  false, false, Setup,  true,  makeGouraudUnit},
-    {Method::GouraudClassical, "gouraud-classical", C, true,  true,   false,  false, false, No,     false, makeGouraudClassicalUnit},
-    {Method::Phong,            "phong",             N, false, true,   false,  true,  false, No,     true,  makePhongUnit},
-    {Method::PhongIncremental, "phong-incremental", N, false, true,   false,  true,  false, No,     true,  makePhongIncrementalUnit},
-    {Method::PhongFixed,       "phong-fixed",       N, false, true,   false,  true,  false, Walk,   true,  makePhongFixedUnit},
-    {Method::NormalBisection,  "normal-bisection",  N, false, true,   false,  true,  false, No,     false, makeNormalBisectionUnit},
-    {Method::Biquadratic,      "biquadratic",       C, true,  true,   false,  false, false, No,     false, makeBiquadraticUnit},
-    {Method::ModifiedGouraud,  "modified-gouraud",  C, true,  true,   false,  false, false, No,     false, makeModifiedGouraudUnit},
-    {Method::Adaptive,         "adaptive",          N, true,  true,   false,  false, false, No,     false, makeAdaptiveUnit},
-    {Method::Reference,        "reference",         N, false, true,   false,  false, true,  No,     false, makeReferenceUnit},
+    // method                  name                 attr vertex faces  pixel  exact  2 threads rows  unit
+    {Method::Flat,             "flat",              C, false, true,   false, false, Setup,  true,  makeFlatUnit},
+    {Method::Gouraud,          "gouraud",           C, true,  false,  false, false, Setup,  true,  makeGouraudUnit},
+    {Method::GouraudClassical, "gouraud-classical", C, true,  false,  false, false, No,     false, makeGouraudClassicalUnit},
+    {Method::Phong,            "phong",             N, false, false,  true,  false, No,     true,  makePhongUnit},
+    {Method::PhongIncremental, "phong-incremental", N, false, false,  true,  false, No,     true,  makePhongIncrementalUnit},
+    {Method::PhongFixed,       "phong-fixed",       N, false, false,  true,  false, Walk,   true,  makePhongFixedUnit},
+    {Method::NormalBisection,  "normal-bisection",  N, false, false,  true,  false, No,     false, makeNormalBisectionUnit},
+    {Method::Biquadratic,      "biquadratic",       C, true,  false,  false, false, No,     false, makeBiquadraticUnit},
+    {Method::ModifiedGouraud,  "modified-gouraud",  C, true,  false,  false, false, No,     false, makeModifiedGouraudUnit},
+    {Method::Adaptive,         "adaptive",          N, true,  false,  false, false, No,     false, makeAdaptiveUnit},
+    {Method::Reference,        "reference",         N, false, false,  false, true,  No,     false, makeReferenceUnit},
 };
 constexpr size_t kMethodCount = std::size(kMethodTable);
 

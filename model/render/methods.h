@@ -34,12 +34,10 @@ struct MethodTraits {
   // Shades the Gouraud vertex colours (each vertex once, and only vertices of triangles that
   // survive back-face culling).
   bool vertex_colours;
-  // Reads the vertices' normals (PVertex::n): every method but flat, which lights each polygon
-  // by its face normal. Without, the transform leaves them 0 (transformVertexRange).
-  bool vertex_normals;
-  // Lights each polygon by its face normal (flat: Frame::faceColour). Where no specular unit
-  // counts the lighting, the drawer lights the polygons of an object's triangles that are not
-  // culled early in a pass of their own before it draws them (lightFaces, render.cpp): their
+  // Lights each polygon by its face normal (flat: Frame::faceColour), and so reads no vertex
+  // normal (PVertex::n): the transform leaves them 0 (transformVertexRange). Where no specular
+  // unit counts the lighting, the drawer lights the polygons of an object's triangles that are
+  // not culled early in a pass of their own before it draws them (lightFaces, render.cpp): their
   // square roots, divisions and pow overlap there, where one polygon's waited out its own
   // latency before its setup.
   bool face_colours;

@@ -92,7 +92,7 @@ void clearRect(Framebuffer& fb, const ClearRect& r);
 // render.cpp): an object's vertices, or parts of them on either thread of a two-thread frame.
 // Four at a time in AVX2 lanes where the CPU has them (fixed_simd::availableAvx2: not with
 // SHD_SCALAR) and vector holds, with the same bits as one at a time. Without normals (a method
-// that reads none, MethodTraits::vertex_normals) each vertex's normal is left 0.
+// that reads none, MethodTraits::face_colours) each vertex's normal is left 0.
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                           PVertex* verts, size_t begin, size_t end, bool vector = true, bool normals = true);
 

@@ -99,7 +99,7 @@ struct SharedTransform {
   PVertex* verts = nullptr;
   size_t n = 0;
   bool vector = true;  // Frame::avx2
-  bool normals = true;  // MethodTraits::vertex_normals
+  bool normals = true;  // not MethodTraits::face_colours
   alignas(64) std::atomic<size_t> next{0};
   alignas(64) std::atomic<size_t> done{0};
 
@@ -323,8 +323,7 @@ class SceneDrawer {
   const CameraBasis basis_;
   MethodUnit& unit_;                  // the frame's method's
   const bool vertex_colours_;         // the method's
-  const bool vertex_normals_;         // the method's
-  const bool face_colours_;           // the method's
+  const bool face_colours_;           // the method's (and so no vertex normals)
   // A two-thread frame of a TwoThreads::AfterSetup method: the back end records the triangles.
   const bool back_records_;
   TriangleSetup setup_config_;
@@ -374,7 +373,6 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       basis_(cameraBasis(scene.camera)),
       unit_(f.unit(f.opt.method)),
       vertex_colours_(traits(f.opt.method).vertex_colours),
-      vertex_normals_(traits(f.opt.method).vertex_normals),
       face_colours_(traits(f.opt.method).face_colours),
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
       verts_(res.scratch.get().verts),
@@ -416,7 +414,7 @@ void SceneDrawer::drawObject(size_t oi) {
   // it, the pass shared between both threads, docs/performance.md.)
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
   if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, vertex_normals_);
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, !face_colours_);
     if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, faces_);
   } else {
     DrawJob& j = queue_->slot();
@@ -430,7 +428,7 @@ void SceneDrawer::drawObject(size_t oi) {
     t.verts = verts_.data();
     t.n = verts_.size();
     t.vector = f_.avx2;
-    t.normals = vertex_normals_;
+    t.normals = !face_colours_;
     t.next.store(0, std::memory_order_relaxed);
     t.done.store(0, std::memory_order_relaxed);
     queue_->push(true);  // shown to the back end at once (release)
