@@ -140,7 +140,9 @@ TEST(RowSpans, EqualSetupAndTheWalkOnGeneratorTriangles) {
     const RasterConfig cfg = rendererConfig(m);
     RowSpansConfig rc(cfg);
     ASSERT_TRUE(rc.applies) << m;
-    rc.vector = mi % 2 == 1 && fixed_simd::availableAvx2();  // both planes, alternately
+    // The scalar plane and row loop, the AVX2 ones, and the AVX-512 row loop, in turn.
+    rc.vector = mi % 3 != 0 && fixed_simd::availableAvx2();
+    rc.avx512 = mi % 3 == 2 && fixed_simd::available();
     TriangleGenerator gen(31);
     SpanStream ws, ss;
     Tally tally;
@@ -186,10 +188,12 @@ TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
   // slivers, and every attribute range end.
   std::mt19937_64 rng(33);
   std::uniform_real_distribution<double> u(0, 1);
-  for (const std::string& m : {std::string("serial"), std::string("evenodd"), std::string("seg4full")}) {
+  for (const std::string& m : {std::string("serial"), std::string("evenodd"), std::string("seg4full")})
+    for (const bool avx512 : {false, true}) {
     const RasterConfig cfg = rendererConfig(m, 64, 48);
     RowSpansConfig rc(cfg);
     rc.vector = fixed_simd::availableAvx2();  // the renderer's plane (the scalar one: the test above)
+    rc.avx512 = avx512 && fixed_simd::available();  // and its row loop, AVX2 or AVX-512
     SpanStream ws, ss;
     Tally tally;
     for (int n = 0; n < 20000; ++n) {
@@ -212,10 +216,11 @@ TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
     }
     EXPECT_GT(tally.outcome[RowSpansSetup::Drawn], 8000) << m;
     EXPECT_GT(tally.outcome[RowSpansSetup::Dropped], 1000) << m;
-  }
+    }
 }
 
-// The plane in AVX2 lanes (RowSpansConfig::vector) against the scalar one: the same outcome and
+// The plane in AVX2 lanes (RowSpansConfig::vector), with the AVX2 row loop and with the AVX-512
+// one (RowSpansConfig::avx512, where the CPU has it), against the scalar ones: the same outcome and
 // every field of the rows' spans, on triangles small, wide (out to the guard band) and tall (from
 // far above into the first rows: few rows, large coordinate differences), with attributes over
 // their whole range (the plane's magnitudes beyond where the vector path declines), small
@@ -223,8 +228,10 @@ TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
 TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
   if (!fixed_simd::availableAvx2()) GTEST_SKIP() << "no AVX2 (or SHD_SCALAR set)";
   const RasterConfig cfg = rendererConfig("serial");
-  RowSpansConfig scalar(cfg), vector(cfg);
+  RowSpansConfig scalar(cfg), vector(cfg), wide(cfg);
   vector.vector = true;
+  wide.vector = true;
+  wide.avx512 = fixed_simd::available();
   std::mt19937_64 rng(35);
   std::uniform_real_distribution<double> u(0, 1);
   const double lim[4] = {scalar.lim / scalar.scale[0], scalar.lim / scalar.scale[1], scalar.lim / scalar.scale[2],
@@ -247,17 +254,22 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
         else x.attr[k] = (k < 3 ? u(rng) * 255 : u(rng));
       }
     }
-    RowSpans a, b;
-    const RowSpansSetup ga = setupRowSpans(v, scalar, a), gb = setupRowSpans(v, vector, b);
+    RowSpans a;
+    const RowSpansSetup ga = setupRowSpans(v, scalar, a);
     ++outcome[ga];
-    ASSERT_EQ(ga, gb) << "triangle " << n;
-    if (ga != RowSpansSetup::Drawn) continue;
-    ASSERT_TRUE(a.y0 == b.y0 && a.rows == b.rows && a.x0 == b.x0 && a.fragments == b.fragments && a.groups == b.groups)
-        << "triangle " << n;
-    ASSERT_EQ(a.a0, b.a0) << "triangle " << n;
-    ASSERT_EQ(a.didx, b.didx) << "triangle " << n;
-    ASSERT_EQ(a.didy, b.didy) << "triangle " << n;
-    for (int32_t i = 0; i < a.rows; ++i) ASSERT_EQ(a.span[static_cast<size_t>(i)], b.span[static_cast<size_t>(i)]);
+    for (const RowSpansConfig* c : {&vector, &wide}) {
+      RowSpans b;
+      const RowSpansSetup gb = setupRowSpans(v, *c, b);
+      ASSERT_EQ(ga, gb) << "triangle " << n << (c->avx512 ? " (AVX-512 rows)" : "");
+      if (ga != RowSpansSetup::Drawn) continue;
+      ASSERT_TRUE(a.y0 == b.y0 && a.rows == b.rows && a.x0 == b.x0 && a.fragments == b.fragments &&
+                  a.groups == b.groups)
+          << "triangle " << n << (c->avx512 ? " (AVX-512 rows)" : "");
+      ASSERT_EQ(a.a0, b.a0) << "triangle " << n;
+      ASSERT_EQ(a.didx, b.didx) << "triangle " << n;
+      ASSERT_EQ(a.didy, b.didy) << "triangle " << n;
+      for (int32_t i = 0; i < a.rows; ++i) ASSERT_EQ(a.span[static_cast<size_t>(i)], b.span[static_cast<size_t>(i)]);
+    }
   }
   EXPECT_GT(outcome[RowSpansSetup::Drawn], 100000);
   EXPECT_GT(outcome[RowSpansSetup::General], 1000);  // the whole range: planes beyond 32 bits

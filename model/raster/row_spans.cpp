@@ -211,7 +211,7 @@ SHD_AVX2 bool plane(const CodesF& a, const PlaneGeom& g, RowSpans& o) {
 
 }  // namespace planeavx2
 
-namespace rowsavx2 {
+namespace rowsx86 {
 
 // The sum, the least and the greatest of 8 32-bit lanes.
 SHD_AVX2 inline __m256i swapHalves(__m256i v) { return _mm256_permute2x128_si256(v, v, 1); }
@@ -231,6 +231,54 @@ SHD_AVX2 inline int64_t max8(__m256i v) {
   v = _mm256_max_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(1, 0, 3, 2)));
   return lane0(_mm256_max_epi32(v, _mm256_shuffle_epi32(v, _MM_SHUFFLE(2, 3, 0, 1))));
 }
+
+// Pass 2 of the row loops below: RowTally::add of 8 rows at a time, in 32-bit lanes, from the
+// rows' [lo, hi] (clamped as walk's pass 1 clamps them).
+struct Tally8 {
+  RowTally& t;
+  __m256i w, none, one, align, rows8, fragments, groups, xmin, xmax;
+  __m128i shift;
+  int64_t first = -1, last = -1;
+  SHD_AVX2 Tally8(int64_t W, RowTally& tally)
+      : t(tally),
+        w(_mm256_set1_epi32(static_cast<int32_t>(W))),
+        none(_mm256_set1_epi32(-1)),
+        one(_mm256_set1_epi32(1)),
+        align(_mm256_set1_epi32(static_cast<int32_t>(tally.align))),
+        rows8(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)),
+        fragments(_mm256_setzero_si256()),
+        groups(_mm256_setzero_si256()),
+        xmin(w),
+        xmax(none),
+        shift(_mm_cvtsi32_si128(tally.lane_shift)) {}
+  // Rows g .. g + 7 (those below n).
+  SHD_AVX2 inline void add(int64_t g, int64_t n, __m256i lo, __m256i hi) {
+    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int32_t>(n - g)), rows8);
+    const __m256i any = _mm256_andnot_si256(_mm256_cmpgt_epi32(lo, hi), valid);
+    fragments = _mm256_add_epi32(fragments, _mm256_and_si256(any, _mm256_add_epi32(_mm256_sub_epi32(hi, lo), one)));
+    const __m256i span_groups =
+        _mm256_add_epi32(_mm256_sra_epi32(_mm256_sub_epi32(hi, _mm256_and_si256(lo, align)), shift), one);
+    groups = _mm256_add_epi32(groups, _mm256_and_si256(any, span_groups));
+    xmin = _mm256_min_epi32(xmin, _mm256_blendv_epi8(w, lo, any));
+    xmax = _mm256_max_epi32(xmax, _mm256_blendv_epi8(none, hi, any));
+    // span: (lo, hi) as int16_t, or (1, 0) without a pixel.
+    const __m256i span = _mm256_or_si256(_mm256_and_si256(lo, _mm256_set1_epi32(0xFFFF)), _mm256_slli_epi32(hi, 16));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(t.o->span.data() + g), _mm256_blendv_epi8(one, span, any));
+    const unsigned mask = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(any)));
+    if (mask != 0) {
+      first = first < 0 ? g + __builtin_ctz(mask) : first;
+      last = g + 31 - __builtin_clz(mask);
+    }
+  }
+  SHD_AVX2 void finish() {
+    t.first = first;
+    t.last = last;
+    t.fragments = sum8(fragments);
+    t.groups = sum8(groups);
+    t.xmin = min8(xmin);
+    t.xmax = max8(xmax);
+  }
+};
 
 // The scalar row loop in AVX2 lanes, in two passes.
 //   1. The edges: the left ones (x >= q) in lanes 0 and 1, the right ones (x <= -q) in lanes 2
@@ -276,12 +324,7 @@ SHD_AVX2 bool walk(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTal
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(bound.data() + 2 * n), zero);
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(bound.data() + 2 * n + 8), zero);
 
-  const __m256i w = _mm256_set1_epi32(static_cast<int32_t>(W)), none = _mm256_set1_epi32(-1), one = _mm256_set1_epi32(1);
-  const __m256i align = _mm256_set1_epi32(static_cast<int32_t>(t.align));
-  const __m128i shift = _mm_cvtsi32_si128(t.lane_shift);
-  const __m256i rows8 = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  __m256i fragments = zero, groups = zero, xmin = w, xmax = none;
-  int64_t first = -1, last = -1;
+  Tally8 tally(W, t);
   for (int64_t g = 0; g < n; g += 8) {
     const __m256 a = _mm256_load_ps(reinterpret_cast<const float*>(bound.data() + 2 * g));     // rows g .. g + 3
     const __m256 b = _mm256_load_ps(reinterpret_cast<const float*>(bound.data() + 2 * g + 8));  // g + 4 .. g + 7
@@ -291,33 +334,64 @@ SHD_AVX2 bool walk(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTal
     const __m256i hi = _mm256_sub_epi32(
         zero, _mm256_permute4x64_epi64(_mm256_castps_si256(_mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1))),
                                        _MM_SHUFFLE(3, 1, 2, 0)));
-    const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int32_t>(n - g)), rows8);
-    const __m256i any = _mm256_andnot_si256(_mm256_cmpgt_epi32(lo, hi), valid);
-    fragments = _mm256_add_epi32(fragments, _mm256_and_si256(any, _mm256_add_epi32(_mm256_sub_epi32(hi, lo), one)));
-    const __m256i span_groups =
-        _mm256_add_epi32(_mm256_sra_epi32(_mm256_sub_epi32(hi, _mm256_and_si256(lo, align)), shift), one);
-    groups = _mm256_add_epi32(groups, _mm256_and_si256(any, span_groups));
-    xmin = _mm256_min_epi32(xmin, _mm256_blendv_epi8(w, lo, any));
-    xmax = _mm256_max_epi32(xmax, _mm256_blendv_epi8(none, hi, any));
-    // span: (lo, hi) as int16_t, or (1, 0) without a pixel.
-    const __m256i span = _mm256_or_si256(_mm256_and_si256(lo, _mm256_set1_epi32(0xFFFF)), _mm256_slli_epi32(hi, 16));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(t.o->span.data() + g), _mm256_blendv_epi8(one, span, any));
-    const unsigned mask = static_cast<unsigned>(_mm256_movemask_ps(_mm256_castsi256_ps(any)));
-    if (mask != 0) {
-      first = first < 0 ? g + __builtin_ctz(mask) : first;
-      last = g + 31 - __builtin_clz(mask);
-    }
+    tally.add(g, n, lo, hi);
   }
-  t.first = first;
-  t.last = last;
-  t.fragments = sum8(fragments);
-  t.groups = sum8(groups);
-  t.xmin = min8(xmin);
-  t.xmax = max8(xmax);
+  tally.finish();
   return true;
 }
 
-}  // namespace rowsavx2
+// GCC 12's AVX-512 headers pass an undefined vector as the unused merge source of unmasked
+// intrinsics, which -Wmaybe-uninitialized reports (GCC bug 105593, as in render/fixed_simd.cpp).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+// walk in AVX-512 (RowSpansConfig::avx512), its pass 1 in closed form, 8 rows at once in 64-bit
+// lanes and an edge a vector: the DDA's bound after i steps is q0 + i k + ceil((i m - r0) / D)
+// (q_i = ceil(N_i / D) with N_i = q0 D - r0 + i (k D + m)). Its quotient in doubles: i m - r0
+// and D are integers below 2^47 (i < 64, 0 <= m, r0 < D, and D = |A| < 2^40 by
+// RowSpansConfig::applies), exact, and the correctly rounded quotient has the exact one's
+// ceiling: where the exact one is not an integer j, it lies at least 1 / D > 2^-40 from j and
+// from j - 1, more than half a unit in the last place of a double of magnitude up to 64
+// (2^-47), so rounding reaches neither. Each side's bound is the greatest of its edges' (a side
+// without an edge: none, as the scalar loop's), clamped as walk's. Takes every triangle.
+SHD_AVX512 void walk512(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTally& t) {
+  const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m512d iota_d = _mm512_cvtepi64_pd(iota);
+  __m512i base[3], step[3];    // q0 + i k for the group's rows, and 8 k
+  __m512d num[3], num_step[3];  // i m - r0, and 8 m
+  __m512d den[3];
+  for (size_t s = 0; s < 3; ++s) {
+    const RowEdge& g = e[s];
+    base[s] = _mm512_add_epi64(_mm512_set1_epi64(g.q), _mm512_mullo_epi64(iota, _mm512_set1_epi64(g.k)));
+    step[s] = _mm512_set1_epi64(8 * g.k);
+    const __m512d m = _mm512_set1_pd(static_cast<double>(g.m));
+    num[s] = _mm512_fmsub_pd(iota_d, m, _mm512_set1_pd(static_cast<double>(g.r)));
+    num_step[s] = _mm512_mul_pd(m, _mm512_set1_pd(8.0));
+    den[s] = _mm512_set1_pd(static_cast<double>(g.D));
+  }
+  const __m512i none = _mm512_set1_epi64(INT64_MIN);
+  const __m512i lo_min = _mm512_setzero_si512(), lo_max = _mm512_set1_epi64(W);
+  const __m512i nhi_min = _mm512_set1_epi64(1 - W), nhi_max = _mm512_set1_epi64(1);
+  Tally8 tally(W, t);
+  for (int64_t g = 0; g < n; g += 8) {
+    __m512i lo = none, nhi = none;  // the greatest bound of each side: x >= lo, x <= -nhi
+    for (size_t s = 0; s < 3; ++s) {
+      const __m512i q = _mm512_add_epi64(
+          base[s], _mm512_cvt_roundpd_epi64(_mm512_div_pd(num[s], den[s]), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
+      if (e[s].right) nhi = _mm512_max_epi64(nhi, q);
+      else lo = _mm512_max_epi64(lo, q);
+      base[s] = _mm512_add_epi64(base[s], step[s]);
+      num[s] = _mm512_add_pd(num[s], num_step[s]);
+    }
+    lo = _mm512_min_epi64(_mm512_max_epi64(lo, lo_min), lo_max);
+    nhi = _mm512_min_epi64(_mm512_max_epi64(nhi, nhi_min), nhi_max);
+    tally.add(g, n, _mm512_cvtepi64_epi32(lo), _mm256_sub_epi32(_mm256_setzero_si256(), _mm512_cvtepi64_epi32(nhi)));
+  }
+  tally.finish();
+}
+#pragma GCC diagnostic pop
+
+}  // namespace rowsx86
 #endif
 
 }  // namespace
@@ -409,7 +483,8 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   RowTally t(c, o);
   const int64_t n = r1 - r0 + 1;
 #ifdef SHD_X86_KERNELS
-  if (!vector || !rowsavx2::walk(e, n, c.W, t))
+  if (vector && c.avx512) rowsx86::walk512(e, n, c.W, t);
+  else if (!vector || !rowsx86::walk(e, n, c.W, t))
 #endif
     for (int64_t i = 0; i < n; ++i) {
       int64_t lo = 0, hi = c.W - 1;

@@ -71,6 +71,8 @@ struct RowSpansConfig {
   // The plane of the 4 attributes in AVX2 lanes, where the magnitudes allow (the same integers;
   // set only where the CPU has AVX2: the renderer's Frame::avx2).
   bool vector = false;
+  // Its row loop in AVX-512 as well (set only where the CPU has AVX-512 and vector holds).
+  bool avx512 = false;
   explicit RowSpansConfig(const RasterConfig& cfg);
 };
 

@@ -399,8 +399,11 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
     c.rs_unit.emplace(c.rc_unit);
     if (!c.rs_colour->applies) c.rs_colour.reset();
     if (!c.rs_unit->applies) c.rs_unit.reset();
-    if (c.rs_colour) c.rs_colour->vector = f.avx2;
-    if (c.rs_unit) c.rs_unit->vector = f.avx2;
+    for (std::optional<RowSpansConfig>* rs : {&c.rs_colour, &c.rs_unit})
+      if (*rs) {
+        (*rs)->vector = f.avx2;
+        (*rs)->avx512 = f.avx2 && fixed_simd::available();
+      }
   }
 }
 
