@@ -275,13 +275,14 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
   EXPECT_GT(outcome[RowSpansSetup::General], 1000);  // the whole range: planes beyond 32 bits
 }
 
-// The AVX2 colour kernel straight from the rows' spans (fixed_simd::colourSpansAvx2, flat and
-// Gouraud's with AVX2 and no AVX-512) against what it replaces, spanRows and the run kernel: the
-// same depth, tag and colour buffers and the same counts, on the generator's triangles drawn one
-// over another on a 512 x 512 frame (every other one with a triangle buffer), with colours
-// around [0, 255] and depth codes over the whole range.
-TEST(RowSpans, ColourSpansEqualSpanRowsAndTheRunKernel) {
-  if (!fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX2 here";
+// The colour kernels straight from the rows' spans (fixed_simd::colourSpansAvx2 and
+// colourSpansAvx512, flat and Gouraud's where the CPU has AVX2 or AVX-512) against what they
+// replace, spanRows and the run kernel of the same instructions: the same depth, tag and colour
+// buffers and the same counts, on the generator's triangles drawn one over another on a 512 x 512
+// frame (every other one with a triangle buffer), with colours around [0, 255] and depth codes
+// over the whole range.
+namespace {
+void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::ColourSpansKernel spans_kernel) {
   const RasterConfig cfg = rendererConfig("serial");
   const RowSpansConfig rc(cfg);
   const size_t W = 512, n = W * 512;
@@ -313,8 +314,8 @@ TEST(RowSpans, ColourSpansEqualSpanRowsAndTheRunKernel) {
     const fixed_simd::Target tb{depth_b.data(), tags ? tri_b.data() : nullptr, k, W};
     fixed_simd::spanRows(s, W, runs);
     uint64_t pa = 0, pb = 0;
-    const uint64_t ca = fixed_simd::colourRunsAvx2(runs, ta, rgb_a.data(), pa);
-    const uint64_t cb = fixed_simd::colourSpansAvx2(s, W, runs.frac, tb, rgb_b.data(), pb);
+    const uint64_t ca = runs_kernel(runs, ta, rgb_a.data(), pa);
+    const uint64_t cb = spans_kernel(s, W, runs.frac, tb, rgb_b.data(), pb);
     ASSERT_EQ(cb, ca) << "triangle " << k;
     ASSERT_EQ(pb, pa) << "triangle " << k;
     ++drawn;
@@ -332,6 +333,14 @@ TEST(RowSpans, ColourSpansEqualSpanRowsAndTheRunKernel) {
   EXPECT_LT(passed, fragments * 9 / 10);
   EXPECT_GT(covered, passed / 10);
   EXPECT_LT(covered, passed * 9 / 10);
+}
+}  // namespace
+
+TEST(RowSpans, ColourSpansEqualSpanRowsAndTheRunKernel) {
+  if (!fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX2 here";
+  colourSpansEqualRuns(fixed_simd::colourRunsAvx2, fixed_simd::colourSpansAvx2);
+  if (!fixed_simd::cpuHasAvx512()) GTEST_SKIP() << "no AVX-512 here: the AVX2 kernels alone compared";
+  colourSpansEqualRuns(fixed_simd::colourRunsAvx512, fixed_simd::colourSpansAvx512);
 }
 
 TEST(RowSpans, DeclineWhatSetupRefusesOrTheyCannotHold) {

@@ -195,10 +195,11 @@ struct GroupCodes {
   std::array<uint32_t, 3> ck;
   explicit GroupCodes(const ColourRuns::Row& row)
       : zk(row.z), ck{static_cast<uint32_t>(row.c[0]), static_cast<uint32_t>(row.c[1]), static_cast<uint32_t>(row.c[2])} {}
-  void next(const ColourRuns& r) {
-    zk += 8 * r.dz;
-    for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(r.dc[ch]);
+  void next(uint32_t dz, const std::array<int32_t, 3>& dc) {
+    zk += 8 * dz;
+    for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(dc[ch]);
   }
+  void next(const ColourRuns& r) { next(r.dz, r.dc); }
 };
 
 // The colour bytes of 8 fragments whose codes are code[ch] (a channel's in its lanes):
@@ -407,6 +408,14 @@ SHD_AVX2_PRFCHW uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, ui
   return covered;
 }
 
+// 8 pixels' colour bytes (colourBytesOf's packing) at out, each pixel's 3 where it passed.
+SHD_AVX512 inline void storeColours8(__m256i bytes, __mmask8 pass, uint8_t* out) {
+  // 3 mask bits per pass bit.
+  const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
+  _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
+  _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
+}
+
 SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8_t* rgb, uint64_t& passed) {
   const RunLanes l = runLanes(r);
   uint64_t covered = 0, pass_count = 0;
@@ -416,14 +425,7 @@ SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8
     for (size_t k = 0; k < row.count; k += 8, g.next(r)) {
       const __mmask8 pass = zTest8(t, row.p + k, row.count - k, g.zk, l.dz, covered);
       pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
-      if (pass != 0) {
-        const __m256i bytes = colourBytes8(l, g.ck);
-        // Each pixel's 3 bytes where it passed: 3 mask bits per pass bit.
-        const uint32_t lo = kSpread3[pass & 15], hi = kSpread3[(pass >> 4) & 15];
-        uint8_t* const out = rgb + 3 * (row.p + k);
-        _mm_mask_storeu_epi8(out, static_cast<__mmask16>(lo), _mm256_castsi256_si128(bytes));
-        _mm_mask_storeu_epi8(out + 12, static_cast<__mmask16>(hi), _mm256_extracti128_si256(bytes, 1));
-      }
+      if (pass != 0) storeColours8(colourBytes8(l, g.ck), pass, rgb + 3 * (row.p + k));
     }
   }
   passed += pass_count;
@@ -481,6 +483,29 @@ SHD_AVX2_PRFCHW uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, 
       code[ch] = _mm256_add_epi32(_mm256_permutevar8x32_epi32(at, _mm256_set1_epi32(static_cast<int32_t>(ch + 1))), l.dc[ch]);
     colourRunAvx2(l, step, t, rgb, p, count, room, _mm256_add_epi32(_mm256_broadcastd_epi32(at4), l.dz), code, covered,
                   pass_count);
+  });
+  passed += pass_count;
+  return covered;
+}
+
+// colourRunsAvx512's groups straight from the rows' spans, as colourSpansAvx2 does for the AVX2
+// kernel: a row's codes at its first pixel from eachSpanRow's lanes (z, c0, c1, c2).
+SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb,
+                                      uint64_t& passed) {
+  const std::array<int32_t, 3> dc = {static_cast<int32_t>(s.didx[0]), static_cast<int32_t>(s.didx[1]),
+                                     static_cast<int32_t>(s.didx[2])};
+  const uint32_t dz = static_cast<uint32_t>(s.didx[3]);
+  const RunLanes l = runLanes(dz, dc, frac);
+  uint64_t covered = 0, pass_count = 0;
+  eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
+    ColourRuns::Row row;
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(&row) + offsetof(ColourRuns::Row, z)), at);
+    GroupCodes g(row);
+    for (size_t k = 0; k < count; k += 8, g.next(dz, dc)) {
+      const __mmask8 pass = zTest8(t, p + k, count - k, g.zk, l.dz, covered);
+      pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
+      if (pass != 0) storeColours8(colourBytes8(l, g.ck), pass, rgb + 3 * (p + k));
+    }
   });
   passed += pass_count;
   return covered;
@@ -754,6 +779,9 @@ uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const ui
 ColourKernel colourKernel() { return nullptr; }
 uint64_t colourSpansAvx2(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourSpansAvx2: built without the vector kernels");
+}
+uint64_t colourSpansAvx512(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&) {
+  throw std::logic_error("fixed_simd::colourSpansAvx512: built without the vector kernels");
 }
 size_t bufferRunAvx2(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRunAvx2: built without the vector kernels");

@@ -149,6 +149,8 @@ ColourKernel colourKernel();
 // the colour codes' fraction bits, as ColourRuns::frac). Returns and adds to passed as the
 // colour kernels. For where colourKernel() is colourRunsAvx2 (Frame::colour_spans).
 uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
+// The same with colourRunsAvx512's operations, for where colourKernel() is colourRunsAvx512.
+uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
 using ColourSpansKernel = uint64_t (*)(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&);
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
