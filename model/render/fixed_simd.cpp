@@ -455,6 +455,7 @@ SHD_AVX2 [[gnu::always_inline]] inline void eachSpanRow(const RowSpans& s, size_
   }
 }
 
+static_assert(RowSpans::kMaxRows <= ColourRuns::kCap, "a triangle's rows in one ColourRuns");
 SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
   for (size_t k = 0; k < 3; ++k) r.dc[k] = static_cast<int32_t>(s.didx[k]);
   r.dz = static_cast<uint32_t>(s.didx[3]);

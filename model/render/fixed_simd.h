@@ -127,7 +127,9 @@ struct ColourRuns {
 // top to bottom (W: pixels per framebuffer row), with the codes at its first pixel (RowSpans::at
 // mod 2^32, in 32-bit lanes: the same bits), r.n their number, and the steps the triangle's
 // gradients (as the walk's runs; a run of one pixel reads none). For a CPU with AVX2 (every one
-// with AVX-512 has it): where colourKernel() is not null.
+// with AVX-512 has it). The renderer draws rows' spans with colourSpansAvx2 or colourSpansAvx512,
+// which fuse this with a run kernel; RowSpans.ColourSpansEqualSpanRowsAndTheRunKernel holds each
+// to spanRows and the run kernel of the same instructions.
 void spanRows(const RowSpans& s, size_t W, ColourRuns& r);
 
 // The runs' z-test, 8 pixels at a time, and where it passes the depth code and the tag written,

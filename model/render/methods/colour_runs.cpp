@@ -133,20 +133,12 @@ struct ColourRunLoop {
 };
 
 // A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
-// walk: straight from the rows (Frame::colour_spans, AVX2), or the runs fixed_simd::spanRows
-// makes of them.
-static_assert(RowSpans::kMaxRows <= fixed_simd::ColourRuns::kCap, "a triangle's rows in one call");
-void drawColourSpans(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& runs, const fixed_simd::Target& target) {
+// walk (Frame::colour_spans).
+void drawColourSpans(Frame& f, const SpanTriangle& t, const fixed_simd::Target& target) {
   const RowSpans& s = *t.rows;
   if (!t.counted) f.countRows(s);
   uint64_t passed = 0;
-  if (f.colour_spans != nullptr) {
-    f.st.pixels_covered += f.colour_spans(s, static_cast<size_t>(f.W), runs.frac, target, f.fb.rgb.data(), passed);
-  } else {
-    fixed_simd::spanRows(s, static_cast<size_t>(f.W), runs);
-    f.st.pixels_covered += f.colour_kernel(runs, target, f.fb.rgb.data(), passed);
-    runs.n = 0;
-  }
+  f.st.pixels_covered += f.colour_spans(s, static_cast<size_t>(f.W), kColourFrac, target, f.fb.rgb.data(), passed);
   f.st.depth_rejected += s.fragments - passed;
 }
 
@@ -159,7 +151,7 @@ void drawColourRuns(Frame& f, const SpanTriangle& t, fixed_simd::ColourRuns& run
   const PixelWriter write = f.writer(t.tag);
   const fixed_simd::Target target{fb.depth.data(), f.tags(), static_cast<int32_t>(t.tag), static_cast<size_t>(W)};
   runs.frac = kColourFrac;
-  if (t.rows != nullptr && f.colour_kernel != nullptr) return drawColourSpans(f, t, runs, target);
+  if (t.rows != nullptr && f.colour_spans != nullptr) return drawColourSpans(f, t, target);
   PendingRuns pending{f.colour_kernel, target, fb.rgb.data(), f.st.pixels_covered, f.st.depth_rejected, runs};
   ColourFragment fragment{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, pending};
   ColourRunLoop run{write, fb.depth.data(), W, f.st.pixels_covered, f.st.depth_rejected, pending};
