@@ -44,7 +44,8 @@ void BM_Frame(benchmark::State& state, Method method, const char* mode, const ch
     render(scene, opt, span, spec, frame);
     benchmark::DoNotOptimize(frame.fb.rgb.data());
   }
-  // phong-fixed's kernel on this CPU: AVX-512, AVX2, or the scalar one (SHD_SCALAR=1 forces it).
+  // phong-fixed's kernel on this CPU: AVX-512, AVX2, or the scalar one (SHD_SCALAR=1 forces it,
+  // SHD_NO_AVX512=1 the AVX2 one).
   if (method == Method::PhongFixed)
     state.SetLabel(fixed_simd::available() ? "avx512 kernel" : fixed_simd::availableAvx2() ? "avx2 kernel" : "scalar kernel");
   state.counters["fragments"] = static_cast<double>(frame.stats.fragments);

@@ -34,7 +34,12 @@ static bool scalarForced() {
   static const bool yes = std::getenv("SHD_SCALAR") != nullptr;
   return yes;
 }
-bool available() { return cpuHasAvx512() && !scalarForced(); }
+// SHD_NO_AVX512: the AVX2 kernels on a CPU with AVX-512, as a CPU without it runs them.
+static bool avx512Off() {
+  static const bool yes = std::getenv("SHD_NO_AVX512") != nullptr;
+  return yes;
+}
+bool available() { return cpuHasAvx512() && !scalarForced() && !avx512Off(); }
 bool availableAvx2() { return cpuHasAvx2() && !scalarForced(); }
 
 namespace {

@@ -28,8 +28,9 @@
 
 namespace shd::fixed_simd {
 
-// The CPU runs the vector kernel (AVX-512 F, DQ, CD, VL and BW), and SHD_SCALAR is not set in the
-// environment (which forces the scalar path, for comparisons).
+// The CPU runs the vector kernel (AVX-512 F, DQ, CD, VL and BW), and neither SHD_SCALAR (which
+// forces the scalar paths) nor SHD_NO_AVX512 (the AVX2 paths where the CPU has AVX2) is set in
+// the environment: both are for comparisons and tests.
 bool available();
 // The CPU runs the AVX2 colour-run kernel (colourRunsAvx2, without AVX-512), and SHD_SCALAR is not set.
 bool availableAvx2();
