@@ -277,7 +277,8 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
 
 // The colour kernels straight from the rows' spans (fixed_simd::colourSpansAvx2 and
 // colourSpansAvx512, flat and Gouraud's where the CPU has AVX2 or AVX-512) against what they
-// replace, spanRows and the run kernel of the same instructions: the same depth, tag and colour
+// replace, the rows' runs (emitRowSpans, as the walk hands them over) and the run kernel of the
+// same instructions: the same depth, tag and colour
 // buffers and the same counts, on the generator's triangles drawn one over another on a 512 x 512
 // frame (every other one with a triangle buffer), with colours around [0, 255] and depth codes
 // over the whole range.
@@ -312,7 +313,19 @@ void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::Colo
     const bool tags = k % 2 == 0;
     const fixed_simd::Target ta{depth_a.data(), tags ? tri_a.data() : nullptr, k, W};
     const fixed_simd::Target tb{depth_b.data(), tags ? tri_b.data() : nullptr, k, W};
-    fixed_simd::spanRows(s, W, runs);
+    // One run per row with a pixel, its codes mod 2^32; the steps are the triangle's gradients.
+    for (size_t ch = 0; ch < 3; ++ch) runs.dc[ch] = static_cast<int32_t>(s.didx[ch]);
+    runs.dz = static_cast<uint32_t>(s.didx[3]);
+    runs.n = 0;
+    auto row = [&](const RowRun& r) {
+      fixed_simd::ColourRuns::Row& out = runs.rows[runs.n++];
+      out.p = static_cast<size_t>(r.y) * W + static_cast<size_t>(r.x0);
+      out.count = static_cast<size_t>(r.count);
+      out.room = W - static_cast<size_t>(r.x0);
+      out.z = static_cast<uint32_t>(r.a0[3]);
+      for (size_t ch = 0; ch < 3; ++ch) out.c[ch] = static_cast<int32_t>(r.a0[ch]);
+    };
+    emitRowSpans(s, row);
     uint64_t pa = 0, pb = 0;
     const uint64_t ca = runs_kernel(runs, ta, rgb_a.data(), pa);
     const uint64_t cb = spans_kernel(s, W, runs.frac, tb, rgb_b.data(), pb);

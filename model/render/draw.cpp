@@ -18,9 +18,7 @@ Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Fra
       buffer_run(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::bufferKernel() : nullptr),
       colour_kernel(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::colourKernel()
                                                                                       : nullptr),
-      colour_spans(colour_kernel == fixed_simd::colourRunsAvx2     ? fixed_simd::colourSpansAvx2
-                   : colour_kernel == fixed_simd::colourRunsAvx512 ? fixed_simd::colourSpansAvx512
-                                                                   : nullptr),
+      colour_spans(colour_kernel != nullptr ? fixed_simd::colourSpansKernel() : nullptr),
       avx2(opt.vector_kernel && fixed_simd::availableAvx2()) {}
 
 Frame::~Frame() = default;

@@ -238,8 +238,8 @@ class Frame {
   // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
   // (fixed_simd::colourKernel); null: the scalar loop.
   const fixed_simd::ColourKernel colour_kernel;
-  // The colour kernel's pass straight from the rows' spans (fixed_simd::colourSpansAvx2 or
-  // colourSpansAvx512, the one of colour_kernel's instructions); null where colour_kernel is.
+  // The colour kernel's pass straight from the rows' spans (fixed_simd::colourSpansKernel);
+  // null where colour_kernel is.
   const fixed_simd::ColourSpansKernel colour_spans;
   // The AVX2 paths of setup: the vertex transform (transformVertexRange) and the rows' spans'
   // plane (RowSpansConfig::vector), where the CPU has AVX2 and opt.vector_kernel holds.

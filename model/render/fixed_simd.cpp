@@ -30,17 +30,17 @@ bool cpuHasAvx2() {
   static const bool yes = __builtin_cpu_supports("avx2");
   return yes;
 }
-static bool scalarForced() {
-  static const bool yes = std::getenv("SHD_SCALAR") != nullptr;
+static bool envSet(const char* name) { return std::getenv(name) != nullptr; }
+// SHD_SCALAR: the scalar paths; SHD_NO_AVX512: the AVX2 kernels on a CPU with AVX-512, as a CPU
+// without it runs them.
+bool available() {
+  static const bool yes = cpuHasAvx512() && !envSet("SHD_SCALAR") && !envSet("SHD_NO_AVX512");
   return yes;
 }
-// SHD_NO_AVX512: the AVX2 kernels on a CPU with AVX-512, as a CPU without it runs them.
-static bool avx512Off() {
-  static const bool yes = std::getenv("SHD_NO_AVX512") != nullptr;
+bool availableAvx2() {
+  static const bool yes = cpuHasAvx2() && !envSet("SHD_SCALAR");
   return yes;
 }
-bool available() { return cpuHasAvx512() && !scalarForced() && !avx512Off(); }
-bool availableAvx2() { return cpuHasAvx2() && !scalarForced(); }
 
 namespace {
 
@@ -200,6 +200,11 @@ struct GroupCodes {
   std::array<uint32_t, 3> ck;
   explicit GroupCodes(const ColourRuns::Row& row)
       : zk(row.z), ck{static_cast<uint32_t>(row.c[0]), static_cast<uint32_t>(row.c[1]), static_cast<uint32_t>(row.c[2])} {}
+  // From eachSpanRow's lanes (z, c0, c1, c2).
+  SHD_AVX2 explicit GroupCodes(__m128i at)
+      : zk(static_cast<uint32_t>(_mm_extract_epi32(at, 0))),
+        ck{static_cast<uint32_t>(_mm_extract_epi32(at, 1)), static_cast<uint32_t>(_mm_extract_epi32(at, 2)),
+           static_cast<uint32_t>(_mm_extract_epi32(at, 3))} {}
   void next(uint32_t dz, const std::array<int32_t, 3>& dc) {
     zk += 8 * dz;
     for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(dc[ch]);
@@ -460,21 +465,6 @@ SHD_AVX2 [[gnu::always_inline]] inline void eachSpanRow(const RowSpans& s, size_
   }
 }
 
-static_assert(RowSpans::kMaxRows <= ColourRuns::kCap, "a triangle's rows in one ColourRuns");
-SHD_AVX2 void spanRows(const RowSpans& s, size_t W, ColourRuns& r) {
-  for (size_t k = 0; k < 3; ++k) r.dc[k] = static_cast<int32_t>(s.didx[k]);
-  r.dz = static_cast<uint32_t>(s.didx[3]);
-  size_t n = 0;
-  eachSpanRow(s, W, [&](size_t p, size_t count, size_t room, __m128i at) SHD_AVX2 {
-    ColourRuns::Row& row = r.rows[n++];
-    row.p = p;
-    row.count = count;
-    row.room = room;
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(&row) + offsetof(ColourRuns::Row, z)), at);
-  });
-  r.n = n;
-}
-
 SHD_AVX2_PRFCHW uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb,
                                          uint64_t& passed) {
   const std::array<int32_t, 3> dc = {static_cast<int32_t>(s.didx[0]), static_cast<int32_t>(s.didx[1]),
@@ -504,9 +494,7 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
   const RunLanes l = runLanes(dz, dc, frac);
   uint64_t covered = 0, pass_count = 0;
   eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
-    ColourRuns::Row row;
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(reinterpret_cast<char*>(&row) + offsetof(ColourRuns::Row, z)), at);
-    GroupCodes g(row);
+    GroupCodes g(at);
     for (size_t k = 0; k < count; k += 8, g.next(dz, dc)) {
       const __mmask8 pass = zTest8(t, p + k, count - k, g.zk, l.dz, covered);
       pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
@@ -519,6 +507,9 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
 
 ColourKernel colourKernel() {
   return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
+}
+ColourSpansKernel colourSpansKernel() {
+  return available() ? colourSpansAvx512 : availableAvx2() ? colourSpansAvx2 : nullptr;
 }
 
 // ---- shadeNh in AVX2: shadeGroup's operations on 4 64-bit lanes, two per group of 8 ----
@@ -775,14 +766,12 @@ uint64_t colourRunsAvx512(const ColourRuns&, const Target&, uint8_t*, uint64_t&)
 uint64_t colourRunsAvx2(const ColourRuns&, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourRunsAvx2: built without the vector kernels");
 }
-void spanRows(const RowSpans&, size_t, ColourRuns&) {
-  throw std::logic_error("fixed_simd::spanRows: built without the vector kernels");
-}
 uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
                      int64_t* const[3]) {
   return allGroups(n);
 }
 ColourKernel colourKernel() { return nullptr; }
+ColourSpansKernel colourSpansKernel() { return nullptr; }
 uint64_t colourSpansAvx2(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourSpansAvx2: built without the vector kernels");
 }

@@ -124,15 +124,6 @@ struct ColourRuns {
   std::array<Row, kCap> rows;
 };
 
-// The runs of a triangle's rows' spans (raster/row_spans.h) into r: one per row with a pixel,
-// top to bottom (W: pixels per framebuffer row), with the codes at its first pixel (RowSpans::at
-// mod 2^32, in 32-bit lanes: the same bits), r.n their number, and the steps the triangle's
-// gradients (as the walk's runs; a run of one pixel reads none). For a CPU with AVX2 (every one
-// with AVX-512 has it). The renderer draws rows' spans with colourSpansAvx2 or colourSpansAvx512,
-// which fuse this with a run kernel; RowSpans.ColourSpansEqualSpanRowsAndTheRunKernel holds each
-// to spanRows and the run kernel of the same instructions.
-void spanRows(const RowSpans& s, size_t W, ColourRuns& r);
-
 // The runs' z-test, 8 pixels at a time, and where it passes the depth code and the tag written,
 // and the colour: unorm8FromCode of each code (shading.h) at rgb[3 pixel + ch], run after run.
 // Returns the passing pixels whose depth was 0 (not covered before); adds the passing pixels to
@@ -147,14 +138,17 @@ uint64_t colourRunsAvx2(const ColourRuns& r, const Target& t, uint8_t* rgb, uint
 using ColourKernel = uint64_t (*)(const ColourRuns&, const Target&, uint8_t*, uint64_t&);
 ColourKernel colourKernel();
 
-// spanRows and colourRunsAvx2 in one pass: a triangle's rows' spans z-tested and coloured row by
-// row, without their runs in between (the same codes, mod 2^32, and the same operations; frac:
-// the colour codes' fraction bits, as ColourRuns::frac). Returns and adds to passed as the
-// colour kernels. For where colourKernel() is colourRunsAvx2 (Frame::colour_spans).
+// colourRunsAvx2 straight from a triangle's rows' spans (raster/row_spans.h): its rows z-tested
+// and coloured row by row, each row a run from its first pixel with the codes there (RowSpans::at
+// mod 2^32, in 32-bit lanes: the same bits) and the triangle's gradients as its steps, without a
+// list of runs in between (frac: the colour codes' fraction bits, as ColourRuns::frac; W: pixels
+// per framebuffer row). Returns and adds to passed as the colour kernels.
 uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
-// The same with colourRunsAvx512's operations, for where colourKernel() is colourRunsAvx512.
+// The same with colourRunsAvx512's operations.
 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
+// The one of colourKernel()'s instructions (Frame::colour_spans), null where that is.
 using ColourSpansKernel = uint64_t (*)(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&);
+ColourSpansKernel colourSpansKernel();
 
 // Fragments first, first + 1, ... of run r, 8 at a time while the batch has room for 8 more:
 // the z-test (the fragment's code above the buffer's), and where it passes the code and the
