@@ -427,6 +427,118 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   if (fixed_simd::cpuHasAvx2()) checkBufferKernel("avx2", fixed_simd::bufferRunAvx2);
 }
 
+// fixed_simd::bufferSpans and bufferSpansAvx2 against what phong-fixed did before them with a
+// triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made a Run as
+// batchRun makes it (dot58 of the codes at its first pixel, SquaredNormRecurrence::terms) and
+// buffered by the kernel's bufferRun, already held to the run loop above. Random rows' spans of
+// up to 64 rows, with rows without a pixel and rows of one, attribute codes over the whole
+// int32_t range (so the dot products and squared norms wrap mod 2^64), random subsets of the
+// rows (RowShare), depth buffers around the codes, and batches filled to every level: the same
+// entries in the same order, depth and tag buffers and fresh pixels.
+static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spans, fixed_simd::BufferKernel runs) {
+  SCOPED_TRACE(name);
+  std::mt19937_64 rng(23);
+  constexpr size_t W = 80, H = 80;  // rows y0 + 64 and the prefetches of the row after next
+  auto batch = std::make_unique<fixed_simd::Batch>();
+  uint64_t fragments = 0, passed = 0, stops = 0, masked = 0;
+  for (int t = 0; t < 4000; ++t) {
+    RowSpans s;
+    s.rows = 1 + static_cast<int32_t>(t % 4 == 0 ? rng() % RowSpans::kMaxRows : rng() % 10);
+    s.y0 = static_cast<int32_t>(rng() % (H - 2 - static_cast<size_t>(s.rows)));
+    for (int32_t i = 0; i < s.rows; ++i) {
+      const int16_t lo = static_cast<int16_t>(rng() % W), pick = static_cast<int16_t>(rng() % 8);
+      const int16_t hi = pick == 0 ? static_cast<int16_t>(lo - 1) : (pick == 1 ? lo : static_cast<int16_t>(std::min<size_t>(W - 1, lo + rng() % 40)));
+      s.span[static_cast<size_t>(i)] = {lo, hi};
+    }
+    s.x0 = std::max<int32_t>(0, s.span[0][0]);
+    for (size_t k = 0; k < 4; ++k) {  // at() within int32_t is not needed: the kernel's arithmetic wraps
+      s.a0[k] = static_cast<int64_t>(static_cast<int32_t>(rng()));
+      s.didx[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 31))) - (int64_t{1} << 20);
+      s.didy[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 31))) - (int64_t{1} << 20);
+    }
+    fixed_simd::NhSpans r{&s, ~uint64_t{0}, {}, {}, W};
+    for (size_t k = 0; k < 3; ++k) {
+      r.l[k] = static_cast<int32_t>(rng());
+      r.h[k] = static_cast<int32_t>(rng());
+    }
+    if (t % 3 == 0) {
+      r.rows = rng();
+      masked += static_cast<uint64_t>(s.rows - __builtin_popcountll(r.rows & (~uint64_t{0} >> (64 - s.rows))));
+    }
+    // Depth: around each fragment's code (below, equal, above, or 0), random elsewhere.
+    std::vector<int32_t> depth(W * H);
+    for (int32_t& d : depth) d = static_cast<int32_t>(rng());
+    for (int32_t i = 0; i < s.rows; ++i)
+      for (int64_t x = s.span[static_cast<size_t>(i)][0]; x <= s.span[static_cast<size_t>(i)][1]; ++x) {
+        const uint32_t z = static_cast<uint32_t>(s.at(3, x, i));
+        const uint64_t pick = rng() % 4;
+        depth[static_cast<size_t>(s.y0 + i) * W + static_cast<size_t>(x)] =
+            static_cast<int32_t>(pick == 0 ? 0u : (pick == 1 ? z : z + static_cast<uint32_t>(rng() % 5) - 2u));
+      }
+    std::vector<int32_t> tri(depth.size(), -1), want_depth = depth, want_tri = tri;
+    const size_t level = rng() % (fixed_simd::Batch::kCap + 1);
+    // The reference: the rows' runs, one bufferRun call after another.
+    std::vector<std::array<uint64_t, 4>> want, got;  // sq, l, h, pixel
+    uint64_t want_fresh = 0, fresh = 0;
+    batch->n = level;
+    auto take = [&](std::vector<std::array<uint64_t, 4>>& out, size_t from) {
+      for (size_t i = from; i < batch->n; ++i) out.push_back({batch->sq[i], batch->l[i], batch->h[i], batch->pixel[i]});
+    };
+    auto row_run = [&](const RowRun& rr) {
+      const SquaredNormRecurrence::Terms sq =
+          SquaredNormRecurrence::terms({rr.a0[0], rr.a0[1], rr.a0[2]}, {rr.da[0], rr.da[1], rr.da[2]});
+      fixed_simd::Run run{{static_cast<size_t>(rr.y) * W + static_cast<size_t>(rr.x0), static_cast<size_t>(rr.count),
+                           static_cast<uint32_t>(rr.a0[3]), static_cast<uint32_t>(rr.da[3])},
+                          sq.a, sq.two_b, sq.c,
+                          static_cast<uint64_t>(fixed_detail::dot58(rr.a0, r.l)),
+                          static_cast<uint64_t>(fixed_detail::dot58(rr.da, r.l)),
+                          static_cast<uint64_t>(fixed_detail::dot58(rr.a0, r.h)),
+                          static_cast<uint64_t>(fixed_detail::dot58(rr.da, r.h)),
+                          W - static_cast<size_t>(rr.x0)};
+      const fixed_simd::Target target{want_depth.data(), want_tri.data(), 5, W};
+      for (size_t k = 0;;) {
+        const size_t from = batch->n;
+        k = runs(run, k, target, *batch, want_fresh);
+        take(want, from);
+        if (k >= run.px.count) break;
+        batch->n = 0;
+      }
+      fragments += static_cast<uint64_t>(rr.count);
+    };
+    emitRowSpans(s, row_run, [&](int32_t y) { return ((r.rows >> (y - s.y0)) & 1) != 0; });
+    // The kernel, from the same batch level.
+    batch->n = level;
+    const fixed_simd::Target target{depth.data(), tri.data(), 5, W};
+    fixed_simd::SpanCursor at;
+    for (;;) {
+      const size_t from = batch->n;
+      const bool done = spans(r, at, target, *batch, fresh);
+      take(got, from);
+      if (done) break;
+      ASSERT_GT(batch->n + 8, fixed_simd::Batch::kCap) << "stopped with room for 8, triangle " << t;
+      ++stops;
+      batch->n = 0;
+    }
+    ASSERT_EQ(depth, want_depth) << "triangle " << t;
+    ASSERT_EQ(tri, want_tri) << "triangle " << t;
+    ASSERT_EQ(fresh, want_fresh) << "triangle " << t;
+    ASSERT_EQ(got.size(), want.size()) << "triangle " << t;
+    for (size_t i = 0; i < got.size(); ++i) ASSERT_EQ(got[i], want[i]) << "triangle " << t << " fragment " << i;
+    passed += want.size();
+  }
+  // Both outcomes of the z-test, stops for a full batch, and rows left out, many times each.
+  EXPECT_GT(passed, fragments / 4);
+  EXPECT_LT(passed, fragments * 3 / 4);
+  EXPECT_GT(stops, 200u);
+  EXPECT_GT(masked, 1000u);
+}
+
+TEST(FixedSimd, BufferSpansEqualsTheRowsRuns) {
+  if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
+  if (fixed_simd::cpuHasAvx512()) checkSpansKernel("avx512", fixed_simd::bufferSpans, fixed_simd::bufferRun);
+  if (fixed_simd::cpuHasAvx2()) checkSpansKernel("avx2", fixed_simd::bufferSpansAvx2, fixed_simd::bufferRunAvx2);
+}
+
 // The colour-run kernels (fixed_simd::colourRunsAvx512, colourRunsAvx2) against the flat/Gouraud
 // run loop, pixel by pixel: calls of 1 to 4 runs with the same steps, each run of 1 to 40 pixels
 // from every start offset in a buffer of its own, over depth buffers holding codes above, below

@@ -16,6 +16,7 @@ Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Fra
       span(span),
       walker(span.walker()),
       buffer_run(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::bufferKernel() : nullptr),
+      buffer_spans(buffer_run != nullptr ? fixed_simd::spansBufferKernel() : nullptr),
       colour_kernel(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::colourKernel()
                                                                                       : nullptr),
       colour_spans(colour_kernel != nullptr ? fixed_simd::colourSpansKernel() : nullptr),

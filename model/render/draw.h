@@ -62,6 +62,12 @@ struct RowShare {
   }
   // Whether a row of a triangle's rows' spans is mine.
   bool anyRow(const RowSpans& s) const { return anyIn(s.y0, s.y0 + s.rows - 1); }
+  // The rows of s that are mine: bit i for row y0 + i.
+  uint64_t rowMask(const RowSpans& s) const {
+    uint64_t m = 0;
+    for (int32_t i = 0; i < s.rows; ++i) m |= uint64_t{mine(s.y0 + i)} << i;
+    return m;
+  }
 };
 
 // A screen triangle set up for the span unit, with the method that draws it: by setup (a span
@@ -235,6 +241,9 @@ class Frame {
   // codes that fit int32_t (AttrBits <= 32), z-tested into the batch by this kernel
   // (fixed_simd::bufferKernel, AVX-512 or AVX2); null: the scalar run loop.
   const fixed_simd::BufferKernel buffer_run;
+  // The same kernel's pass over a triangle's rows' spans (fixed_simd::spansBufferKernel), null
+  // where buffer_run is.
+  const fixed_simd::SpansBufferKernel buffer_spans;
   // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
   // (fixed_simd::colourKernel); null: the scalar loop.
   const fixed_simd::ColourKernel colour_kernel;

@@ -279,6 +279,8 @@ class FixedPointShader {
     static constexpr bool kNeedsNv = needsNv(C);
     bool vectorised() const { return nh_ != nullptr; }
     const fixed_simd::NhParams& nhParams() const { return simd_params_; }
+    const std::array<int32_t, 3>& lightL() const { return lights_[0].l; }  // the one light's (kGroups)
+    const std::array<int32_t, 3>& lightH() const { return lights_[0].h; }
     uint64_t dotL() const { return l_[0]; }
     uint64_t dotH() const { return h_[0]; }
     uint64_t stepL() const { return dl_[0]; }

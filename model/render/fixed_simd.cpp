@@ -276,7 +276,11 @@ SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_
   });
 }
 
-SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+namespace {
+
+// bufferRun's loop, inlined into bufferRun and bufferSpans.
+SHD_AVX512 [[gnu::always_inline]] inline size_t bufferRunIn(const Run& r, size_t first, const Target& t, Batch& b,
+                                                            uint64_t& fresh) {
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512i a = _mm512_set1_epi64(static_cast<int64_t>(r.a)), two_b = _mm512_set1_epi64(static_cast<int64_t>(r.two_b));
   const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
@@ -306,6 +310,12 @@ SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& 
   b.n = n;
   fresh += covered;
   return std::min(k, r.px.count);
+}
+
+}  // namespace
+
+SHD_AVX512 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+  return bufferRunIn(r, first, t, b, fresh);
 }
 
 // zTest8 in AVX2, with vector masks: the 8 fragments at pixels p + 0 .. 7 with the depth codes z
@@ -709,11 +719,11 @@ SHD_AVX2 inline RunInputs4 runInputs4(const Run& r, __m256i kv) {
           _mm256_add_epi64(_mm256_set1_epi64x(static_cast<int64_t>(r.h)), times(kv, r.dh))};
 }
 
-}  // namespace
-
 // bufferRun's loop with zTest8Avx2, and the passing fragments' inputs computed in two halves of
-// 4 64-bit lanes, each packed by a permutation (AVX2 has no compress).
-SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+// 4 64-bit lanes, each packed by a permutation (AVX2 has no compress); inlined into
+// bufferRunAvx2 and bufferSpansAvx2.
+SHD_AVX2 [[gnu::always_inline]] inline size_t bufferRunAvx2In(const Run& r, size_t first, const Target& t, Batch& b,
+                                                              uint64_t& fresh) {
   const __m256i lanes = lanes8(), dz_lanes = laneSteps(r.px.dz);
   const __m256i lane4 = _mm256_setr_epi64x(0, 1, 2, 3);
   size_t n = b.n, k = first;
@@ -742,8 +752,73 @@ SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch
   return std::min(k, r.px.count);
 }
 
+// A triangle's rows' spans as its runs (NhSpans): the dot products and the squared-norm terms of
+// row i's first pixel from the triangle's, the runs buffered by buffer(run, first fragment) from
+// `at` on. Where a row's run stops (the batch full), `at` is left at its next fragment.
+// The dot products are linear mod 2^64 (dot58 is a sum of products mod 2^64), so at the row's
+// first pixel, RowSpans::at(k, lo, i) = a0 + u didx + i didy with u = lo - x0, N.L is
+// a0.L + u (didx.L) + i (didy.L), each mod 2^64: the values batchRun takes from dot58 of the
+// codes there.
+template <class Buffer>
+[[gnu::always_inline]] inline bool eachSpanRun(const NhSpans& r, SpanCursor& at, Buffer buffer) {
+  const RowSpans& s = *r.s;
+  auto dot = [](const std::array<int64_t, 4>& n, const std::array<int32_t, 3>& u) {
+    uint64_t d = 0;
+    for (size_t k = 0; k < 3; ++k) d += static_cast<uint64_t>(n[k]) * static_cast<uint64_t>(int64_t{u[k]});
+    return d;
+  };
+  const uint64_t l0 = dot(s.a0, r.l), lx = dot(s.didx, r.l), ly = dot(s.didy, r.l);
+  const uint64_t h0 = dot(s.a0, r.h), hx = dot(s.didx, r.h), hy = dot(s.didy, r.h);
+  uint64_t c = 0;
+  for (size_t k = 0; k < 3; ++k) c += static_cast<uint64_t>(s.didx[k]) * static_cast<uint64_t>(s.didx[k]);
+  Run run;
+  run.c = c;
+  run.dl = lx;
+  run.dh = hx;
+  run.px.dz = static_cast<uint32_t>(s.didx[3]);
+  for (; at.row < s.rows; ++at.row, at.k = 0) {
+    const int32_t i = at.row;
+    const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo > hi || ((r.rows >> i) & 1) == 0) continue;
+    const uint64_t u = static_cast<uint64_t>(lo - s.x0), iu = static_cast<uint64_t>(i);
+    uint64_t a = 0, b = 0;
+    for (size_t k = 0; k < 3; ++k) {
+      const uint64_t n = static_cast<uint64_t>(s.at(k, lo, i)), d = static_cast<uint64_t>(s.didx[k]);
+      a += n * n;
+      b += n * d;
+    }
+    run.a = a;
+    run.two_b = 2 * b;
+    run.l = l0 + u * lx + iu * ly;
+    run.h = h0 + u * hx + iu * hy;
+    run.px.p = static_cast<size_t>(s.y0 + i) * r.W + static_cast<size_t>(lo);
+    run.px.count = static_cast<size_t>(hi - lo + 1);
+    run.px.z = static_cast<uint32_t>(s.at(3, lo, i));
+    run.room = r.W - static_cast<size_t>(lo);
+    at.k = buffer(run, at.k);
+    if (at.k < run.px.count) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+  return bufferRunAvx2In(r, first, t, b, fresh);
+}
+
+SHD_AVX512 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh) {
+  return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX512 { return bufferRunIn(run, first, t, b, fresh); });
+}
+SHD_AVX2 bool bufferSpansAvx2(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh) {
+  return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX2 { return bufferRunAvx2In(run, first, t, b, fresh); });
+}
+
 NhKernel nhKernel() { return available() ? shadeNh : availableAvx2() ? shadeNhAvx2 : nullptr; }
 BufferKernel bufferKernel() { return available() ? bufferRun : availableAvx2() ? bufferRunAvx2 : nullptr; }
+SpansBufferKernel spansBufferKernel() {
+  return available() ? bufferSpans : availableAvx2() ? bufferSpansAvx2 : nullptr;
+}
 
 #pragma GCC diagnostic pop
 
@@ -781,8 +856,15 @@ uint64_t colourSpansAvx512(const RowSpans&, size_t, int, const Target&, uint8_t*
 size_t bufferRunAvx2(const Run&, size_t, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferRunAvx2: built without the vector kernels");
 }
+bool bufferSpans(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_t&) {
+  throw std::logic_error("fixed_simd::bufferSpans: built without the vector kernel");
+}
+bool bufferSpansAvx2(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_t&) {
+  throw std::logic_error("fixed_simd::bufferSpansAvx2: built without the vector kernels");
+}
 NhKernel nhKernel() { return nullptr; }
 BufferKernel bufferKernel() { return nullptr; }
+SpansBufferKernel spansBufferKernel() { return nullptr; }
 
 #endif
 

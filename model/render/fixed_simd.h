@@ -163,4 +163,30 @@ size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint
 using BufferKernel = size_t (*)(const Run&, size_t, const Target&, Batch&, uint64_t&);
 BufferKernel bufferKernel();
 
+// A phong-fixed triangle's rows' spans (raster/row_spans.h) as runs, without the walk: each row
+// of s whose bit is set in `rows` (bit i: row y0 + i) a run from its first pixel, with the
+// normal codes and depth code there (RowSpans::at) and the triangle's gradients along x as its
+// steps, its dot products with the light's l and h (Q1.30, dot58's operands) and its
+// squared-norm terms: the Run that phong-fixed's batchRun makes of the walk's RowRun of the row.
+struct NhSpans {
+  const RowSpans* s = nullptr;
+  uint64_t rows = ~uint64_t{0};
+  std::array<int32_t, 3> l{}, h{};
+  size_t W = 0;  // pixels per framebuffer row
+};
+// Where the buffering of an NhSpans stands: fragment k of row `row` (of s).
+struct SpanCursor {
+  int32_t row = 0;
+  size_t k = 0;
+};
+// The runs of r buffered as bufferRun buffers each, from `at` on, while the batch has room for
+// 8 more: returns true when every run is in, else false with `at` at the first fragment not
+// taken (the caller shades the batch and calls again). Adds to fresh as bufferRun.
+bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh);
+// The same with bufferRunAvx2.
+bool bufferSpansAvx2(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh);
+// The one that goes with bufferKernel() (null where that is).
+using SpansBufferKernel = bool (*)(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_t&);
+SpansBufferKernel spansBufferKernel();
+
 }  // namespace shd::fixed_simd

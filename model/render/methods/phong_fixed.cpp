@@ -174,9 +174,37 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   t.st.depth_rejected += run.px.count - passed;
 }
 
-// The walk with the vector kernel's batch.
+// A triangle's rows' spans into the batch without the walk (Frame::buffer_spans): the runs
+// batchRun would take, row by row, in one pass; the rows of tri.share.
+template <class Kernel>
+void batchSpans(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
+  const RowSpans& s = *tri.rows;
+  if (!tri.counted) t.f.countRows(s);
+  fixed_simd::NhSpans r{&s, ~uint64_t{0}, kernel.lightL(), kernel.lightH(), static_cast<size_t>(t.W)};
+  uint64_t fragments = s.fragments;
+  if (tri.share.side != RowShare::Side::All) {
+    r.rows = tri.share.rowMask(s);
+    fragments = 0;
+    for (int32_t i = 0; i < s.rows; ++i)
+      if ((r.rows >> i) & 1) fragments += static_cast<uint64_t>(std::max(0, s.span[static_cast<size_t>(i)][1] - s.span[static_cast<size_t>(i)][0] + 1));
+  }
+  fixed_simd::SpanCursor at;
+  uint64_t newly = 0, passed = 0;
+  for (;;) {
+    const size_t buffered = t.batch.n;
+    const bool done = t.f.buffer_spans(r, at, t.target, t.batch, newly);
+    passed += t.batch.n - buffered;  // the fragments that passed the z-test
+    if (done) break;
+    flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
+  }
+  t.st.pixels_covered += newly;
+  t.st.depth_rejected += fragments - passed;
+}
+
+// The walk with the vector kernel's batch, or the rows' spans without it.
 template <class Kernel>
 void walkBatched(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
+  if (tri.rows != nullptr && tri.walked == nullptr && t.f.buffer_spans != nullptr) return batchSpans(t, tri, kernel);
   auto fragment = [&t, &kernel](int32_t x, int32_t y, const int64_t* attr) {
     if (t.batch.n > 0) flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
     fixedFragment(t, x, y, attr);
