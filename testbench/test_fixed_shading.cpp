@@ -446,9 +446,10 @@ static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spa
     s.rows = 1 + static_cast<int32_t>(t % 4 == 0 ? rng() % RowSpans::kMaxRows : rng() % 10);
     s.y0 = static_cast<int32_t>(rng() % (H - 2 - static_cast<size_t>(s.rows)));
     for (int32_t i = 0; i < s.rows; ++i) {
-      const int16_t lo = static_cast<int16_t>(rng() % W), pick = static_cast<int16_t>(rng() % 8);
-      const int16_t hi = pick == 0 ? static_cast<int16_t>(lo - 1) : (pick == 1 ? lo : static_cast<int16_t>(std::min<size_t>(W - 1, lo + rng() % 40)));
-      s.span[static_cast<size_t>(i)] = {lo, hi};
+      // No pixel, one pixel, or up to 40 (to the row's end).
+      const size_t lo = rng() % W, pick = rng() % 8;
+      const size_t hi = pick == 0 ? lo - 1 : (pick == 1 ? lo : std::min<size_t>(W - 1, lo + rng() % 40));
+      s.span[static_cast<size_t>(i)] = {static_cast<int16_t>(lo), static_cast<int16_t>(hi)};
     }
     s.x0 = std::max<int32_t>(0, s.span[0][0]);
     for (size_t k = 0; k < 4; ++k) {  // at() within int32_t is not needed: the kernel's arithmetic wraps

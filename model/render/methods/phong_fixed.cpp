@@ -174,20 +174,26 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
   t.st.depth_rejected += run.px.count - passed;
 }
 
+// The fragments of the rows of s in `rows` (bit i: row y0 + i).
+inline uint64_t fragmentsOf(const RowSpans& s, uint64_t rows) {
+  uint64_t n = 0;
+  for (int32_t i = 0; i < s.rows; ++i) {
+    const std::array<int16_t, 2>& sp = s.span[static_cast<size_t>(i)];
+    if (((rows >> i) & 1) != 0 && sp[0] <= sp[1]) n += static_cast<uint64_t>(sp[1] - sp[0] + 1);
+  }
+  return n;
+}
+
 // A triangle's rows' spans into the batch without the walk (Frame::buffer_spans): the runs
 // batchRun would take, row by row, in one pass; the rows of tri.share.
 template <class Kernel>
 void batchSpans(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
   const RowSpans& s = *tri.rows;
   if (!tri.counted) t.f.countRows(s);
-  fixed_simd::NhSpans r{&s, ~uint64_t{0}, kernel.lightL(), kernel.lightH(), static_cast<size_t>(t.W)};
-  uint64_t fragments = s.fragments;
-  if (tri.share.side != RowShare::Side::All) {
-    r.rows = tri.share.rowMask(s);
-    fragments = 0;
-    for (int32_t i = 0; i < s.rows; ++i)
-      if ((r.rows >> i) & 1) fragments += static_cast<uint64_t>(std::max(0, s.span[static_cast<size_t>(i)][1] - s.span[static_cast<size_t>(i)][0] + 1));
-  }
+  const bool all = tri.share.side == RowShare::Side::All;
+  const fixed_simd::NhSpans r{&s, all ? ~uint64_t{0} : tri.share.rowMask(s), kernel.lightL(), kernel.lightH(),
+                              static_cast<size_t>(t.W)};
+  const uint64_t fragments = all ? s.fragments : fragmentsOf(s, r.rows);
   fixed_simd::SpanCursor at;
   uint64_t newly = 0, passed = 0;
   for (;;) {
