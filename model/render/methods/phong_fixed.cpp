@@ -11,9 +11,10 @@
 //              constant increments (directional lights, device lobes on the unit's memo);
 //   batch      the vector kernels' case (one directional light, a lobe of N.H, AVX-512 or
 //              AVX2): the runs of an object's triangles z-tested and buffered
-//              (fixed_simd::bufferKernel) and shaded 8 at a time (fixed_simd::nhKernel). The
-//              groups are independent, so the processor overlaps them, where one group per
-//              row of 5 or 6 pixels would wait out its own latency.
+//              (fixed_simd::bufferKernel; a triangle's rows' spans all with one call,
+//              fixed_simd::spansBufferKernel) and shaded 8 at a time (fixed_simd::nhKernel).
+//              The groups are independent, so the processor overlaps them, where one group
+//              per row of 5 or 6 pixels would wait out its own latency.
 #include <algorithm>
 #include <cmath>
 #include <optional>
