@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "render/fixed_shading.h"
 #include "render/normalize.h"
 #include "render/x86_targets.h"
 
@@ -515,12 +516,6 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
   return covered;
 }
 
-ColourKernel colourKernel() {
-  return available() ? colourRunsAvx512 : availableAvx2() ? colourRunsAvx2 : nullptr;
-}
-ColourSpansKernel colourSpansKernel() {
-  return available() ? colourSpansAvx512 : availableAvx2() ? colourSpansAvx2 : nullptr;
-}
 
 // ---- shadeNh in AVX2: shadeGroup's operations on 4 64-bit lanes, two per group of 8 ----
 
@@ -763,16 +758,12 @@ template <class Buffer>
 [[gnu::always_inline]] inline bool eachSpanRun(const NhSpans& r, SpanCursor& at, Buffer buffer) {
   const RowSpans& s = *r.s;
   auto dot = [](const std::array<int64_t, 4>& n, const std::array<int32_t, 3>& u) {
-    uint64_t d = 0;
-    for (size_t k = 0; k < 3; ++k) d += static_cast<uint64_t>(n[k]) * static_cast<uint64_t>(int64_t{u[k]});
-    return d;
+    return static_cast<uint64_t>(fixed_detail::dot58(n.data(), u));
   };
   const uint64_t l0 = dot(s.a0, r.l), lx = dot(s.didx, r.l), ly = dot(s.didy, r.l);
   const uint64_t h0 = dot(s.a0, r.h), hx = dot(s.didx, r.h), hy = dot(s.didy, r.h);
-  uint64_t c = 0;
-  for (size_t k = 0; k < 3; ++k) c += static_cast<uint64_t>(s.didx[k]) * static_cast<uint64_t>(s.didx[k]);
+  const std::array<int64_t, 3> dn{s.didx[0], s.didx[1], s.didx[2]};
   Run run;
-  run.c = c;
   run.dl = lx;
   run.dh = hx;
   run.px.dz = static_cast<uint32_t>(s.didx[3]);
@@ -781,14 +772,11 @@ template <class Buffer>
     const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
     if (lo > hi || ((r.rows >> i) & 1) == 0) continue;
     const uint64_t u = static_cast<uint64_t>(lo - s.x0), iu = static_cast<uint64_t>(i);
-    uint64_t a = 0, b = 0;
-    for (size_t k = 0; k < 3; ++k) {
-      const uint64_t n = static_cast<uint64_t>(s.at(k, lo, i)), d = static_cast<uint64_t>(s.didx[k]);
-      a += n * n;
-      b += n * d;
-    }
-    run.a = a;
-    run.two_b = 2 * b;
+    const SquaredNormRecurrence::Terms sq =
+        SquaredNormRecurrence::terms({s.at(0, lo, i), s.at(1, lo, i), s.at(2, lo, i)}, dn);
+    run.a = sq.a;
+    run.two_b = sq.two_b;
+    run.c = sq.c;
     run.l = l0 + u * lx + iu * ly;
     run.h = h0 + u * hx + iu * hy;
     run.px.p = static_cast<size_t>(s.y0 + i) * r.W + static_cast<size_t>(lo);
@@ -814,11 +802,6 @@ SHD_AVX2 bool bufferSpansAvx2(const NhSpans& r, SpanCursor& at, const Target& t,
   return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX2 { return bufferRunAvx2In(run, first, t, b, fresh); });
 }
 
-NhKernel nhKernel() { return available() ? shadeNh : availableAvx2() ? shadeNhAvx2 : nullptr; }
-BufferKernel bufferKernel() { return available() ? bufferRun : availableAvx2() ? bufferRunAvx2 : nullptr; }
-SpansBufferKernel spansBufferKernel() {
-  return available() ? bufferSpans : availableAvx2() ? bufferSpansAvx2 : nullptr;
-}
 
 #pragma GCC diagnostic pop
 
@@ -845,8 +828,6 @@ uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const ui
                      int64_t* const[3]) {
   return allGroups(n);
 }
-ColourKernel colourKernel() { return nullptr; }
-ColourSpansKernel colourSpansKernel() { return nullptr; }
 uint64_t colourSpansAvx2(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourSpansAvx2: built without the vector kernels");
 }
@@ -862,10 +843,21 @@ bool bufferSpans(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_t&) 
 bool bufferSpansAvx2(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_t&) {
   throw std::logic_error("fixed_simd::bufferSpansAvx2: built without the vector kernels");
 }
-NhKernel nhKernel() { return nullptr; }
-BufferKernel bufferKernel() { return nullptr; }
-SpansBufferKernel spansBufferKernel() { return nullptr; }
 
 #endif
+
+// Each kernel's choice: the AVX-512 one where available(), else the AVX2 one where
+// availableAvx2(), else null (the scalar path; always without SHD_X86_KERNELS).
+namespace {
+template <class Kernel>
+Kernel byCpu(Kernel avx512, Kernel avx2) {
+  return available() ? avx512 : availableAvx2() ? avx2 : nullptr;
+}
+}  // namespace
+ColourKernel colourKernel() { return byCpu<ColourKernel>(colourRunsAvx512, colourRunsAvx2); }
+ColourSpansKernel colourSpansKernel() { return byCpu<ColourSpansKernel>(colourSpansAvx512, colourSpansAvx2); }
+NhKernel nhKernel() { return byCpu<NhKernel>(shadeNh, shadeNhAvx2); }
+BufferKernel bufferKernel() { return byCpu<BufferKernel>(bufferRun, bufferRunAvx2); }
+SpansBufferKernel spansBufferKernel() { return byCpu<SpansBufferKernel>(bufferSpans, bufferSpansAvx2); }
 
 }  // namespace shd::fixed_simd

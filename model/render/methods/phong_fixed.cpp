@@ -140,6 +140,19 @@ void flushBatch(fixed_simd::Batch& b, uint8_t* const out, Kernel& kernel) {
   b.n = 0;
 }
 
+// Fragments into the batch by buffer() (true: all of them in), the batch shaded each time it
+// fills before the end; returns the fragments buffered (those that passed the z-test).
+template <class Kernel, class Buffer>
+uint64_t bufferAll(FixedTriangle& t, Kernel& kernel, Buffer buffer) {
+  for (uint64_t passed = 0;;) {
+    const size_t before = t.batch.n;
+    const bool done = buffer();
+    passed += t.batch.n - before;
+    if (done) return passed;
+    flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
+  }
+}
+
 // A run into the batch: z-tested, its depth codes written, its passing fragments' squared
 // norms and dot products buffered (Frame::buffer_run). Other runs (null buffer_run, right to left)
 // take fixedRun.
@@ -163,14 +176,12 @@ void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
                             kernel.dotH(),
                             kernel.stepH(),
                             static_cast<size_t>(t.W - r.x0)};
-  uint64_t newly = 0, passed = 0;
-  for (size_t k = 0;;) {
-    const size_t buffered = t.batch.n;
+  uint64_t newly = 0;
+  size_t k = 0;
+  const uint64_t passed = bufferAll(t, kernel, [&] {
     k = t.f.buffer_run(run, k, t.target, t.batch, newly);
-    passed += t.batch.n - buffered;  // the fragments that passed the z-test
-    if (k >= run.px.count) break;
-    flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
-  }
+    return k >= run.px.count;
+  });
   t.st.pixels_covered += newly;
   t.st.depth_rejected += run.px.count - passed;
 }
@@ -196,14 +207,8 @@ void batchSpans(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
                               static_cast<size_t>(t.W)};
   const uint64_t fragments = all ? s.fragments : fragmentsOf(s, r.rows);
   fixed_simd::SpanCursor at;
-  uint64_t newly = 0, passed = 0;
-  for (;;) {
-    const size_t buffered = t.batch.n;
-    const bool done = t.f.buffer_spans(r, at, t.target, t.batch, newly);
-    passed += t.batch.n - buffered;  // the fragments that passed the z-test
-    if (done) break;
-    flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
-  }
+  uint64_t newly = 0;
+  const uint64_t passed = bufferAll(t, kernel, [&] { return t.f.buffer_spans(r, at, t.target, t.batch, newly); });
   t.st.pixels_covered += newly;
   t.st.depth_rejected += fragments - passed;
 }
