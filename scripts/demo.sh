@@ -9,6 +9,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out"
 "$root/scripts/install_deps.sh"
+source "$root/scripts/direct_python.sh"
 "$root/scripts/build.sh" "$root/build"
 S="$root/build/sim/shadesim"
 mkdir -p "$out/prom"

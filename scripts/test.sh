@@ -11,6 +11,7 @@ sanitize=0
 if [ "${1:-}" = "--sanitize" ]; then sanitize=1; shift; fi
 start=$(date +%s)
 "$root/scripts/install_deps.sh"
+source "$root/scripts/direct_python.sh"
 "$root/scripts/build.sh" "$root/build"
 echo "test.sh: built after $(( $(date +%s) - start )) s"
 ctest --test-dir "$root/build" --output-on-failure -j "$(nproc)" "$@"
