@@ -62,23 +62,19 @@ RunWalk walkWithRuns(const SpanParams& p, const SpanDesc& d, std::vector<SpanFra
       [&](int32_t x, int32_t y, const int64_t* attr) {
         if (y != last_y) ++rw.fragment_rows;
         last_y = y;
-        SpanFragment f;
-        f.tag = d.tag;
-        f.x = x;
-        f.y = y;
-        for (int a = 0; a < p.NumAttr; ++a) f.attr.push_back(attr[a]);
-        out.push_back(f);
+        // The fragment added without attributes, which are then written in place: one copy
+        // of them instead of two (into a local fragment, then into `out`).
+        out.push_back({d.tag, x, y, {}});
+        AttrVec& fa = out.back().attr;
+        for (int a = 0; a < p.NumAttr; ++a) fa.push_back(attr[a]);
       },
       [&](const RowRun& r) {
         ++rw.run_rows;
         last_y = INT32_MIN;
         for (int64_t i = 0; i < r.count; ++i) {
-          SpanFragment f;
-          f.tag = d.tag;
-          f.x = static_cast<int32_t>(r.x0 + i * r.dx);
-          f.y = r.y;
-          for (int a = 0; a < p.NumAttr; ++a) f.attr.push_back(r.a0[a] + i * r.da[a]);
-          out.push_back(f);
+          out.push_back({d.tag, static_cast<int32_t>(r.x0 + i * r.dx), r.y, {}});
+          AttrVec& fa = out.back().attr;
+          for (int a = 0; a < p.NumAttr; ++a) fa.push_back(r.a0[a] + i * r.da[a]);
         }
       });
   return rw;
@@ -128,9 +124,12 @@ std::string describe(const GenTriangle& t) {
 
 // The functional walker (walkSpanUnit, the renderer's fast path), fragment by fragment and with
 // runs, against the cycle-by-cycle model's run of the same descriptor: the same fragments in the
-// same order, the same cycles.
-void checkWalkers(const SpanParams& p, const SpanDesc& d, const SpanRun& run, const char* mode, const GenTriangle& t) {
-  std::vector<SpanFragment> walked;
+// same order, the same cycles. `walked` is the caller's buffer, cleared here and reused from
+// triangle to triangle: a fresh vector per call, grown and freed each time, cost more (in copies
+// and page faults) than the walkers themselves.
+void checkWalkers(const SpanParams& p, const SpanDesc& d, const SpanRun& run, const char* mode, const GenTriangle& t,
+                  std::vector<SpanFragment>& walked) {
+  walked.clear();
   const SpanWalk wk = walkSpanUnit(p, d, walked);
   ASSERT_EQ(wk.cycles, run.cycles) << mode << " walker cycles, " << describe(t);
   ASSERT_EQ(wk.row_cycles, run.row_cycles) << mode << " walker ROW cycles, " << describe(t);
@@ -179,10 +178,22 @@ void checkModesAgainstSerial(uint64_t seed, long count, bool check_walkers) {
   long frags = 0;
   std::vector<SpanFragment> serial;
   std::vector<SpanRun> runs(units.size());  // reused: no allocation per triangle
+  std::vector<SpanFragment> walked;         // checkWalkers' buffer, likewise
   // Per pixel: the last triangle (n + 1) the serial mode drew it in and the index of that
-  // fragment; the last (triangle, mode) that drew it.
-  std::vector<uint64_t> drawn(static_cast<size_t>(c.width) * c.height, 0), seen(drawn.size(), 0);
-  std::vector<uint32_t> serial_at(drawn.size(), 0);
+  // fragment; the last (triangle, mode) that drew it. One record per pixel, so that a
+  // fragment's checks read one cache line, not one in each of three arrays.
+  struct PixelMark {
+    uint64_t drawn = 0, seen = 0;
+    uint32_t serial_at = 0;
+  };
+  std::vector<PixelMark> marks(static_cast<size_t>(c.width) * c.height);
+  // A mode draws each pixel at most once (checked below), so a triangle has at most one fragment
+  // per pixel: with that reserved up front the buffers never grow, where growing copied their
+  // fragments and touched fresh pages each time a larger triangle came (untouched capacity
+  // costs no memory).
+  serial.reserve(marks.size());
+  for (SpanRun& r : runs) r.fragments.reserve(marks.size());
+  if (check_walkers) walked.reserve(marks.size());
   uint64_t now = 0;
   for (long n = 0; n < count; ++n) {
     const GenTriangle t = gen.next();
@@ -197,7 +208,7 @@ void checkModesAgainstSerial(uint64_t seed, long count, bool check_walkers) {
       if (s.desc) {
         runSpanUnit(units[mi], *s.desc, run);
         if (check_walkers) {
-          checkWalkers(cfgs[mi].unit, *s.desc, run, mode, t);
+          checkWalkers(cfgs[mi].unit, *s.desc, run, mode, t, walked);
           if (testing::Test::HasFatalFailure()) return;
         }
       }
@@ -214,20 +225,21 @@ void checkModesAgainstSerial(uint64_t seed, long count, bool check_walkers) {
           FAIL() << mode << " fragment (" << f.x << ", " << f.y << ") outside the viewport, " << describe(t);
         }
         const size_t p = static_cast<size_t>(f.y) * c.width + f.x;
-        if (seen[p] == visit) {
+        PixelMark& mark = marks[p];
+        if (mark.seen == visit) {
           FAIL() << mode << " pixel (" << f.x << ", " << f.y << ") twice, " << describe(t);
         }
-        seen[p] = visit;
+        mark.seen = visit;
         if (mi == 0) {
-          drawn[p] = static_cast<uint64_t>(n) + 1;
-          serial_at[p] = static_cast<uint32_t>(i);
+          mark.drawn = static_cast<uint64_t>(n) + 1;
+          mark.serial_at = static_cast<uint32_t>(i);
         } else {
-          if (drawn[p] != static_cast<uint64_t>(n) + 1) {
+          if (mark.drawn != static_cast<uint64_t>(n) + 1) {
             FAIL() << mode << " pixel (" << f.x << ", " << f.y << ") that serial does not draw, seed " << seed << " "
                    << describe(t);
           }
-          if (f.attr != serial[serial_at[p]].attr) {
-            ASSERT_EQ(f.attr, serial[serial_at[p]].attr) << mode << " seed " << seed << " " << describe(t);
+          if (f.attr != serial[mark.serial_at].attr) {
+            ASSERT_EQ(f.attr, serial[mark.serial_at].attr) << mode << " seed " << seed << " " << describe(t);
           }
         }
       }

@@ -297,8 +297,13 @@ void runSpanUnit(SpanUnitModel& m, const SpanDesc& d, SpanRun& run) {
       in.desc_valid = false;
       continue;
     }
-    for (const SpanLaneOut& l : o.lane)
-      if (l.valid) run.fragments.push_back({o.tag, l.x, l.y, l.attr});
+    for (const SpanLaneOut& l : o.lane) {
+      if (!l.valid) continue;
+      // The fragment added without attributes, which are then copied in place: one copy of
+      // them instead of two (into a temporary fragment, then into the vector).
+      run.fragments.push_back({o.tag, l.x, l.y, {}});
+      run.fragments.back().attr = l.attr;
+    }
     if (m.idle()) break;
   }
   run.valid_lanes = run.fragments.size();
