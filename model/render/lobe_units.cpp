@@ -1,6 +1,7 @@
 #include "render/lobe_units.h"
 
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -23,7 +24,11 @@ SpecUnitConfig LobeConfigs::load(Lobe l) const {
 }
 
 std::unique_ptr<ModelSpecEngine> modelSpecEngine(const SpecUnitConfig& cfg) {
-  auto e = std::make_unique<ModelSpecEngine>(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl));
+  return modelSpecEngine(cfg, buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl));
+}
+
+std::unique_ptr<ModelSpecEngine> modelSpecEngine(const SpecUnitConfig& cfg, PromTable table) {
+  auto e = std::make_unique<ModelSpecEngine>(std::move(table));
   if (!cfg.cos_code_min.empty()) {
     if (cfg.cos_code_min.size() != e->table().entries.size())
       throw std::invalid_argument(fmt::format("configuration {}: inputs.cos_code_min has {} codes, its PROM {} entries",

@@ -27,6 +27,9 @@ struct LobeConfigs {
 // refuses (std::invalid_argument naming the configuration when the list does not have one code
 // per PROM entry).
 std::unique_ptr<ModelSpecEngine> modelSpecEngine(const SpecUnitConfig& cfg);
+// The same with the configuration's PROM table already built (buildPromTable of its "prom" and
+// "rtl"): for a caller that keeps the table of a configuration it makes engines of again.
+std::unique_ptr<ModelSpecEngine> modelSpecEngine(const SpecUnitConfig& cfg, PromTable table);
 
 // The model's engines (bit-exact specular units with their PROM tables) for the device lobes
 // the scene uses with these options; `view` points into `owned`.

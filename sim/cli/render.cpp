@@ -183,7 +183,10 @@ int RenderCmd::run(const CLI::App& app) {
   const double ms = medianFrameMs(sc, ro, model, res, frames, scratch);
   // The reference and the error against it.
   say("reference (double precision, exact pow)");
-  const Comparison c = compareWithReference(res, renderReference(sc, ro), highlight_lsb_, heat_scale_);
+  const Image img = frameImage(res.fb);
+  const ReferenceImage ref = referenceImage(renderReference(sc, ro), highlight_lsb_);
+  const Comparison c = compareWithReference(img, coveredPixels(res.fb), ref, heat_scale_);
+  const Image reference = roundToUnorm8(ref.exact);  // as shown
   nlohmann::json j = statistics(sc, ro, res, ms, frames, c);
   if (res.stats.pixels_covered == 0) {  // a blank image is not a result: say so (and in the JSON)
     const std::string w = fmt::format("nothing drawn: all {} triangles are culled or outside the view (check the "
@@ -201,8 +204,8 @@ int RenderCmd::run(const CLI::App& app) {
   }
   // Every output is written only now, as one set (io/files.h): a failure leaves none of them.
   OutputFiles files;
-  files.add(outputs[0], encodePng(outputs[0], frameImage(res.fb)));
-  files.add(outputs[1], encodePng(outputs[1], c.reference));
+  files.add(outputs[0], encodePng(outputs[0], img));
+  files.add(outputs[1], encodePng(outputs[1], reference));
   files.add(outputs[2], encodePng(outputs[2], c.heat));
   if (!json_path_.empty()) files.add(json_path_, j.dump(2) + "\n");
   files.commit();

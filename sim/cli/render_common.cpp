@@ -1,6 +1,9 @@
 #include "cli/render_common.h"
 
 #include <algorithm>
+#include <map>
+#include <mutex>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -20,6 +23,19 @@ SpecUnitConfig lobeConfigArg(const LobeConfigs& lobes, Lobe l) {
   }
 }
 
+const PromTable& promTable(const SpecUnitConfig& cfg) {
+  // Keyed by everything buildPromTable reads: every "rtl" parameter and the "prom" section (the
+  // level exactly, in hexadecimal floating point).
+  const std::string key = fmt::format("{} {} {:a} {} {}", cfg.rtl.toJson().dump(), cfg.prom.fit, cfg.prom.level,
+                                      cfg.prom.is_list, cfg.prom.n);
+  static std::mutex mutex;
+  static std::map<std::string, PromTable> tables;  // a map: its elements stay where they are
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto it = tables.find(key);
+  if (it == tables.end()) it = tables.emplace(key, buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl)).first;
+  return it->second;
+}
+
 Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConfig& span, const LobeConfigs& lobes,
                     bool with_rtl, const fs::path& tmp, const std::string& fail_dir) {
   Engines e;
@@ -29,10 +45,10 @@ Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConf
     const SpecUnitConfig cfg = lobeConfigArg(lobes, l);
     if (with_rtl) {
       fs::create_directories(tmp);
-      e.spec.push_back(std::make_unique<RtlSpecEngine>(cfg, buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl),
-                                                       (tmp / ("spec_" + cfg.name + ".hex")).string(), fail_dir));
+      e.spec.push_back(
+          std::make_unique<RtlSpecEngine>(cfg, promTable(cfg), (tmp / ("spec_" + cfg.name + ".hex")).string(), fail_dir));
     } else {
-      e.spec.push_back(modelSpecEngine(cfg));
+      e.spec.push_back(modelSpecEngine(cfg, promTable(cfg)));
     }
     e.view.set(l, e.spec.back().get());
   }
@@ -47,16 +63,22 @@ RenderResult renderReference(const Scene& sc, const RenderOptions& ro) {
   return render(sc, rref, serial, SpecEngines{});
 }
 
-Comparison compareWithReference(const RenderResult& res, const RenderResult& ref, double highlight_lsb,
+ReferenceImage referenceImage(RenderResult ref, double highlight_lsb) {
+  // The specular part as an image: its samples taken over from the frame, not copied into a
+  // new image (which would be cleared first, then overwritten).
+  ImageF spec;
+  spec.width = ref.fb.width;
+  spec.height = ref.fb.height;
+  spec.rgb = std::move(ref.fb.spec_lsb);
+  return {exactImage(ref.fb), coveredPixels(ref.fb), thresholdMask(spec, highlight_lsb)};
+}
+
+Comparison compareWithReference(const Image& img, const PixelMask& covered, const ReferenceImage& ref,
                                 double heat_scale) {
-  const Image img = frameImage(res.fb);
-  const ImageF reff = exactImage(ref.fb);
-  ImageF spec_ref(ref.fb.width, ref.fb.height);
-  spec_ref.rgb = ref.fb.spec_lsb;
-  const PixelMask covered = intersect(coveredPixels(res.fb), coveredPixels(ref.fb));
-  const PixelMask highlight = intersect(covered, thresholdMask(spec_ref, highlight_lsb));
-  return {imageMetrics(img, reff, covered), imageMetrics(img, reff, highlight), roundToUnorm8(reff),
-          errorHeatmap(img, reff, heat_scale, covered)};
+  const PixelMask both = intersect(covered, ref.covered);
+  const PixelMask highlight = intersect(both, ref.highlight);
+  return {imageMetrics(img, ref.exact, both), imageMetrics(img, ref.exact, highlight),
+          errorHeatmap(img, ref.exact, heat_scale, both)};
 }
 
 RtlCheck checkRtlFrame(const Scene& sc, const RenderResult& res, const RenderResult& hres) {

@@ -24,6 +24,11 @@ namespace shd::cli {
 // (--quadratic-config or --cubic-config).
 SpecUnitConfig lobeConfigArg(const LobeConfigs& lobes, Lobe l);
 
+// The PROM table of a specular configuration (buildPromTable of its "prom" and "rtl"), built once
+// per process and kept: a report makes the engines of every row, and the fit (the piecewise
+// kind's minimax segments above all) would otherwise be repeated for each method and mode.
+const PromTable& promTable(const SpecUnitConfig& cfg);
+
 // The engines of one path (model or RTL) for the device lobes the scene uses.
 struct Engines {
   std::unique_ptr<SpanEngine> span;
@@ -39,14 +44,25 @@ Engines makeEngines(const Scene& sc, const RenderOptions& ro, const SpanUnitConf
 // (Method::Reference through a serial span engine, which it does not use for pixels).
 RenderResult renderReference(const Scene& sc, const RenderOptions& ro);
 
-// The image against the reference: metrics over the pixels both cover and over the highlight
-// (pixels whose reference specular part exceeds highlight_lsb), the reference as shown (clamped
-// to [0, 255] and rounded) and the heat map of the error (white at heat_scale LSBs).
+// What an image is measured against, taken from the reference frame once: its exact colour
+// clamped to [0, 255] (exactImage), the pixels it covers and the highlight (the pixels whose
+// specular part exceeds highlight_lsb). A report compares every method of a lobe with the same
+// reference, so these are made once per lobe, not once per method. `ref` is taken over (its
+// specular part is moved, not copied).
+struct ReferenceImage {
+  ImageF exact;
+  PixelMask covered, highlight;
+};
+ReferenceImage referenceImage(RenderResult ref, double highlight_lsb);
+
+// A frame's image and the pixels it covers (frameImage, coveredPixels) against the reference:
+// metrics over the pixels both cover and over the highlight among them, and the heat map of the
+// error (white at heat_scale LSBs). The reference as shown is roundToUnorm8(ref.exact).
 struct Comparison {
   ImageMetrics all, highlight;
-  Image reference, heat;
+  Image heat;
 };
-Comparison compareWithReference(const RenderResult& res, const RenderResult& ref, double highlight_lsb,
+Comparison compareWithReference(const Image& img, const PixelMask& covered, const ReferenceImage& ref,
                                 double heat_scale);
 
 // A frame rendered with the verilated units against the model's: the pixels that differ, the

@@ -56,12 +56,17 @@ std::string cellSkipReason(Method m, const LobeGroup& g) {
   return "";
 }
 
-// The image and its heat map, encoded, and their thumbnail for the contact sheet.
-CellImages cellImages(Method m, const LobeGroup& g, const Image& img, const Image& heat) {
-  CellImages c;
+// The files of method m with lobe group g: images/<method>_<lobe>.png and its heat map's.
+void nameCellFiles(Method m, const LobeGroup& g, CellImages& c) {
   const std::string stem = fmt::format("images/{}_{}", toString(m), g.name);
   c.image_file = stem + ".png";
   c.heat_file = stem + "_error.png";
+}
+
+// The image and its heat map, encoded, and their thumbnail for the contact sheet.
+CellImages cellImages(Method m, const LobeGroup& g, const Image& img, const Image& heat) {
+  CellImages c;
+  nameCellFiles(m, g, c);
   c.image_png = encodePng(c.image_file, img);
   c.heat_png = encodePng(c.heat_file, heat);
   const int factor = std::max(1, (std::max(img.width, img.height) + kThumbSize - 1) / kThumbSize);
@@ -69,19 +74,56 @@ CellImages cellImages(Method m, const LobeGroup& g, const Image& img, const Imag
   return c;
 }
 
+// A method's image of a lobe against the lobe's reference: the metrics and the files.
+struct CellComparison {
+  ImageMetrics all, highlight;
+  CellImages files;
+};
+
+// A lobe's reference, and the distinct images its methods drew so far, each as
+// compareWithReference reads it (the image and the pixels covered) with what it gave.
+struct LobeImages {
+  struct Drawn {
+    Image image;
+    PixelMask covered;
+    CellComparison comparison;
+  };
+  ReferenceImage reference;
+  std::vector<Drawn> drawn;
+};
+
+// Method m's image and covered pixels against the lobe's reference; or, when an earlier method
+// of the lobe drew the same image over the same pixels (adaptive choosing Phong for every
+// triangle, say), that method's comparison: the same metrics and PNG bytes under m's file names,
+// neither measured nor encoded again.
+CellComparison compareCell(Method m, const LobeGroup& g, const Image& img, const PixelMask& covered, double heat_scale,
+                           LobeImages& lobe) {
+  const auto same = std::find_if(lobe.drawn.begin(), lobe.drawn.end(), [&](const LobeImages::Drawn& d) {
+    return d.image == img && d.covered.bits == covered.bits;
+  });
+  if (same != lobe.drawn.end()) {
+    CellComparison c = same->comparison;
+    nameCellFiles(m, g, c.files);
+    return c;
+  }
+  const Comparison c = compareWithReference(img, covered, lobe.reference, heat_scale);
+  lobe.drawn.push_back({img, covered, {c.all, c.highlight, cellImages(m, g, img, c.heat)}});
+  return lobe.drawn.back().comparison;
+}
+
 // What every mode's row of a method and lobe holds besides its own measurements.
 nlohmann::json cellBase(Method m, const LobeGroup& g, const std::vector<std::string>& spec_configs,
-                        const CellImages& files, const Comparison& c) {
-  return {{"method", toString(m)},        {"lobe", g.name},
-          {"spec_configs", spec_configs}, {"image", files.image_file},
-          {"heat_map", files.heat_file},  {"metrics", toJson(c.all)},
+                        const CellComparison& c) {
+  return {{"method", toString(m)},         {"lobe", g.name},
+          {"spec_configs", spec_configs},  {"image", c.files.image_file},
+          {"heat_map", c.files.heat_file}, {"metrics", toJson(c.all)},
           {"highlight", toJson(c.highlight)}};
 }
 
 // The rows of one method and lobe, one per mode: rendered by the model (s.frames frames, the
 // median time), the image compared with the first mode's, and with --rtl by the verilated units.
 // The renderer's std::invalid_argument on the first frame means the combination does not apply.
-nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const RenderResult& ref, Progress& progress,
+nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, LobeImages& lobe, Progress& progress,
                            Measured& out) {
   const Scene& sc = *s.scene;
   const LobeGroup& g = out.groups[gi];
@@ -103,10 +145,9 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, const Rend
     const double ms = medianFrameMs(sc, ro, model, res, s.frames, scratch);
     const Image img = frameImage(res.fb);
     if (rows.empty()) {
-      const Comparison c = compareWithReference(res, ref, s.highlight_lsb, s.heat_scale);
-      CellImages files = cellImages(m, g, img, c.heat);
-      base = cellBase(m, g, spec_configs, files, c);
-      out.images[{gi, static_cast<size_t>(m)}] = std::move(files);
+      CellComparison c = compareCell(m, g, img, coveredPixels(res.fb), s.heat_scale, lobe);
+      base = cellBase(m, g, spec_configs, c);
+      out.images[{gi, static_cast<size_t>(m)}] = std::move(c.files);
       first = img;
     } else {
       ++out.mode_comparisons;
@@ -181,7 +222,7 @@ Measured measureReport(const ReportSetup& s) {
     }
     RenderOptions ro;
     ro.brdf = g.brdf;
-    const RenderResult ref = renderReference(sc, ro);
+    LobeImages lobe{referenceImage(renderReference(sc, ro), s.highlight_lsb), {}};
     for (Method m : out.methods) {
       const std::string why = cellSkipReason(m, g);
       if (!why.empty()) {
@@ -190,7 +231,7 @@ Measured measureReport(const ReportSetup& s) {
       }
       const size_t done_before = out.renders_done;
       try {
-        for (nlohmann::json& row : measureCell(s, m, gi, ref, progress, out)) out.rows.push_back(std::move(row));
+        for (nlohmann::json& row : measureCell(s, m, gi, lobe, progress, out)) out.rows.push_back(std::move(row));
       } catch (const std::invalid_argument& e) {  // the renderer refuses the combination
         out.skipped.push_back({{"method", toString(m)}, {"lobe", g.name}, {"why", fmt::format("not rendered: {}", e.what())}});
         if (first_refusal.empty()) first_refusal = e.what();
