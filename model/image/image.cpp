@@ -11,6 +11,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -54,6 +55,11 @@ void requireSameSize(int w0, int h0, int w1, int h1, const char* what) {
 Image::Image(int w, int h) : width(w), height(h), rgb(checkedSamples(w, h, 3, "Image"), 0) {}
 
 ImageF::ImageF(int w, int h) : width(w), height(h), rgb(checkedSamples(w, h, 3, "ImageF"), 0.0) {}
+
+ImageF::ImageF(int w, int h, std::vector<double> samples) : width(w), height(h), rgb(std::move(samples)) {
+  if (rgb.size() != checkedSamples(w, h, 3, "ImageF"))
+    throw std::invalid_argument(fmt::format("ImageF: {} samples for {}x{} pixels", rgb.size(), w, h));
+}
 
 PixelMask::PixelMask(int w, int h, bool value)
     : width(w), height(h), bits(checkedSamples(w, h, 1, "PixelMask"), value) {}

@@ -53,6 +53,9 @@ struct ImageF {
 
   ImageF() = default;
   ImageF(int width, int height);  // all 0.0; std::invalid_argument as Image(w, h)
+  // The samples given (taken over, not cleared and copied); std::invalid_argument unless there are
+  // 3 per pixel.
+  ImageF(int width, int height, std::vector<double> samples);
 
   size_t pixelCount() const { return static_cast<size_t>(width) * static_cast<size_t>(height); }
   double* at(int x, int y) { return rgb.data() + index(x, y); }

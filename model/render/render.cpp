@@ -819,8 +819,7 @@ PixelMask coveredPixels(const Framebuffer& fb) {
 }
 
 ImageF exactImage(const Framebuffer& reference) {
-  ImageF img(reference.width, reference.height);
-  img.rgb = reference.lsb;
+  ImageF img(reference.width, reference.height, reference.lsb);
   for (double& v : img.rgb) v = std::clamp(v, 0.0, 255.0);
   return img;
 }

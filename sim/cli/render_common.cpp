@@ -64,12 +64,7 @@ RenderResult renderReference(const Scene& sc, const RenderOptions& ro) {
 }
 
 ReferenceImage referenceImage(RenderResult ref, double highlight_lsb) {
-  // The specular part as an image: its samples taken over from the frame, not copied into a
-  // new image (which would be cleared first, then overwritten).
-  ImageF spec;
-  spec.width = ref.fb.width;
-  spec.height = ref.fb.height;
-  spec.rgb = std::move(ref.fb.spec_lsb);
+  const ImageF spec(ref.fb.width, ref.fb.height, std::move(ref.fb.spec_lsb));  // taken over, not copied
   return {exactImage(ref.fb), coveredPixels(ref.fb), thresholdMask(spec, highlight_lsb)};
 }
 

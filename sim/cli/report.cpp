@@ -237,7 +237,7 @@ json ReportCmd::unitsJson(const std::vector<SpanUnitConfig>& modes, const Measur
                              {"prom", {{"fit", c.prom.fit}, {"level", c.prom.level}, {"n", c.prom.n}}},
                              {"lobe", lobe}};
     const std::string what = fmt::format("specular configuration {}", c.name);
-    const auto table = std::make_shared<const PromTable>(promTable(c));
+    const PromTable* table = &promTable(c);  // kept for the process: the jobs may run after this loop
     units["spec"][c.name]["scene_error"] = sceneSpecError(*table, scene_n_);
     if (hw.synth)
       area_jobs.push_back({"spec", c.name, "area", "area of " + what, [table, t = *hw.synth] { return specPointArea(*table, t); }});
