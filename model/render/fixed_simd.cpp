@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
+#include <type_traits>
 
 #include "render/fixed_shading.h"
 #include "render/normalize.h"
@@ -81,18 +82,26 @@ constexpr std::array<uint16_t, 16> kSpread3 = [] {
   return t;
 }();
 
-// One group of n <= 8 fragments at offset i of shadeNh's arrays; false when it declines them.
-// Inline into shadeNh's loop, where the compiler keeps the broadcast constants out of the loop.
-// kCodes: codes is not null (a compile-time case: the renderer's loop, without the test and
-// the code stores, runs some 20 % faster).
-template <bool kCodes>
-SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
-                                  size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
-  // Lanes past n compute on whatever their entries hold; they read no table (masked gathers)
-  // and their results are not stored.
+// shadeNh works in two passes over its fragments, each group of 8 in each:
+//   scaleGroup  the squared norm's cosine scale r64 (rsqrtCore and cosineScale), or the group
+//               declined;
+//   shadeGroup  from r64 and the dot products, the colours.
+// One pass doing both left the processor waiting on the lobe table's gather (a third of the
+// kernel's samples on the instruction after it): a group's chain of dependent operations, from
+// its squared norm through the seed's lookup, the products with r64 and the gather to its
+// stores, is longer than the out-of-order window holds of the groups behind it. Split, each
+// pass's groups overlap: on an AMD EPYC (family 26) the kernel took 0.64-0.84 of its samples, a
+// phong-fixed frame of builtin:sphere 0.90 of its time; the AVX2 kernel's frame 0.86
+// (docs/performance.md).
+// Both inline into shadeNh's loops, where the compiler keeps the broadcast constants out of
+// the loop. Lanes past n compute on whatever their entries hold; they read no table (masked
+// gathers) and their results are not stored.
+
+// The cosine scale r64 of each of the n <= 8 squared norms at sq, stored at r64_out; false
+// (nothing stored) when a fragment needs the scalar path.
+SHD_AVX512 inline bool scaleGroup(const uint64_t* sq, int n, uint64_t* r64_out) {
   const __mmask8 valid = static_cast<__mmask8>((1u << n) - 1);
   const __m512i v = _mm512_loadu_si512(sq);
-  const __m512i dot_l = _mm512_loadu_si512(l), dot_h = _mm512_loadu_si512(h);
 
   // rsqrtCore<10>: bits, shift = bits <= 62 ? (62 - bits) / 2 : -1, m, mq = m >> 30.
   const __m512i bits = _mm512_sub_epi64(_mm512_set1_epi64(64), _mm512_lzcnt_epi64(v));
@@ -128,8 +137,19 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
   const __m512i r = _mm512_srai_epi64(
       _mm512_mullo_epi64(r0, _mm512_sub_epi64(_mm512_set1_epi64(int64_t{3} << 32), mr)), 17);
   // cosineScale: s = 61 - shift, r64 = r << (64 - s) = r << (3 + shift).
-  const __m512i r64 = _mm512_sllv_epi64(r, _mm512_add_epi64(shift, _mm512_set1_epi64(3)));
+  _mm512_storeu_si512(r64_out, _mm512_sllv_epi64(r, _mm512_add_epi64(shift, _mm512_set1_epi64(3))));
+  return true;
+}
 
+// The colours of the n <= 8 fragments at offset i of shadeNh's arrays from their cosine scales
+// (scaleGroup's) and dot products. kCodes: codes is not null (a compile-time case: the
+// renderer's loop, without the test and the code stores, runs some 20 % faster).
+template <bool kCodes>
+SHD_AVX512 inline void shadeGroup(const NhParams& p, const uint64_t* r64s, const uint64_t* l, const uint64_t* h, int n,
+                                  size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
+  const __mmask8 valid = static_cast<__mmask8>((1u << n) - 1);
+  const __m512i r64 = _mm512_loadu_si512(r64s);
+  const __m512i dot_l = _mm512_loadu_si512(l), dot_h = _mm512_loadu_si512(h);
   const __m512i nl = scaleCosines(dot_l, r64);
   const __mmask8 lit = _mm512_cmpgt_epi64_mask(nl, _mm512_setzero_si512());
   const __m512i nh = scaleCosines(dot_h, r64);
@@ -160,7 +180,6 @@ SHD_AVX512 inline bool shadeGroup(const NhParams& p, const uint64_t* sq, const u
     _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k] + i), _mm512_cvtepi64_epi8(out));
     if constexpr (kCodes) _mm512_storeu_si512(codes[k] + i, code);
   }
-  return true;
 }
 
 // AVX2 helpers, inlined into the AVX2 and the AVX-512 kernels (a subset of either's target).
@@ -268,13 +287,22 @@ template <class Group>
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
-  if (codes != nullptr)
-    return eachGroup(n, [&](size_t i, int count) SHD_AVX512 {
-      return shadeGroup<true>(p, sq + i, l + i, h + i, count, i, rgb, codes);
+  if (n > kMaxBatch) throw std::logic_error("fixed_simd::shadeNh: more than kMaxBatch fragments");
+  uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before shadeGroup reads it
+  const uint64_t declined =
+      eachGroup(n, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); });
+  const auto shade = [&](auto with_codes) SHD_AVX512 {
+    eachGroup(n, [&](size_t i, int count) SHD_AVX512 {
+      if (((declined >> (i / 8)) & 1) == 0)
+        shadeGroup<decltype(with_codes)::value>(p, r64 + i, l + i, h + i, count, i, rgb, codes);
+      return true;
     });
-  return eachGroup(n, [&](size_t i, int count) SHD_AVX512 {
-    return shadeGroup<false>(p, sq + i, l + i, h + i, count, i, rgb, nullptr);
-  });
+  };
+  if (codes != nullptr)
+    shade(std::true_type{});
+  else
+    shade(std::false_type{});
+  return declined;
 }
 
 namespace {
@@ -556,13 +584,11 @@ SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
   return _mm256_add_epi64(hi, _mm256_srli_epi64(mulLo64(d, r64), 63));
 }
 
-// shadeGroup's datapath on the 4 fragments at sq, l, h (`valid`: the lanes that are fragments),
-// up to the 12-fraction-bit codes; false when a valid lane needs the scalar path.
-SHD_AVX2 [[gnu::always_inline]] inline bool shadeLanes4(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h,
-                                 __m256i valid, __m256i (&code)[3]) {
+// scaleGroup's datapath on the 4 squared norms at sq (`valid`: the lanes that are fragments),
+// their cosine scales stored at r64_out; false (nothing stored) when a valid lane needs the
+// scalar path.
+SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m256i valid, uint64_t* r64_out) {
   const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sq));
-  const __m256i dot_l = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l));
-  const __m256i dot_h = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h));
   // rsqrtCore<10>: the bit length (lane by lane: AVX2 has no count of leading zeros), shift.
   auto bitsOf = [](uint64_t x) { return x == 0 ? int64_t{0} : int64_t{64 - __builtin_clzll(x)}; };
   const __m256i bits = _mm256_set_epi64x(bitsOf(sq[3]), bitsOf(sq[2]), bitsOf(sq[1]), bitsOf(sq[0]));
@@ -584,8 +610,17 @@ SHD_AVX2 [[gnu::always_inline]] inline bool shadeLanes4(const NhParams& p, const
   const __m256i mr = _mm256_add_epi64(_mm256_mul_epu32(mq, _mm256_srli_epi64(r0sq, 32)),
                                       _mm256_srli_epi64(_mm256_mul_epu32(mq, r0sq), 32));
   const __m256i r = sra64<17>(mulLo64(r0, _mm256_sub_epi64(_mm256_set1_epi64x(int64_t{3} << 32), mr)));
-  const __m256i r64 = _mm256_sllv_epi64(r, _mm256_add_epi64(shift, _mm256_set1_epi64x(3)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(r64_out), _mm256_sllv_epi64(r, _mm256_add_epi64(shift, _mm256_set1_epi64x(3))));
+  return true;
+}
 
+// shadeGroup's datapath on the 4 fragments at r64 (scaleLanes4's), l, h (`valid`: the lanes
+// that are fragments), up to the 12-fraction-bit codes.
+SHD_AVX2 [[gnu::always_inline]] inline void shadeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
+                                                        const uint64_t* h, __m256i valid, __m256i (&code)[3]) {
+  const __m256i r64 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r64s));
+  const __m256i dot_l = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l));
+  const __m256i dot_h = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h));
   const __m256i nl = scaleCosines4(dot_l, r64);
   const __m256i lit = _mm256_cmpgt_epi64(nl, _mm256_setzero_si256());
   const __m256i nh = scaleCosines4(dot_h, r64);
@@ -612,7 +647,6 @@ SHD_AVX2 [[gnu::always_inline]] inline bool shadeLanes4(const NhParams& p, const
     const __m256i specular = _mm256_srli_epi64(_mm256_add_epi64(_mm256_mul_epu32(ks, f), _mm256_set1_epi64x(1 << 23)), 24);
     code[k] = _mm256_add_epi64(_mm256_set1_epi64x(p.ambient[k]), _mm256_and_si256(lit, _mm256_add_epi64(diffuse, specular)));
   }
-  return true;
 }
 
 // The output byte of each channel's code (as shadeGroup's out) in the low byte of the 64-bit lanes.
@@ -621,14 +655,21 @@ SHD_AVX2 inline __m256i outputs4(__m256i code) {
       _mm256_add_epi64(min64(code, _mm256_set1_epi64x(int64_t{255} << 12)), _mm256_set1_epi64x(1 << 11)), 12);
 }
 
+// The valid lanes of a group of n fragments: of its first four (half 0) or last four (half 1).
+SHD_AVX2 inline __m256i validLanes4(int n, int half) {
+  return _mm256_cmpgt_epi64(_mm256_set1_epi64x(n - 4 * half), _mm256_setr_epi64x(0, 1, 2, 3));
+}
+
+// scaleGroup and shadeGroup on two groups of 4 lanes each.
+SHD_AVX2 inline bool scaleGroupAvx2(const uint64_t* sq, int n, uint64_t* r64_out) {
+  return scaleLanes4(sq, validLanes4(n, 0), r64_out) && scaleLanes4(sq + 4, validLanes4(n, 1), r64_out + 4);
+}
 template <bool kCodes>
-SHD_AVX2 inline bool shadeGroupAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, int n,
+SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const uint64_t* r64, const uint64_t* l, const uint64_t* h, int n,
                                     size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
-  const __m256i lane = _mm256_setr_epi64x(0, 1, 2, 3);
   __m256i a[3], b[3];
-  if (!shadeLanes4(p, sq, l, h, _mm256_cmpgt_epi64(_mm256_set1_epi64x(n), lane), a) ||
-      !shadeLanes4(p, sq + 4, l + 4, h + 4, _mm256_cmpgt_epi64(_mm256_set1_epi64x(n - 4), lane), b))
-    return false;
+  shadeLanes4(p, r64, l, h, validLanes4(n, 0), a);
+  shadeLanes4(p, r64 + 4, l + 4, h + 4, validLanes4(n, 1), b);
   // Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
   const __m256i pick_a = _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
                                           -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
@@ -643,20 +684,28 @@ SHD_AVX2 inline bool shadeGroupAvx2(const NhParams& p, const uint64_t* sq, const
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i + 4), b[k]);
     }
   }
-  return true;
 }
 
 }  // namespace
 
 SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                               uint8_t* const rgb[3], int64_t* const codes[3]) {
-  if (codes != nullptr)
-    return eachGroup(n, [&](size_t i, int count) SHD_AVX2 {
-      return shadeGroupAvx2<true>(p, sq + i, l + i, h + i, count, i, rgb, codes);
+  if (n > kMaxBatch) throw std::logic_error("fixed_simd::shadeNhAvx2: more than kMaxBatch fragments");
+  uint64_t r64[kMaxBatch];  // as shadeNh's
+  const uint64_t declined =
+      eachGroup(n, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); });
+  const auto shade = [&](auto with_codes) SHD_AVX2 {
+    eachGroup(n, [&](size_t i, int count) SHD_AVX2 {
+      if (((declined >> (i / 8)) & 1) == 0)
+        shadeGroupAvx2<decltype(with_codes)::value>(p, r64 + i, l + i, h + i, count, i, rgb, codes);
+      return true;
     });
-  return eachGroup(n, [&](size_t i, int count) SHD_AVX2 {
-    return shadeGroupAvx2<false>(p, sq + i, l + i, h + i, count, i, rgb, nullptr);
-  });
+  };
+  if (codes != nullptr)
+    shade(std::true_type{});
+  else
+    shade(std::false_type{});
+  return declined;
 }
 
 // ---- bufferRun in AVX2 ----
