@@ -14,11 +14,11 @@
 #     and vector files.
 # The scratch build compiles only what depends on the registry: its embedded files and the
 # verilated models of the two new configurations (SHD_VERILATE); the model, vector, co-simulation
-# and CLI libraries are BUILD_DIR's, the build running this test (SHD_PREBUILT, of the same
-# source tree and build type). The registry's other configurations are there for the golden
-# model, marked "no verilated model". shadesim_systemc is not compiled here: the main build runs
-# the SystemC testbench on every configuration of the registry, through the same
-# per-configuration CMake code that this build generates for the new ones.
+# and CLI libraries and Verilator's runtime are BUILD_DIR's, the build running this test
+# (SHD_PREBUILT, of the same source tree and build type). The registry's other configurations
+# are there for the golden model, marked "no verilated model". shadesim_systemc is not compiled
+# here: the main build runs the SystemC testbench on every configuration of the registry,
+# through the same per-configuration CMake code that this build generates for the new ones.
 set -euo pipefail
 src=$(cd "$1" && pwd)
 work=$2
