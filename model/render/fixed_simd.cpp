@@ -283,26 +283,37 @@ template <class Group>
   return declined;
 }
 
+// The second pass of shadeNh's: shade(i, count, codes) for each group not declined, codes a
+// std::bool_constant (kCodes: the kernel stores the codes).
+template <bool kCodes, class Shade>
+[[gnu::always_inline]] inline void shadePass(size_t n, uint64_t declined, Shade& shade) {
+  for (size_t g = 0; g * 8 < n; ++g)
+    if (((declined >> g) & 1) == 0)
+      shade(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)), std::bool_constant<kCodes>{});
+}
+// shadeNh's two passes: scale(i, count) for every group (eachGroup's group), then shadePass
+// (with codes: the caller wants the codes). Returns the groups declined.
+template <class Scale, class Shade>
+[[gnu::always_inline]] inline uint64_t twoPasses(size_t n, bool codes, Scale scale, Shade shade) {
+  const uint64_t declined = eachGroup(n, scale);
+  if (codes)
+    shadePass<true>(n, declined, shade);
+  else
+    shadePass<false>(n, declined, shade);
+  return declined;
+}
+
 }  // namespace
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
   if (n > kMaxBatch) throw std::logic_error("fixed_simd::shadeNh: more than kMaxBatch fragments");
   uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before shadeGroup reads it
-  const uint64_t declined =
-      eachGroup(n, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); });
-  const auto shade = [&](auto with_codes) SHD_AVX512 {
-    eachGroup(n, [&](size_t i, int count) SHD_AVX512 {
-      if (((declined >> (i / 8)) & 1) == 0)
+  return twoPasses(
+      n, codes != nullptr, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); },
+      [&](size_t i, int count, auto with_codes) SHD_AVX512 {
         shadeGroup<decltype(with_codes)::value>(p, r64 + i, l + i, h + i, count, i, rgb, codes);
-      return true;
-    });
-  };
-  if (codes != nullptr)
-    shade(std::true_type{});
-  else
-    shade(std::false_type{});
-  return declined;
+      });
 }
 
 namespace {
@@ -692,20 +703,11 @@ SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint6
                               uint8_t* const rgb[3], int64_t* const codes[3]) {
   if (n > kMaxBatch) throw std::logic_error("fixed_simd::shadeNhAvx2: more than kMaxBatch fragments");
   uint64_t r64[kMaxBatch];  // as shadeNh's
-  const uint64_t declined =
-      eachGroup(n, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); });
-  const auto shade = [&](auto with_codes) SHD_AVX2 {
-    eachGroup(n, [&](size_t i, int count) SHD_AVX2 {
-      if (((declined >> (i / 8)) & 1) == 0)
+  return twoPasses(
+      n, codes != nullptr, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); },
+      [&](size_t i, int count, auto with_codes) SHD_AVX2 {
         shadeGroupAvx2<decltype(with_codes)::value>(p, r64 + i, l + i, h + i, count, i, rgb, codes);
-      return true;
-    });
-  };
-  if (codes != nullptr)
-    shade(std::true_type{});
-  else
-    shade(std::false_type{});
-  return declined;
+      });
 }
 
 // ---- bufferRun in AVX2 ----
