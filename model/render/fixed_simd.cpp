@@ -91,8 +91,8 @@ constexpr std::array<uint16_t, 16> kSpread3 = [] {
 // its squared norm through the seed's lookup, the products with r64 and the gather to its
 // stores, is longer than the out-of-order window holds of the groups behind it. Split, each
 // pass's groups overlap: on an AMD EPYC (family 26) the kernel took 0.64-0.84 of its samples, a
-// phong-fixed frame of builtin:sphere 0.90 of its time; the AVX2 kernel's frame 0.86
-// (docs/performance.md).
+// phong-fixed frame of builtin:sphere 0.89 of its time; the AVX2 kernel's frame 0.91
+// (docs/performance.md, "What makes a frame fast").
 // Both inline into shadeNh's loops, where the compiler keeps the broadcast constants out of
 // the loop. Lanes past n compute on whatever their entries hold; they read no table (masked
 // gathers) and their results are not stored.
