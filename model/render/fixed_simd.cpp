@@ -292,9 +292,11 @@ template <bool kCodes, class Shade>
       shade(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)), std::bool_constant<kCodes>{});
 }
 // shadeNh's two passes: scale(i, count) for every group (eachGroup's group), then shadePass
-// (with codes: the caller wants the codes). Returns the groups declined.
+// (with codes: the caller wants the codes). Returns the groups declined. n is at most kMaxBatch
+// (the kernels' arrays of cosine scales).
 template <class Scale, class Shade>
 [[gnu::always_inline]] inline uint64_t twoPasses(size_t n, bool codes, Scale scale, Shade shade) {
+  if (n > kMaxBatch) throw std::logic_error("fixed_simd: a batch of more than kMaxBatch fragments");
   const uint64_t declined = eachGroup(n, scale);
   if (codes)
     shadePass<true>(n, declined, shade);
@@ -307,7 +309,6 @@ template <class Scale, class Shade>
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
-  if (n > kMaxBatch) throw std::logic_error("fixed_simd::shadeNh: more than kMaxBatch fragments");
   uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before shadeGroup reads it
   return twoPasses(
       n, codes != nullptr, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); },
@@ -701,7 +702,6 @@ SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const uint64_t* r64, cons
 
 SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                               uint8_t* const rgb[3], int64_t* const codes[3]) {
-  if (n > kMaxBatch) throw std::logic_error("fixed_simd::shadeNhAvx2: more than kMaxBatch fragments");
   uint64_t r64[kMaxBatch];  // as shadeNh's
   return twoPasses(
       n, codes != nullptr, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); },
