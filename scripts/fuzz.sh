@@ -74,6 +74,7 @@ mode_of() {
   esac
 }
 
+"$root/scripts/install_deps.sh" build tools fuzz
 echo "fuzz.sh: building $build"
 if [ ! -f "$build/CMakeCache.txt" ]; then
   nice cmake -S "$root" -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DSHD_FUZZ=ON -DSHD_BENCHMARKS=OFF >/dev/null

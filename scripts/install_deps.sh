@@ -1,28 +1,58 @@
 #!/usr/bin/env bash
 # Installs the Debian packages shadesim builds and runs with, skipping the ones present.
-# Every package the build, the tests or the demo use is listed here, including those a fresh
-# machine may already have, so that nothing depends on a hand-installed tool.
+#   scripts/install_deps.sh [GROUP...]     groups: build tools fuzz (default: build tools)
+# Every package the build, the tests, the demo or a script uses is listed here, including those
+# a fresh machine may already have, so that nothing depends on a hand-installed tool.
+#   build  what the build compiles and links with (scripts/build.sh)
+#   tools  what the tests and the demo run beside shadesim: simulators, synthesis, place and
+#          route, the provers, plots, the mesh corpus
+#   fuzz   clang for the libFuzzer build (scripts/fuzz.sh)
+# test.sh and demo.sh install build, then tools while the build compiles
+# (scripts/install_while_building.sh).
 set -euo pipefail
-packages=(
-  build-essential cmake ninja-build pkg-config python3 python3-matplotlib
-  verilator iverilog yosys nextpnr-ice40 libjemalloc2
-  sollya gappa clang parallel
-  libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libpng-dev
-  libassimp-dev assimp-testmodels
-)
+group_packages() {
+  case "$1" in
+    build) echo build-essential cmake ninja-build pkg-config python3 verilator \
+                libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev \
+                libgtest-dev libgmock-dev libbenchmark-dev libpng-dev libassimp-dev ;;
+    # python3-munkres: python3-matplotlib needs python3-fonttools, which takes python3-scipy
+    # or python3-munkres; named here, apt takes munkres (11 kB) instead of scipy and what scipy
+    # brings (pythran, boost, BLAS: 34 packages; a fresh machine's install 0.85x the time).
+    tools) echo iverilog yosys nextpnr-ice40 libjemalloc2 sollya gappa parallel \
+                python3-matplotlib python3-munkres assimp-testmodels ;;
+    fuzz) echo clang ;;
+    *) echo "install_deps: unknown group '$1' (build, tools, fuzz)" >&2; return 2 ;;
+  esac
+}
+groups=("$@")
+[ ${#groups[@]} -gt 0 ] || groups=(build tools)
+packages=()
+for g in "${groups[@]}"; do
+  list=$(group_packages "$g") || exit 2
+  read -r -a more <<< "$list"
+  packages+=("${more[@]}")
+done
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 if [ ${#missing[@]} -eq 0 ]; then
-  echo "install_deps: all ${#packages[@]} packages present"
+  echo "install_deps: all ${#packages[@]} packages of ${groups[*]} present"
   exit 0
 fi
 echo "install_deps: installing ${missing[*]}"
 sudo=""
 [ "$(id -u)" = 0 ] || sudo="sudo"
 export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+install() { $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null; }
+# The package lists are read again only when they do not know every missing package (a fresh
+# machine), or when an install from them fails (lists older than the mirror's files).
+if ! apt-cache show "${missing[@]}" >/dev/null 2>&1; then
+  $sudo apt-get update -qq
+  install
+elif ! install; then
+  echo "install_deps: the install failed; reading the package lists again and retrying"
+  $sudo apt-get update -qq
+  install
+fi
 echo "install_deps: done"
