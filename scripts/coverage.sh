@@ -16,8 +16,8 @@ slow=0
 if [ "${1:-}" = "--slow" ]; then slow=1; shift; fi
 build="$root/build-cov"
 out="$root/out/coverage"
-source "$root/scripts/install_while_building.sh"
-shd_install_and_build "$build" -DSHD_COVERAGE=ON
+"$root/scripts/install_deps.sh"
+"$root/scripts/build.sh" "$build" -DSHD_COVERAGE=ON
 rm -rf "$out"
 mkdir -p "$out/raw"
 SHD_COVERAGE_DIR="$out/raw" ctest --test-dir "$build" -L rtl -LE slow -j "$(nproc)" --output-on-failure "$@"

@@ -8,8 +8,9 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 out="$root/out"
-source "$root/scripts/install_while_building.sh"
-shd_install_and_build "$root/build"
+"$root/scripts/install_deps.sh"
+source "$root/scripts/direct_python.sh"
+"$root/scripts/build.sh" "$root/build"
 S="$root/build/sim/shadesim"
 mkdir -p "$out/prom"
 

@@ -7,8 +7,8 @@
 #   tools  what the tests and the demo run beside shadesim: simulators, synthesis, place and
 #          route, the provers, plots, the mesh corpus
 #   fuzz   clang for the libFuzzer build (scripts/fuzz.sh)
-# test.sh and demo.sh install build, then tools while the build compiles
-# (scripts/install_while_building.sh).
+# On a fresh 2-core machine the install is mostly CPU (unpacking, byte-compiling): installing
+# the tools while the build compiled made the build that much slower (docs/verification.md).
 set -euo pipefail
 group_packages() {
   case "$1" in

@@ -10,8 +10,9 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 sanitize=0
 if [ "${1:-}" = "--sanitize" ]; then sanitize=1; shift; fi
 start=$(date +%s)
-source "$root/scripts/install_while_building.sh"
-shd_install_and_build "$root/build"
+"$root/scripts/install_deps.sh"
+source "$root/scripts/direct_python.sh"
+"$root/scripts/build.sh" "$root/build"
 echo "test.sh: built after $(( $(date +%s) - start )) s"
 ctest --test-dir "$root/build" --output-on-failure -j "$(nproc)" "$@"
 echo "test.sh: release tests passed after $(( $(date +%s) - start )) s"
