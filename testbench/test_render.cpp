@@ -9,6 +9,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <tuple>
 
 #include "render/draw.h"
 #include "render/fixed_simd.h"
@@ -1008,15 +1009,18 @@ TEST(Render, TwoThreadsEqualOneThread) {
 // same walk, frame over frame on two threads equals one thread, rows' spans and walks alike.
 TEST(Render, TwoThreadsShareTheRowsWalkedAhead) {
   const RowShare all{}, front{RowShare::Side::Front}, back{RowShare::Side::Back};
+  const RowShare top{RowShare::Side::Rows, 0, 77}, bottom{RowShare::Side::Rows, 77, 4096};
   int front_rows = 0;
   for (int32_t y = 0; y < 4096; ++y) {
     ASSERT_TRUE(all.mine(y));
     ASSERT_NE(front.mine(y), back.mine(y)) << "row " << y;
+    ASSERT_NE(top.mine(y), bottom.mine(y)) << "row " << y;
+    EXPECT_EQ(top.mine(y), y < 77) << "row " << y;
     front_rows += front.mine(y);
     EXPECT_EQ(front.mine(y), y % 64 < 24) << "row " << y;
   }
   EXPECT_EQ(front_rows, 4096 * 3 / 8);
-  for (const RowShare& share : {all, front, back})
+  for (const RowShare& share : {all, front, back, top, bottom})
     for (int32_t y0 = 0; y0 < 200; ++y0)
       for (int32_t y1 = y0; y1 < y0 + 70; ++y1) {
         bool any = false;
@@ -1031,6 +1035,7 @@ TEST(Render, TwoThreadsShareTheRowsWalkedAhead) {
       RenderOptions o;
       o.method = Method::PhongFixed;
       o.brdf = "blinn";  // builtin:materials' cubic material would need the cubic unit
+      o.split_rows = false;  // the walk ahead, not the split by rows
       PhongWidths w;
       w.NormalFracBits = 20;
       w.CosFracBits = 24;
@@ -1059,6 +1064,7 @@ TEST(Render, TwoThreadsSetUpOnEitherSide) {
           o.method = m;
           o.brdf = brdf;
           o.hand_off_below = below;
+          o.split_rows = false;  // the front and the back end
           expectTwoThreadsEqualOne(s, o, one, two, what);
         }
   }
@@ -1075,11 +1081,64 @@ TEST(Render, TwoThreadsSetUpOnEitherSide) {
       const std::string want = testutil::errorOf<std::invalid_argument>(fails);
       EXPECT_NE(want.find("triangle 2: attribute 0 = nan"), std::string::npos) << what << ": " << want;  // after 2 drawn
       o.threads = 2;
+      EXPECT_EQ(testutil::errorOf<std::invalid_argument>(fails), want) << what << " split by rows";
+      o.split_rows = false;
       for (size_t below : shares) {
         o.hand_off_below = below;
         EXPECT_EQ(testutil::errorOf<std::invalid_argument>(fails), want) << what << " hand_off_below " << below;
       }
     }
+}
+
+// Two threads split by rows (RenderOptions::split_rows, render.cpp's SplitSide): the same
+// bytes, triangle list, counts and drawn rectangle as one thread for flat, Gouraud and
+// phong-fixed on every built-in scene (builtin:plane: triangles clipped at the near plane and
+// the guard band), wherever the frame splits: all rows the bottom's or the top's, one row, a
+// third, the middle, and the adaptive split frame over frame. With and without the triangle
+// buffer (each side's tags made the frame's), the rows' spans (every triangle walked from its
+// descriptor, each side replaying its rows) and the vector kernels (the scalar paths).
+TEST(Render, TwoThreadsSplitByRowsEqualOneThread) {
+  int compared = 0;
+  for (const char* name : {"builtin:sphere", "builtin:plane", "builtin:torus", "builtin:materials"}) {
+    const Scene s = loadScene(name);
+    const int H = s.camera.height;
+    for (Method m : {Method::Flat, Method::Gouraud, Method::PhongFixed})
+      for (const char* variant : {"", "no tags", "no row spans", "scalar"})
+        for (int split : {-1, 0, 1, H / 3, H / 2 + 1, H}) {
+          const std::string what = fmt::format("{} {} {} split at {}", name, toString(m), variant, split);
+          ModelEngines one("serial"), two("serial");
+          RenderOptions o;
+          o.method = m;
+          o.brdf = "blinn";  // builtin:materials' cubic material would need the cubic unit
+          o.split_row = split;
+          o.tags = std::string(variant) != "no tags";
+          o.row_spans = std::string(variant) != "no row spans";
+          o.vector_kernel = std::string(variant) != "scalar";
+          o.threads = 2;
+          ASSERT_TRUE(splitsByRows(s, o, two.span)) << what;
+          const RenderResult a = expectTwoThreadsEqualOne(s, o, one, two, what);
+          o.threads = 2;
+          const RenderResult b = render(s, o, two.span, two.view);
+          EXPECT_EQ(std::make_tuple(a.fb.drawn_x0, a.fb.drawn_y0, a.fb.drawn_x1, a.fb.drawn_y1),
+                    std::make_tuple(b.fb.drawn_x0, b.fb.drawn_y0, b.fb.drawn_x1, b.fb.drawn_y1))
+              << what;
+          ++compared;
+        }
+  }
+  EXPECT_EQ(compared, 4 * 3 * 4 * 6);
+  // Not split: a device lobe, the full-rate unit's stream, or split_rows off.
+  const Scene sphere = loadScene("builtin:sphere");
+  ModelEngines serial("serial"), full("sierpinskifull");
+  RenderOptions o;
+  o.method = Method::Gouraud;
+  o.threads = 2;
+  EXPECT_TRUE(splitsByRows(sphere, o, serial.span));
+  EXPECT_FALSE(splitsByRows(sphere, o, full.span));
+  o.split_rows = false;
+  EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
+  o.split_rows = true;
+  o.brdf = "quadratic";
+  EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
 }
 
 // What cannot run on two threads is refused, naming why; an error on either thread reaches the

@@ -28,6 +28,7 @@
 // frames.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -86,6 +87,32 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
 // The cycles and fragments walkSpanUnit counts for the descriptor setup makes of the same
 // triangle (p: the unit, NumTri 1), the full-rate unit's on `stream` (as walkSpanUnit's).
 SpanWalk countRowSpans(const SpanParams& p, const RowSpans& s, SpanStream* stream);
+
+// The rows y0 .. y1 - 1 of s as rows' spans of their own (the same pixels and attribute codes
+// there; groups left 0: for drawing, not for counting): false when none of them holds a pixel.
+// The rows past out.rows, to the next multiple of 8, hold no pixel.
+inline bool sliceRowSpans(const RowSpans& s, int32_t y0, int32_t y1, RowSpans& out) {
+  auto empty = [&s](int32_t i) { return s.span[static_cast<size_t>(i)][0] > s.span[static_cast<size_t>(i)][1]; };
+  int32_t a = std::max(y0 - s.y0, 0), b = std::min(y1 - s.y0, s.rows);  // rows a .. b - 1 of s
+  while (a < b && empty(a)) ++a;
+  while (b > a && empty(b - 1)) --b;
+  if (a >= b) return false;
+  out.y0 = s.y0 + a;
+  out.rows = b - a;
+  out.x0 = s.span[static_cast<size_t>(a)][0];
+  for (size_t k = 0; k < 4; ++k) out.a0[k] = s.at(k, out.x0, a);
+  out.didx = s.didx;
+  out.didy = s.didy;
+  out.fragments = 0;
+  out.groups = 0;
+  for (int32_t i = a; i < b; ++i) {
+    const auto& sp = s.span[static_cast<size_t>(i)];
+    out.span[static_cast<size_t>(i - a)] = sp;
+    if (sp[0] <= sp[1]) out.fragments += static_cast<uint32_t>(sp[1] - sp[0] + 1);
+  }
+  for (int32_t i = out.rows; i % 8 != 0; ++i) out.span[static_cast<size_t>(i)] = {1, 0};
+  return true;
+}
 
 // The rows' fragments as walkSpanUnit hands them to a run consumer: one RowRun per row with a
 // pixel, top to bottom, each left to right; only the screen rows y where keep(y) holds.

@@ -41,23 +41,29 @@ struct RecordedWalk {
   std::vector<Event> events;
 };
 
-// The rows of a triangle walked ahead (TwoThreads::AfterWalk) that a two-thread frame's side
-// draws: the screen in bands of 8 rows, kBands to a period, the front end taking the first
-// kFrontBands of each period and the back end the others (All: every row, one thread). Each
+// The rows of a triangle that a side of a two-thread frame draws. Walked ahead
+// (TwoThreads::AfterWalk): the screen in bands of 8 rows, kBands to a period, the front end
+// taking the first kFrontBands of each period and the back end the others. Split by rows
+// (render.cpp, "split by rows"): the rows y0 .. y1 - 1 (Rows). All: every row, one thread. Each
 // pixel is then drawn by one side alone, in the triangles' order, as one thread draws it; each
 // side counts the pixels it draws. The front end's share is the smaller, as it also culls,
 // sets up and walks: of 0 to 4 bands in 8, 3 made phong-fixed's frame on builtin:sphere the
 // shortest on a 2-core AMD EPYC VM without AVX-512 (docs/performance.md).
 struct RowShare {
-  enum class Side : uint8_t { All, Front, Back };
+  enum class Side : uint8_t { All, Front, Back, Rows };
   Side side = Side::All;
+  int32_t y0 = 0, y1 = 0;  // Rows: this side's rows
   static constexpr int kBandShift = 3, kBands = 8, kFrontBands = 3;
   static bool front(int32_t y) { return ((y >> kBandShift) & (kBands - 1)) < kFrontBands; }
-  bool mine(int32_t y) const { return side == Side::All || (side == Side::Front) == front(y); }
+  bool mine(int32_t y) const {
+    if (side == Side::Rows) return y >= y0 && y < y1;
+    return side == Side::All || (side == Side::Front) == front(y);
+  }
   // Whether a row of y0 .. y1 (y0 <= y1) is mine.
-  bool anyIn(int32_t y0, int32_t y1) const {
-    for (int32_t band = y0 >> kBandShift; band <= y1 >> kBandShift; ++band)
-      if (mine(std::max(y0, band << kBandShift))) return true;
+  bool anyIn(int32_t lo, int32_t hi) const {
+    if (side == Side::Rows) return lo < y1 && hi >= y0;
+    for (int32_t band = lo >> kBandShift; band <= hi >> kBandShift; ++band)
+      if (mine(std::max(lo, band << kBandShift))) return true;
     return false;
   }
   // Whether a row of a triangle's rows' spans is mine.

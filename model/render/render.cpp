@@ -2,12 +2,14 @@
 // render/pipeline.h's, the drawing of each screen triangle the method's unit's
 // (render/methods.h, render/methods/*.cpp); what is left here is the order: per object its
 // lighting and vertices, per mesh triangle culling, the vertex colours, clipping, the method's
-// parts of the polygon, and per part the span unit's setup.
+// parts of the polygon, and per part the span unit's setup. On two threads the frame is split
+// by rows (SplitSide) or into a front and a back end (DrawQueue, BackEnd).
 #include "render/render.h"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <condition_variable>
 #include <exception>
@@ -17,6 +19,7 @@
 #include <optional>
 #include <stdexcept>
 #include <thread>
+#include <tuple>
 
 #include <immintrin.h>
 
@@ -29,12 +32,73 @@
 
 namespace shd {
 
-// A frame's buffers kept in its result (ScratchBuffers): the current object's vertices, which
-// of them have their colour, and its triangles' face colours (lightFaces).
-struct RenderScratch {
+// A drawer's buffers kept in a frame's result: the current object's vertices, which of them
+// have their colour, and its triangles' face colours (lightFaces).
+struct alignas(64) DrawScratch {  // in lines of its own: each side of a split frame writes its own
   std::vector<PVertex> verts;
   std::vector<uint8_t> lit;
   std::vector<std::array<double, 3>> faces;
+};
+
+// The frame's key of a screen triangle: its object, its mesh triangle and which part of it.
+struct PartKey {
+  uint32_t object, mesh, part;
+  bool operator<(const PartKey& o) const { return std::tie(object, mesh, part) < std::tie(o.object, o.mesh, o.part); }
+};
+
+// A side of a two-thread frame split by rows (renderSplit): the rows it draws, and the screen
+// triangles it owns. A mesh triangle's owner is the side of its first row that may hold a pixel
+// (the top side for a triangle not wholly in front of the near plane, whose rows are known only
+// once it is clipped). The owner counts the triangle, sets up each of its parts and records
+// those setup keeps (PartKey order: the order of one thread); the other side sets up only the
+// parts that may reach its rows. Each side draws its rows of every part it set up, objects
+// and triangles in the order of one thread, so each pixel sees the triangles in that order.
+// A pixel's tag (Framebuffer::tri) is written as the side's own index of the triangle, or
+// kForeignTag plus its index in `foreign`, and made the frame's after both sides end.
+struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
+  static constexpr uint32_t kForeignTag = uint32_t{1} << 30;
+  struct Record {
+    PartKey key;
+    ScreenTriangleInfo info;
+  };
+  RowShare rows{RowShare::Side::Rows};  // its rows, y0 .. y1 - 1
+  int32_t split = 0, H = 0;             // the bottom side's first row; the frame's rows
+  bool top = true;
+  std::vector<Record> owned;        // in key order
+  std::vector<PartKey> foreign;     // drawn here, owned by the other side, in key order
+  std::vector<uint32_t> global;     // the frame's index of owned[i], then of foreign[i]
+  RenderStats stats;                // the bottom side's counts (the top counts into the frame's)
+  RenderStats others;               // the counts of the other side's triangles (not kept)
+  RecordedWalk walk;                // a part set up without rows' spans, walked for its rows
+  std::exception_ptr error;
+  // The rows lo .. hi a triangle whose vertices lie at these y may reach: those of the pixel
+  // centres within them, within [floor(ymin), ceil(ymax)], and one more each way (setup's
+  // snapping moves a vertex by less than a subpixel), which [trunc(ymin) - 2, trunc(ymax) + 2]
+  // holds; clamped to -1 .. H (NaN: -1, on both sides alike).
+  std::pair<int32_t, int32_t> rowsOf(double ymin, double ymax) const {
+    auto row = [this](double y, int32_t d) {
+      if (!(y > -1.0)) return -1;
+      return y < H ? std::clamp(static_cast<int32_t>(y) + d, -1, H) : H;
+    };
+    return {row(ymin, -2), row(ymax, 2)};
+  }
+  bool owns(int32_t lo) const { return (std::clamp(lo, 0, H - 1) < split) == top; }
+  // Whether this side clips the mesh triangle tv, not culled early (and whether it owns it).
+  bool takes(const TriangleView& tv, bool& owner) const {
+    owner = top;
+    if (!tv.all_in) return true;
+    const auto [lo, hi] = rowsOf(std::min({tv.v0->y, tv.v1->y, tv.v2->y}), std::max({tv.v0->y, tv.v1->y, tv.v2->y}));
+    owner = owns(lo);
+    return owner || rows.anyIn(lo, hi);
+  }
+};
+
+// A frame's buffers kept in its result (ScratchBuffers): the drawers' buffers (second: the
+// second side's of a frame split by rows), the split's sides, and the row it split at last.
+struct RenderScratch {
+  DrawScratch main, second;
+  std::array<SplitSide, 2> sides;
+  int32_t split = -1;
 };
 ScratchBuffers::ScratchBuffers() : p_(std::make_unique<RenderScratch>()) {}
 ScratchBuffers::~ScratchBuffers() = default;
@@ -77,12 +141,15 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
 // The face colours (Frame::faceColour) of an object's triangles, its vertices transformed: of
 // those wholly in front of the near plane and not culled early, the polygons the drawer will
 // draw as the triangles themselves unless the guard band clips them (the others' are not set).
+// A side of a frame split by rows lights those it takes.
 void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris,
-                std::vector<std::array<double, 3>>& faces) {
+                std::vector<std::array<double, 3>>& faces, const SplitSide* side) {
   faces.resize(tris.size());
+  bool owner;
   for (size_t i = 0; i < tris.size(); ++i) {
     const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
-    if (tv.all_in && !culledEarly(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
+    if (tv.all_in && !culledEarly(tv) && (side == nullptr || side->takes(tv, owner)))
+      faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
   }
 }
 
@@ -300,19 +367,21 @@ class BackThread {
 // per-triangle work reused across the frame (no allocation per triangle once they have grown).
 class SceneDrawer {
  public:
-  // queue: a two-thread frame's, to which the screen triangles go (else they are drawn here);
-  // cleared: its back end has cleared the buffers (the front end draws its share of the
-  // triangles walked ahead after that).
-  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue = nullptr,
-              const std::atomic<bool>* cleared = nullptr);
+  // scratch: the drawer's buffers. queue: a two-thread frame's, to which the screen triangles go
+  // (else they are drawn here); cleared: its back end has cleared the buffers (the front end
+  // draws its share of the triangles walked ahead after that). side: a side of a frame split by
+  // rows, which draws its rows and records the triangles it owns there (not in res).
+  SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawScratch& scratch,
+              DrawQueue* queue = nullptr, const std::atomic<bool>* cleared = nullptr, SplitSide* side = nullptr);
   void drawObject(size_t oi);
   const TriangleSetup& triangleSetup() const { return setup_config_; }
 
  private:
   void lightVertices(const std::array<uint32_t, 3>& tri);
-  void walkAhead(const SpanDesc& d, RecordedWalk& w);
+  void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
+  bool drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner);
   bool queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off);
   SetupInput setupInput(const Part& part, bool colour_attrs) const;
 
@@ -336,9 +405,17 @@ class SceneDrawer {
   Parts parts_;                       // its screen triangles
   DrawQueue* const queue_;
   const std::atomic<bool>* const cleared_;
+  SplitSide* const side_;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
   RowSpans rows_;                     // the same as rows' spans
 };
+
+// The pixels a recorded screen triangle may draw, in the framebuffer's drawn rectangle.
+void markDrawn(Framebuffer& fb, const ScreenTriangleInfo& info) {
+  const auto& p = info.xy;
+  fb.markDrawn(std::min({p[0][0], p[1][0], p[2][0]}), std::min({p[0][1], p[1][1], p[2][1]}),
+               std::max({p[0][0], p[1][0], p[2][0]}), std::max({p[0][1], p[1][1], p[2][1]}));
+}
 
 // A screen triangle that setup kept, recorded: its tag (the next index of `triangles`), where it
 // came from (object, mesh triangle ti, xy(i) its vertex i's screen position), its count, and the
@@ -353,9 +430,7 @@ uint32_t recordTriangle(int object, uint32_t ti, XY xy, bool spans, std::vector<
   for (size_t i = 0; i < 3; ++i) info.xy[i] = xy(i);
   ++st.drawn;
   st.row_spans += spans;
-  const auto& p = info.xy;
-  fb.markDrawn(std::min({p[0][0], p[1][0], p[2][0]}), std::min({p[0][1], p[1][1], p[2][1]}),
-               std::max({p[0][0], p[1][0], p[2][0]}), std::max({p[0][1], p[1][1], p[2][1]}));
+  markDrawn(fb, info);
   return tag;
 }
 
@@ -364,8 +439,8 @@ auto partXY(const Part& part) {
   return [&part](size_t i) { return std::array<double, 2>{part.v[i]->x, part.v[i]->y}; };
 }
 
-SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawQueue* queue,
-                         const std::atomic<bool>* cleared)
+SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res,
+                         DrawScratch& scratch, DrawQueue* queue, const std::atomic<bool>* cleared, SplitSide* side)
     : f_(f),
       scene_(scene),
       engines_(engines),
@@ -375,11 +450,12 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       vertex_colours_(traits(f.opt.method).vertex_colours),
       face_colours_(traits(f.opt.method).face_colours),
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
-      verts_(res.scratch.get().verts),
-      lit_(res.scratch.get().lit),
-      faces_(res.scratch.get().faces),
+      verts_(scratch.verts),
+      lit_(scratch.lit),
+      faces_(scratch.faces),
       queue_(queue),
-      cleared_(cleared) {
+      cleared_(cleared),
+      side_(side) {
   RasterConfig rc;
   rc.width = f.W;
   rc.height = f.H;
@@ -418,7 +494,7 @@ void SceneDrawer::drawObject(size_t oi) {
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
   if (queue_ == nullptr) {
     transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, !face_colours_);
-    if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, faces_);
+    if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, faces_, side_);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -464,15 +540,31 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
 }
 
 void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
-  RenderStats& st = f_.st;
-  ++st.triangles;
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
+  // Split by rows: a triangle culled early is the top side's to count, any other its owner's.
+  bool owner = side_ == nullptr || side_->top;
+  RenderStats* st = owner ? &f_.st : &side_->others;
   if (culledEarly(tv)) {
-    ++st.culled_back;
+    ++st->triangles;
+    ++st->culled_back;
     return;
   }
+  if (side_ != nullptr) {
+    if (!side_->takes(tv, owner)) return;  // the other side's alone
+    st = owner ? &f_.st : &side_->others;
+  }
+  ++st->triangles;
   if (vertex_colours_) lightVertices(tri);
-  if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
+  if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, *st)) return;
+  if (side_ != nullptr) {
+    parts_.clear();
+    f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
+    unit_.parts(fan_, parts_);
+    bool drawn = false;
+    for (size_t k = 0; k < parts_.size(); ++k) drawn |= drawSplitPart(parts_[k], ti, static_cast<uint32_t>(k), owner);
+    if (!drawn) ++st->culled_no_pixel;
+    return;
+  }
   // Lit ahead: a triangle drawn as itself (a clipped one's fan points into poly_).
   f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
   // The screen triangles to draw (a fan of the polygon), each with the unit that draws it:
@@ -487,7 +579,7 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
     const uint8_t first = k == 0 ? DrawJob::kFirstPart : 0, last = k + 1 == parts_.size() ? DrawJob::kLastPart : 0;
     drawn |= drawPart(parts_[k], ti, hand_off ? first | last : 0);
   }
-  if (!drawn && !hand_off) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
+  if (!drawn && !hand_off) ++st->culled_no_pixel;  // every part dropped by setup: nothing on screen
 }
 
 // A part's vertices as its unit sets them up: colour (the part's own, flat's, or the vertex's,
@@ -558,6 +650,41 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
   return true;
 }
 
+// A part on a side of a frame split by rows (SplitSide): set up (false: dropped, or not this
+// side's), recorded and counted by its owner, its rows of this side drawn. tag: the side's own.
+bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner) {
+  SplitSide& side = *side_;
+  const auto [lo, hi] = side.rowsOf(std::min({part.v[0]->y, part.v[1]->y, part.v[2]->y}),
+                                    std::max({part.v[0]->y, part.v[1]->y, part.v[2]->y}));
+  const bool meets = side.rows.anyIn(lo, hi);
+  if (!owner && !meets) return false;
+  const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
+  const uint32_t tag = owner ? static_cast<uint32_t>(side.owned.size())
+                             : SplitSide::kForeignTag + static_cast<uint32_t>(side.foreign.size());
+  bool spans = false;
+  if (!setup_config_.run(setupInput(part, colour_attrs), part.method, colour_attrs, tag, rows_, setup_, spans))
+    return false;  // no pixel centre inside
+  const PartKey key{static_cast<uint32_t>(f_.obj.index), ti, k};
+  if (owner) {
+    SplitSide::Record& r = side.owned.emplace_back();
+    r.key = key;
+    r.info.object = f_.obj.index;
+    r.info.mesh_triangle = ti;
+    for (size_t i = 0; i < 3; ++i) r.info.xy[i] = {part.v[i]->x, part.v[i]->y};
+    ++f_.st.drawn;
+    f_.st.row_spans += spans;
+    if (spans) f_.countRows(rows_);
+  } else {
+    side.foreign.push_back(key);
+  }
+  if (!spans) walkAhead(*setup_.desc, side.walk, owner);
+  if (!meets) return true;
+  part.unit->draw(SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, spans ? &rows_ : nullptr,
+                               setup_config_.raster(colour_attrs), tag, spans ? nullptr : &side.walk, spans,
+                               side.rows});
+  return true;
+}
+
 // A part of a TwoThreads::AfterSetup method queued for the back end, which records it: set up
 // here (false: dropped, not queued), or handed off. Setup's errors here name no tag (the back
 // end gives the tags): the part is then handed off, for the back end to fail on with its tag,
@@ -585,8 +712,9 @@ bool SceneDrawer::queueSetUp(const Part& part, uint32_t ti, const SetupInput& in
 }
 
 // A descriptor walked here, on the front end, for the back end to replay (Frame::replay), and
-// counted as Frame::walk counts it: on this side, with the span engine's stream.
-void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w) {
+// counted as Frame::walk counts it: on this side, with the span engine's stream. On a side of a
+// frame split by rows: for its rows, counted where count (the triangle's owner).
+void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w, bool count) {
   w.events.clear();
   // Each event built whole (an emplace_back() and then its fields cleared the event first, a
   // `rep stos` per row).
@@ -597,7 +725,8 @@ void SceneDrawer::walkAhead(const SpanDesc& d, RecordedWalk& w) {
     w.events.push_back(
         {true, r.x0, r.y, r.dx, r.count, {r.a0[0], r.a0[1], r.a0[2], r.a0[3]}, {r.da[0], r.da[1], r.da[2], r.da[3]}});
   };
-  f_.count(walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull()));
+  const SpanWalk wk = walkSpanUnit(*f_.walker, d, fragment, run, f_.span.streamOrNull());
+  if (count) f_.count(wk);
 }
 
 // The back end of a two-thread frame: its own frame (its own counts) and the front end's setup
@@ -692,7 +821,7 @@ void drawTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& eng
   const std::lock_guard<std::mutex> one_frame(worker.frame);
   DrawQueue& q = worker.queue;
   q.reset();
-  SceneDrawer drawer(front, scene, engines, res, &q, &cleared);
+  SceneDrawer drawer(front, scene, engines, res, res.scratch.get().main, &q, &cleared);
   const auto back = std::make_unique<BackEnd>(scene, front.opt, span, res, drawer);
   back->f.unit(front.opt.method);  // made before the first object's beginObject, as the front's
   const std::function<void()> back_end = [&] {
@@ -744,8 +873,135 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
   }
 }
 
+// A side of a frame split by rows: its rows cleared of what the frame before drew, then its
+// rows of every object drawn.
+void drawSide(const Scene& scene, const SpecEngines& engines, Frame& f, RenderResult& res, DrawScratch& scratch,
+              SplitSide& side, const ClearRect& clear) {
+  ClearRect rows = clear;
+  rows.y0 = std::max(clear.y0, side.rows.y0);
+  rows.y1 = std::min(clear.y1, side.rows.y1 - 1);
+  clearRect(res.fb, rows);
+  SceneDrawer drawer(f, scene, engines, res, scratch, nullptr, nullptr, &side);
+  for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+}
+
+// The sides' screen triangles as the frame's: RenderResult::triangles in PartKey order (one
+// thread's), the rectangle they drew, and each side's tags in the triangle buffer made the
+// frame's (SplitSide::global).
+void mergeSides(std::array<SplitSide, 2>& sides, RenderResult& res) {
+  for (SplitSide& s : sides) s.global.resize(s.owned.size() + s.foreign.size());
+  size_t at[2] = {0, 0};
+  while (at[0] < sides[0].owned.size() || at[1] < sides[1].owned.size()) {
+    const size_t i = at[1] == sides[1].owned.size() ||
+                             (at[0] < sides[0].owned.size() && sides[0].owned[at[0]].key < sides[1].owned[at[1]].key)
+                         ? 0 : 1;
+    SplitSide& s = sides[i];
+    s.global[at[i]] = static_cast<uint32_t>(res.triangles.size());
+    res.triangles.push_back(s.owned[at[i]].info);
+    markDrawn(res.fb, s.owned[at[i]].info);
+    ++at[i];
+  }
+  for (size_t i = 0; i < 2; ++i) {
+    SplitSide& s = sides[i];
+    const SplitSide& owner = sides[1 - i];
+    size_t k = 0;
+    for (size_t j = 0; j < s.foreign.size(); ++j) {
+      while (k < owner.owned.size() && owner.owned[k].key < s.foreign[j]) ++k;
+      if (k == owner.owned.size() || s.foreign[j] < owner.owned[k].key)
+        throw std::logic_error("render: a triangle drawn by one side of a split frame was not recorded by the other");
+      s.global[s.owned.size() + j] = owner.global[k];
+    }
+  }
+  Framebuffer& fb = res.fb;
+  if (fb.tri.empty()) return;
+  for (const SplitSide& s : sides)
+    for (int32_t y = std::max(s.rows.y0, fb.drawn_y0); y <= std::min(s.rows.y1 - 1, fb.drawn_y1); ++y)
+      for (int32_t x = fb.drawn_x0; x <= fb.drawn_x1; ++x) {
+        int32_t& tag = fb.tri[static_cast<size_t>(y) * static_cast<size_t>(fb.width) + static_cast<size_t>(x)];
+        if (tag < 0) continue;
+        const uint32_t t = static_cast<uint32_t>(tag);
+        tag = static_cast<int32_t>(s.global[t >= SplitSide::kForeignTag ? s.owned.size() + (t - SplitSide::kForeignTag) : t]);
+      }
+}
+
+// The frame on two threads split by rows (SplitSide): this thread the top side, the back
+// thread the bottom, at the middle of the rows the frame before drew (the same bytes and counts
+// wherever it splits). On an error on either side, the frame on one thread instead, from
+// cleared buffers: its error, and its buffers as it leaves them.
+void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& engines,
+                 const ClearRect& clear, RenderResult& res) {
+  RenderScratch& scratch = res.scratch.get();
+  const int32_t H = scene.camera.height;
+  if (scratch.split < 0 || scratch.split > H) scratch.split = H / 2;
+  const int32_t split = opt.split_row >= 0 ? std::min(opt.split_row, H) : scratch.split;
+  std::array<SplitSide, 2>& sides = scratch.sides;
+  for (size_t i = 0; i < 2; ++i) {
+    SplitSide& s = sides[i];
+    s.top = i == 0;
+    s.split = split;
+    s.H = H;
+    s.rows.y0 = s.top ? 0 : split;
+    s.rows.y1 = s.top ? split : H;
+    s.owned.clear();
+    s.foreign.clear();
+    s.stats = s.others = RenderStats{};
+    s.error = nullptr;
+  }
+  Frame top(scene, opt, span, res.fb, res.stats);
+  // The bottom side's frame in lines of its own, off this thread's stack.
+  struct alignas(64) BottomFrame {
+    Frame f;
+  };
+  const std::unique_ptr<BottomFrame> bottom(new BottomFrame{Frame(scene, opt, span, res.fb, sides[1].stats)});
+  BackThread& worker = BackThread::instance();
+  {
+    const std::lock_guard<std::mutex> one_frame(worker.frame);
+    const std::function<void()> job = [&] {
+      try {
+        drawSide(scene, engines, bottom->f, res, scratch.second, sides[1], clear);
+      } catch (...) {
+        sides[1].error = std::current_exception();
+      }
+    };
+    worker.start(job);
+    try {
+      drawSide(scene, engines, top, res, scratch.main, sides[0], clear);
+    } catch (...) {
+      sides[0].error = std::current_exception();
+    }
+    worker.wait();
+  }
+  if (sides[0].error || sides[1].error) {
+    res.stats = RenderStats{};
+    res.triangles.clear();
+    clearRect(res.fb, ClearRect{0, 0, res.fb.width - 1, res.fb.height - 1, traits(opt.method).exact});
+    res.fb.drawn_x0 = res.fb.drawn_y0 = INT_MAX;
+    res.fb.drawn_x1 = res.fb.drawn_y1 = INT_MIN;
+    Frame one(scene, opt, span, res.fb, res.stats);
+    SceneDrawer drawer(one, scene, engines, res, scratch.main);
+    for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+    std::rethrow_exception(sides[0].error ? sides[0].error : sides[1].error);  // one thread drew it
+  }
+  res.stats += sides[1].stats;
+  mergeSides(sides, res);
+  if (res.fb.drawn_y0 <= res.fb.drawn_y1) scratch.split = (res.fb.drawn_y0 + res.fb.drawn_y1 + 1) / 2;
+}
+
 }  // namespace
 
+
+// SplitSide: RenderOptions::split_rows, and nothing counted across triangles in their order: no
+// device lobe (the specular unit's cycles, its engine's memo), the paper's span unit (not the
+// full-rate unit's stream). A lobe or material that does not parse: not split, for one
+// thread's error.
+bool splitsByRows(const Scene& scene, const RenderOptions& opt, SpanEngine& span) {
+  if (!opt.split_rows || span.walker() == nullptr || span.streamOrNull() != nullptr) return false;
+  try {
+    return deviceLobesUsed(scene, opt).empty();
+  } catch (const std::exception&) {
+    return false;
+  }
+}
 
 RenderStats& RenderStats::operator+=(const RenderStats& o) {
   triangles += o.triangles;
@@ -849,14 +1105,19 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     throw std::invalid_argument("render: two threads need the model's span unit, not the RTL's");
   const ClearRect clear =
       prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact, opt.tags);
-  Frame frame(scene, opt, span, res.fb, res.stats);
-  span.beginFrame();
-  if (opt.threads == 1) {
-    clearRect(res.fb, clear);
-    SceneDrawer drawer(frame, scene, engines, res);
-    for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+  if (opt.threads == 2 && splitsByRows(scene, opt, span)) {
+    span.beginFrame();
+    renderSplit(scene, opt, span, engines, clear, res);
   } else {
-    renderTwoThreads(scene, span, engines, frame, clear, res);
+    Frame frame(scene, opt, span, res.fb, res.stats);
+    span.beginFrame();
+    if (opt.threads == 1) {
+      clearRect(res.fb, clear);
+      SceneDrawer drawer(frame, scene, engines, res, res.scratch.get().main);
+      for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+    } else {
+      renderTwoThreads(scene, span, engines, frame, clear, res);
+    }
   }
   span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

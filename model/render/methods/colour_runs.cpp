@@ -134,9 +134,16 @@ struct ColourRunLoop {
 
 // A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
 // walk (Frame::colour_spans).
+// A side of a frame split by rows draws the rows of its RowShare: the slice of them, where the
+// triangle has rows of the other side's.
 void drawColourSpans(Frame& f, const SpanTriangle& t, const fixed_simd::Target& target) {
-  const RowSpans& s = *t.rows;
-  if (!t.counted) f.countRows(s);
+  if (!t.counted) f.countRows(*t.rows);
+  const RowShare& share = t.share;
+  const bool sliced =
+      share.side == RowShare::Side::Rows && (t.rows->y0 < share.y0 || t.rows->y0 + t.rows->rows > share.y1);
+  RowSpans slice;
+  if (sliced && !sliceRowSpans(*t.rows, share.y0, share.y1, slice)) return;
+  const RowSpans& s = sliced ? slice : *t.rows;
   uint64_t passed = 0;
   f.st.pixels_covered += f.colour_spans(s, static_cast<size_t>(f.W), kColourFrac, target, f.fb.rgb.data(), passed);
   f.st.depth_rejected += s.fragments - passed;
