@@ -1035,7 +1035,7 @@ TEST(Render, TwoThreadsShareTheRowsWalkedAhead) {
       RenderOptions o;
       o.method = Method::PhongFixed;
       o.brdf = "blinn";  // builtin:materials' cubic material would need the cubic unit
-      o.split_rows = false;  // the walk ahead, not the split by rows
+      o.split = RenderOptions::Split::FrontBack;  // the walk ahead, not the split by rows
       PhongWidths w;
       w.NormalFracBits = 20;
       w.CosFracBits = 24;
@@ -1064,7 +1064,7 @@ TEST(Render, TwoThreadsSetUpOnEitherSide) {
           o.method = m;
           o.brdf = brdf;
           o.hand_off_below = below;
-          o.split_rows = false;  // the front and the back end
+          o.split = RenderOptions::Split::FrontBack;
           expectTwoThreadsEqualOne(s, o, one, two, what);
         }
   }
@@ -1081,8 +1081,9 @@ TEST(Render, TwoThreadsSetUpOnEitherSide) {
       const std::string want = testutil::errorOf<std::invalid_argument>(fails);
       EXPECT_NE(want.find("triangle 2: attribute 0 = nan"), std::string::npos) << what << ": " << want;  // after 2 drawn
       o.threads = 2;
+      o.split = RenderOptions::Split::Rows;
       EXPECT_EQ(testutil::errorOf<std::invalid_argument>(fails), want) << what << " split by rows";
-      o.split_rows = false;
+      o.split = RenderOptions::Split::FrontBack;
       for (size_t below : shares) {
         o.hand_off_below = below;
         EXPECT_EQ(testutil::errorOf<std::invalid_argument>(fails), want) << what << " hand_off_below " << below;
@@ -1090,7 +1091,7 @@ TEST(Render, TwoThreadsSetUpOnEitherSide) {
     }
 }
 
-// Two threads split by rows (RenderOptions::split_rows, render.cpp's SplitSide): the same
+// Two threads split by rows (RenderOptions::Split::Rows, render.cpp's SplitSide): the same
 // bytes, triangle list, counts and drawn rectangle as one thread for flat, Gouraud and
 // phong-fixed on every built-in scene (builtin:plane: triangles clipped at the near plane and
 // the guard band), wherever the frame splits: all rows the bottom's or the top's, one row, a
@@ -1110,6 +1111,7 @@ TEST(Render, TwoThreadsSplitByRowsEqualOneThread) {
           RenderOptions o;
           o.method = m;
           o.brdf = "blinn";  // builtin:materials' cubic material would need the cubic unit
+          o.split = RenderOptions::Split::Rows;
           o.split_row = split;
           o.tags = std::string(variant) != "no tags";
           o.row_spans = std::string(variant) != "no row spans";
@@ -1126,18 +1128,23 @@ TEST(Render, TwoThreadsSplitByRowsEqualOneThread) {
         }
   }
   EXPECT_EQ(compared, 4 * 3 * 4 * 6);
-  // Not split: a device lobe, the full-rate unit's stream, or split_rows off.
+  // Auto: phong-fixed split by rows, flat and Gouraud not. Not split: a device lobe, the
+  // full-rate unit's stream, or Split::FrontBack.
   const Scene sphere = loadScene("builtin:sphere");
   ModelEngines serial("serial"), full("sierpinskifull");
   RenderOptions o;
-  o.method = Method::Gouraud;
   o.threads = 2;
+  for (Method m : {Method::Flat, Method::Gouraud, Method::PhongFixed}) {
+    o.method = m;
+    EXPECT_EQ(splitsByRows(sphere, o, serial.span), m == Method::PhongFixed) << toString(m);
+  }
+  o.split = RenderOptions::Split::Rows;
   EXPECT_TRUE(splitsByRows(sphere, o, serial.span));
   EXPECT_FALSE(splitsByRows(sphere, o, full.span));
-  o.split_rows = false;
-  EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
-  o.split_rows = true;
   o.brdf = "quadratic";
+  EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
+  o.brdf = "";
+  o.split = RenderOptions::Split::FrontBack;
   EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
 }
 

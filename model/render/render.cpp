@@ -70,6 +70,7 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
   RenderStats stats;                // the bottom side's counts (the top counts into the frame's)
   RenderStats others;               // the counts of the other side's triangles (not kept)
   RecordedWalk walk;                // a part set up without rows' spans, walked for its rows
+  double seconds = 0;               // the side's time (drawSide)
   std::exception_ptr error;
   // The rows lo .. hi a triangle whose vertices lie at these y may reach: those of the pixel
   // centres within them, within [floor(ymin), ceil(ymax)], and one more each way (setup's
@@ -310,10 +311,14 @@ class BackThread {
     }
     wake_.notify_one();
   }
+  // Spins for up to 2 ms before it sleeps, as the back thread does between frames: a thread
+  // woken from sleep is put on the core of the thread that wakes it, and then both sides of the
+  // next frame split by rows ran on one core (its frames took 0.95 of one thread's time).
   void wait() {
     const uint64_t posted = posted_.load(std::memory_order_relaxed);
-    for (unsigned spin = 0; done_.load(std::memory_order_acquire) != posted; ++spin) {
-      if (spin < 4096) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2);
+    for (unsigned spin = 1; done_.load(std::memory_order_acquire) != posted; ++spin) {
+      if (spin % 256 != 0 || std::chrono::steady_clock::now() < until) {
         _mm_pause();
         continue;
       }
@@ -877,12 +882,26 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
 // rows of every object drawn.
 void drawSide(const Scene& scene, const SpecEngines& engines, Frame& f, RenderResult& res, DrawScratch& scratch,
               SplitSide& side, const ClearRect& clear) {
+  const auto t0 = std::chrono::steady_clock::now();
   ClearRect rows = clear;
   rows.y0 = std::max(clear.y0, side.rows.y0);
   rows.y1 = std::min(clear.y1, side.rows.y1 - 1);
   clearRect(res.fb, rows);
   SceneDrawer drawer(f, scene, engines, res, scratch, nullptr, nullptr, &side);
   for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+  side.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The next frame's split: where the two sides would take as long, each side's time spread evenly
+// over its rows of the drawn rectangle [y0, y1], halfway from this frame's split (frames of a
+// benchmark or an animation settle on it); the middle of [y0, y1] when this split lay outside.
+int32_t nextSplit(const std::array<SplitSide, 2>& sides, int32_t y0, int32_t y1) {
+  const int32_t split = sides[0].split;
+  if (split <= y0 || split > y1) return (y0 + y1 + 1) / 2;
+  const double top = sides[0].seconds / (split - y0), bottom = sides[1].seconds / (y1 + 1 - split);
+  if (!(top > 0 && bottom > 0)) return split;
+  const double even = (top * y0 + bottom * (y1 + 1)) / (top + bottom);
+  return std::clamp(static_cast<int32_t>(std::lround(0.5 * (split + even))), y0 + 1, y1);
 }
 
 // The sides' screen triangles as the frame's: RenderResult::triangles in PartKey order (one
@@ -925,8 +944,8 @@ void mergeSides(std::array<SplitSide, 2>& sides, RenderResult& res) {
 }
 
 // The frame on two threads split by rows (SplitSide): this thread the top side, the back
-// thread the bottom, at the middle of the rows the frame before drew (the same bytes and counts
-// wherever it splits). On an error on either side, the frame on one thread instead, from
+// thread the bottom, where the frame before found the two would take as long (nextSplit; the
+// same bytes and counts wherever it splits). On an error on either side, the frame on one thread instead, from
 // cleared buffers: its error, and its buffers as it leaves them.
 void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span, const SpecEngines& engines,
                  const ClearRect& clear, RenderResult& res) {
@@ -984,18 +1003,21 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
   }
   res.stats += sides[1].stats;
   mergeSides(sides, res);
-  if (res.fb.drawn_y0 <= res.fb.drawn_y1) scratch.split = (res.fb.drawn_y0 + res.fb.drawn_y1 + 1) / 2;
+  if (res.fb.drawn_y0 <= res.fb.drawn_y1) scratch.split = nextSplit(sides, res.fb.drawn_y0, res.fb.drawn_y1);
 }
 
 }  // namespace
 
 
-// SplitSide: RenderOptions::split_rows, and nothing counted across triangles in their order: no
-// device lobe (the specular unit's cycles, its engine's memo), the paper's span unit (not the
+// SplitSide: RenderOptions::split, and nothing counted across triangles in their order: no device
+// lobe (the specular unit's cycles, its engine's memo), the paper's span unit (not the
 // full-rate unit's stream). A lobe or material that does not parse: not split, for one
 // thread's error.
 bool splitsByRows(const Scene& scene, const RenderOptions& opt, SpanEngine& span) {
-  if (!opt.split_rows || span.walker() == nullptr || span.streamOrNull() != nullptr) return false;
+  using Split = RenderOptions::Split;
+  const bool wanted = opt.split == Split::Rows ||
+                      (opt.split == Split::Auto && traits(opt.method).two_threads == TwoThreads::AfterWalk);
+  if (!wanted || span.walker() == nullptr || span.streamOrNull() != nullptr) return false;
   try {
     return deviceLobesUsed(scene, opt).empty();
   } catch (const std::exception&) {

@@ -178,16 +178,20 @@ struct RenderOptions {
   // datapath at these widths, fragment by fragment (render/fixed_widths.h), the span unit
   // interpolating the normal at their NormalFracBits. PhongWidths{} gives the same images.
   std::optional<PhongWidths> phong_widths;
-  // 1, or 2: the frame on two threads, the same bytes and counts as on one (render.cpp). Split
-  // by rows where split_rows allows (no device lobe, the paper's span unit): each thread draws
-  // every triangle's pixels in its rows of the screen. Otherwise this thread culls, clips and
-  // sets up the triangles (or hands some to the other before setup), another walks, shades and
-  // writes them, in order. For the methods whose traits allow it (MethodTraits::two_threads)
-  // with the model's span unit (SpanEngine::walker); otherwise std::invalid_argument.
+  // 1, or 2: the frame on two threads, the same bytes and counts as on one (render.cpp): split
+  // by rows (each thread draws every triangle's pixels in its rows of the screen), or into a
+  // front end, which culls, clips and sets up the triangles (or hands some to the other before
+  // setup), and a back end, which walks, shades and writes them, in order (`split`). For the
+  // methods whose traits allow it (MethodTraits::two_threads) with the model's span unit
+  // (SpanEngine::walker); otherwise std::invalid_argument.
   int threads = 1;
-  // Two threads split the frame by rows where they can; false: always into the front and the
-  // back end (the same bytes and counts: the tests compare both with one thread).
-  bool split_rows = true;
+  // How two threads split a frame. By rows only where no count depends on the order of the
+  // frame's triangles (no device lobe, the paper's span unit), else into front and back end.
+  // Auto: by rows for a method walked ahead (phong-fixed, whose shading per pixel is the longer
+  // half; flat and Gouraud were faster in front and back end, docs/performance.md). Every choice
+  // gives the same bytes and counts (the tests compare each with one thread).
+  enum class Split { Auto, Rows, FrontBack };
+  Split split = Split::Auto;
   // A frame split by rows: the first row of the bottom side (from 0, all rows the bottom's, to
   // the height, all the top's); -1: the middle of the rows the frame before drew, or of the
   // screen. Any row gives the same bytes and counts.
@@ -305,7 +309,7 @@ struct SpecEngines {
 // The device lobes the scene uses with these options (to build only the engines needed).
 std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt);
 // Whether a two-thread frame of the scene with these options on this span unit splits by rows
-// (RenderOptions::split_rows), else into a front and a back end.
+// (RenderOptions::split), else into a front and a back end.
 bool splitsByRows(const Scene& scene, const RenderOptions& opt, SpanEngine& span);
 
 // Throws std::invalid_argument for an unknown brdf, a shininess the specular unit's PROM does
