@@ -146,12 +146,15 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
 void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris,
                 std::vector<std::array<double, 3>>& faces, const SplitSide* side) {
   faces.resize(tris.size());
+  auto light = [&](auto takes) {
+    for (size_t i = 0; i < tris.size(); ++i) {
+      const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
+      if (tv.all_in && !culledEarly(tv) && takes(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
+    }
+  };
   bool owner;
-  for (size_t i = 0; i < tris.size(); ++i) {
-    const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
-    if (tv.all_in && !culledEarly(tv) && (side == nullptr || side->takes(tv, owner)))
-      faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
-  }
+  if (side == nullptr) light([](const TriangleView&) { return true; });
+  else light([&](const TriangleView& tv) { return side->takes(tv, owner); });
 }
 
 // An object's vertices transformed by both threads of a two-thread frame: each claims chunks
@@ -385,6 +388,7 @@ class SceneDrawer {
   void lightVertices(const std::array<uint32_t, 3>& tri);
   void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
+  void drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
   bool drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner);
   bool queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off);
@@ -544,32 +548,41 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
     }
 }
 
-void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
+// A mesh triangle on a side of a frame split by rows: one culled early is the top side's to
+// count, any other its owner's (SplitSide::takes).
+void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
-  // Split by rows: a triangle culled early is the top side's to count, any other its owner's.
-  bool owner = side_ == nullptr || side_->top;
-  RenderStats* st = owner ? &f_.st : &side_->others;
+  bool owner = side_->top;
   if (culledEarly(tv)) {
-    ++st->triangles;
-    ++st->culled_back;
+    RenderStats& st = owner ? f_.st : side_->others;
+    ++st.triangles;
+    ++st.culled_back;
     return;
   }
-  if (side_ != nullptr) {
-    if (!side_->takes(tv, owner)) return;  // the other side's alone
-    st = owner ? &f_.st : &side_->others;
-  }
-  ++st->triangles;
+  if (!side_->takes(tv, owner)) return;  // the other side's alone
+  RenderStats& st = owner ? f_.st : side_->others;
+  ++st.triangles;
   if (vertex_colours_) lightVertices(tri);
-  if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, *st)) return;
-  if (side_ != nullptr) {
-    parts_.clear();
-    f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
-    unit_.parts(fan_, parts_);
-    bool drawn = false;
-    for (size_t k = 0; k < parts_.size(); ++k) drawn |= drawSplitPart(parts_[k], ti, static_cast<uint32_t>(k), owner);
-    if (!drawn) ++st->culled_no_pixel;
+  if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
+  parts_.clear();
+  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
+  unit_.parts(fan_, parts_);
+  bool drawn = false;
+  for (size_t k = 0; k < parts_.size(); ++k) drawn |= drawSplitPart(parts_[k], ti, static_cast<uint32_t>(k), owner);
+  if (!drawn) ++st.culled_no_pixel;
+}
+
+void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
+  if (side_ != nullptr) return drawSplitTriangle(tri, ti);
+  RenderStats& st = f_.st;
+  ++st.triangles;
+  const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
+  if (culledEarly(tv)) {
+    ++st.culled_back;
     return;
   }
+  if (vertex_colours_) lightVertices(tri);
+  if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
   // Lit ahead: a triangle drawn as itself (a clipped one's fan points into poly_).
   f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
   // The screen triangles to draw (a fan of the polygon), each with the unit that draws it:
@@ -584,7 +597,7 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
     const uint8_t first = k == 0 ? DrawJob::kFirstPart : 0, last = k + 1 == parts_.size() ? DrawJob::kLastPart : 0;
     drawn |= drawPart(parts_[k], ti, hand_off ? first | last : 0);
   }
-  if (!drawn && !hand_off) ++st->culled_no_pixel;  // every part dropped by setup: nothing on screen
+  if (!drawn && !hand_off) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
 }
 
 // A part's vertices as its unit sets them up: colour (the part's own, flat's, or the vertex's,
