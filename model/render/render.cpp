@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <climits>
 #include <cmath>
 #include <condition_variable>
 #include <exception>
@@ -62,7 +61,7 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
     ScreenTriangleInfo info;
   };
   RowShare rows{RowShare::Side::Rows};  // its rows, y0 .. y1 - 1
-  int32_t split = 0, H = 0;             // the bottom side's first row; the frame's rows
+  int32_t H = 0;                        // the frame's rows
   bool top = true;
   std::vector<Record> owned;        // in key order
   std::vector<PartKey> foreign;     // drawn here, owned by the other side, in key order
@@ -72,25 +71,31 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
   RecordedWalk walk;                // a part set up without rows' spans, walked for its rows
   double seconds = 0;               // the side's time (drawSide)
   std::exception_ptr error;
-  // The rows lo .. hi a triangle whose vertices lie at these y may reach: those of the pixel
+  // The bottom side's first row.
+  int32_t split() const { return top ? rows.y1 : rows.y0; }
+  // The rows lo .. hi a triangle whose vertices lie at a, b, c may reach: those of the pixel
   // centres within them, within [floor(ymin), ceil(ymax)], and one more each way (setup's
   // snapping moves a vertex by less than a subpixel), which [trunc(ymin) - 2, trunc(ymax) + 2]
   // holds; clamped to -1 .. H (NaN: -1, on both sides alike).
-  std::pair<int32_t, int32_t> rowsOf(double ymin, double ymax) const {
+  std::pair<int32_t, int32_t> rowsOf(const PVertex& a, const PVertex& b, const PVertex& c) const {
     auto row = [this](double y, int32_t d) {
       if (!(y > -1.0)) return -1;
       return y < H ? std::clamp(static_cast<int32_t>(y) + d, -1, H) : H;
     };
-    return {row(ymin, -2), row(ymax, 2)};
+    return {row(std::min({a.y, b.y, c.y}), -2), row(std::max({a.y, b.y, c.y}), 2)};
   }
-  bool owns(int32_t lo) const { return (std::clamp(lo, 0, H - 1) < split) == top; }
+  bool owns(int32_t lo) const { return (std::clamp(lo, 0, H - 1) < split()) == top; }
   // Whether this side clips the mesh triangle tv, not culled early (and whether it owns it).
   bool takes(const TriangleView& tv, bool& owner) const {
     owner = top;
     if (!tv.all_in) return true;
-    const auto [lo, hi] = rowsOf(std::min({tv.v0->y, tv.v1->y, tv.v2->y}), std::max({tv.v0->y, tv.v1->y, tv.v2->y}));
+    const auto [lo, hi] = rowsOf(*tv.v0, *tv.v1, *tv.v2);
     owner = owns(lo);
     return owner || rows.anyIn(lo, hi);
+  }
+  bool takes(const TriangleView& tv) const {
+    bool owner;
+    return takes(tv, owner);
   }
 };
 
@@ -152,9 +157,8 @@ void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<s
       if (tv.all_in && !culledEarly(tv) && takes(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
     }
   };
-  bool owner;
   if (side == nullptr) light([](const TriangleView&) { return true; });
-  else light([&](const TriangleView& tv) { return side->takes(tv, owner); });
+  else light([side](const TriangleView& tv) { return side->takes(tv); });
 }
 
 // An object's vertices transformed by both threads of a two-thread frame: each claims chunks
@@ -314,20 +318,15 @@ class BackThread {
     }
     wake_.notify_one();
   }
-  // Spins for up to 2 ms before it sleeps, as the back thread does between frames: a thread
-  // woken from sleep is put on the core of the thread that wakes it, and then both sides of the
-  // next frame split by rows ran on one core (its frames took 0.95 of one thread's time).
+  // Spins before it sleeps (spinFor), as the back thread does between frames: woken from
+  // sleep, this thread was put on the back thread's core, and both sides of the next frame split
+  // by rows ran on one core (its frames took 0.95 of one thread's time).
   void wait() {
     const uint64_t posted = posted_.load(std::memory_order_relaxed);
-    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2);
-    for (unsigned spin = 1; done_.load(std::memory_order_acquire) != posted; ++spin) {
-      if (spin % 256 != 0 || std::chrono::steady_clock::now() < until) {
-        _mm_pause();
-        continue;
-      }
-      std::unique_lock<std::mutex> l(m_);
-      finished_.wait(l, [&] { return done_.load(std::memory_order_acquire) == posted; });
-    }
+    const auto done = [&] { return done_.load(std::memory_order_acquire) == posted; };
+    if (spinFor(done)) return;
+    std::unique_lock<std::mutex> l(m_);
+    finished_.wait(l, done);
   }
   ~BackThread() {
     {
@@ -342,17 +341,23 @@ class BackThread {
 
  private:
   BackThread() : thread_([this] { loop(); }) {}
+  // Whether ready() holds within 2 ms of spinning (the clock read every 256 pauses).
+  template <class Ready>
+  static bool spinFor(Ready ready) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2);
+    for (unsigned spin = 1; !ready(); ++spin) {
+      if (spin % 256 == 0 && std::chrono::steady_clock::now() > until) return ready();
+      _mm_pause();
+    }
+    return true;
+  }
   void loop() {
     for (uint64_t taken = 0;;) {
-      const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(2);
-      for (unsigned spin = 1; posted_.load(std::memory_order_acquire) == taken; ++spin) {
-        if (spin % 256 == 0 && std::chrono::steady_clock::now() > until) {
-          std::unique_lock<std::mutex> l(m_);
-          wake_.wait(l, [&] { return stop_ || posted_.load(std::memory_order_acquire) != taken; });
-          if (stop_) return;
-          break;
-        }
-        _mm_pause();
+      const auto posted = [&] { return posted_.load(std::memory_order_acquire) != taken; };
+      if (!spinFor(posted)) {
+        std::unique_lock<std::mutex> l(m_);
+        wake_.wait(l, [&] { return stop_ || posted(); });
+        if (stop_) return;
       }
       taken = posted_.load(std::memory_order_acquire);
       (*job_)();
@@ -672,8 +677,7 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
 // side's), recorded and counted by its owner, its rows of this side drawn. tag: the side's own.
 bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner) {
   SplitSide& side = *side_;
-  const auto [lo, hi] = side.rowsOf(std::min({part.v[0]->y, part.v[1]->y, part.v[2]->y}),
-                                    std::max({part.v[0]->y, part.v[1]->y, part.v[2]->y}));
+  const auto [lo, hi] = side.rowsOf(*part.v[0], *part.v[1], *part.v[2]);
   const bool meets = side.rows.anyIn(lo, hi);
   if (!owner && !meets) return false;
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
@@ -688,7 +692,8 @@ bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool 
     r.key = key;
     r.info.object = f_.obj.index;
     r.info.mesh_triangle = ti;
-    for (size_t i = 0; i < 3; ++i) r.info.xy[i] = {part.v[i]->x, part.v[i]->y};
+    const auto xy = partXY(part);
+    for (size_t i = 0; i < 3; ++i) r.info.xy[i] = xy(i);
     ++f_.st.drawn;
     f_.st.row_spans += spans;
     if (spans) f_.countRows(rows_);
@@ -891,6 +896,13 @@ void renderTwoThreads(const Scene& scene, SpanEngine& span, const SpecEngines& e
   }
 }
 
+// Every object of the scene drawn on this thread: the whole frame, or a side's rows of it.
+void drawScene(Frame& f, const Scene& scene, const SpecEngines& engines, RenderResult& res, DrawScratch& scratch,
+               SplitSide* side = nullptr) {
+  SceneDrawer drawer(f, scene, engines, res, scratch, nullptr, nullptr, side);
+  for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+}
+
 // A side of a frame split by rows: its rows cleared of what the frame before drew, then its
 // rows of every object drawn.
 void drawSide(const Scene& scene, const SpecEngines& engines, Frame& f, RenderResult& res, DrawScratch& scratch,
@@ -900,8 +912,7 @@ void drawSide(const Scene& scene, const SpecEngines& engines, Frame& f, RenderRe
   rows.y0 = std::max(clear.y0, side.rows.y0);
   rows.y1 = std::min(clear.y1, side.rows.y1 - 1);
   clearRect(res.fb, rows);
-  SceneDrawer drawer(f, scene, engines, res, scratch, nullptr, nullptr, &side);
-  for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+  drawScene(f, scene, engines, res, scratch, &side);
   side.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
@@ -909,7 +920,7 @@ void drawSide(const Scene& scene, const SpecEngines& engines, Frame& f, RenderRe
 // over its rows of the drawn rectangle [y0, y1], halfway from this frame's split (frames of a
 // benchmark or an animation settle on it); the middle of [y0, y1] when this split lay outside.
 int32_t nextSplit(const std::array<SplitSide, 2>& sides, int32_t y0, int32_t y1) {
-  const int32_t split = sides[0].split;
+  const int32_t split = sides[0].split();
   if (split <= y0 || split > y1) return (y0 + y1 + 1) / 2;
   const double top = sides[0].seconds / (split - y0), bottom = sides[1].seconds / (y1 + 1 - split);
   if (!(top > 0 && bottom > 0)) return split;
@@ -970,7 +981,6 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
   for (size_t i = 0; i < 2; ++i) {
     SplitSide& s = sides[i];
     s.top = i == 0;
-    s.split = split;
     s.H = H;
     s.rows.y0 = s.top ? 0 : split;
     s.rows.y1 = s.top ? split : H;
@@ -1004,14 +1014,12 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     worker.wait();
   }
   if (sides[0].error || sides[1].error) {
+    // The sides marked nothing drawn (mergeSides does), so the framebuffer's drawn rectangle is
+    // still prepareClear's empty one, as one thread starts with.
     res.stats = RenderStats{};
-    res.triangles.clear();
     clearRect(res.fb, ClearRect{0, 0, res.fb.width - 1, res.fb.height - 1, traits(opt.method).exact});
-    res.fb.drawn_x0 = res.fb.drawn_y0 = INT_MAX;
-    res.fb.drawn_x1 = res.fb.drawn_y1 = INT_MIN;
     Frame one(scene, opt, span, res.fb, res.stats);
-    SceneDrawer drawer(one, scene, engines, res, scratch.main);
-    for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+    drawScene(one, scene, engines, res, scratch.main);
     std::rethrow_exception(sides[0].error ? sides[0].error : sides[1].error);  // one thread drew it
   }
   res.stats += sides[1].stats;
@@ -1140,16 +1148,14 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     throw std::invalid_argument("render: two threads need the model's span unit, not the RTL's");
   const ClearRect clear =
       prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact, opt.tags);
+  span.beginFrame();
   if (opt.threads == 2 && splitsByRows(scene, opt, span)) {
-    span.beginFrame();
     renderSplit(scene, opt, span, engines, clear, res);
   } else {
     Frame frame(scene, opt, span, res.fb, res.stats);
-    span.beginFrame();
     if (opt.threads == 1) {
       clearRect(res.fb, clear);
-      SceneDrawer drawer(frame, scene, engines, res, res.scratch.get().main);
-      for (size_t oi = 0; oi < scene.objects.size(); ++oi) drawer.drawObject(oi);
+      drawScene(frame, scene, engines, res, res.scratch.get().main);
     } else {
       renderTwoThreads(scene, span, engines, frame, clear, res);
     }

@@ -193,8 +193,8 @@ struct RenderOptions {
   enum class Split { Auto, Rows, FrontBack };
   Split split = Split::Auto;
   // A frame split by rows: the first row of the bottom side (from 0, all rows the bottom's, to
-  // the height, all the top's); -1: the middle of the rows the frame before drew, or of the
-  // screen. Any row gives the same bytes and counts.
+  // the height, all the top's); -1: where the frame before found both sides would take as long
+  // (half the screen on the first). Any row gives the same bytes and counts.
   int split_row = -1;
   // Two threads, flat and gouraud: the back end also sets up a mesh triangle that the front end
   // culled and clipped while fewer than this many jobs wait for it (render.cpp, DrawJob); 0:
