@@ -15,11 +15,8 @@ group_packages() {
     build) echo build-essential cmake ninja-build pkg-config python3 verilator \
                 libsystemc-dev libfmt-dev libcli11-dev nlohmann-json3-dev \
                 libgtest-dev libgmock-dev libbenchmark-dev libpng-dev libassimp-dev ;;
-    # python3-munkres: python3-matplotlib needs python3-fonttools, which takes python3-scipy
-    # or python3-munkres; named here, apt takes munkres (11 kB) instead of scipy and what scipy
-    # brings (pythran, boost, BLAS: 34 packages; a fresh machine's install 0.85x the time).
     tools) echo iverilog yosys nextpnr-ice40 libjemalloc2 sollya gappa parallel \
-                python3-matplotlib python3-munkres assimp-testmodels ;;
+                gnuplot-nox assimp-testmodels ;;
     fuzz) echo clang ;;
     *) echo "install_deps: unknown group '$1' (build, tools, fuzz)" >&2; return 2 ;;
   esac

@@ -12,7 +12,7 @@ directory against its report.json (testbench/report_test.sh):
     method and lobe names one image), contact_sheet.png and every image are valid PNG files;
   - per sample row: `shadesim render --json` gives the same error figures and cycles, and its
     image (rendered in that row's mode) has the same PNG bytes as the report's.
-Only the Python standard library: no matplotlib needed to check the plots.
+Only the Python standard library. Its PNG decoder (png_pixels) is also testbench/prune_test.sh's.
 """
 import csv
 import io
@@ -69,6 +69,56 @@ def read_png(path):
             key, _, value = b.partition(b"\0")
             text[key.decode("latin-1")] = value.decode("latin-1")
     return w, h, text
+
+
+def png_pixels(path):
+    """(width, height, bytes per pixel, pixels) of a valid 8-bit non-interlaced PNG (read_png's
+    checks): the rows top to bottom, each of the five row filters (None, Sub, Up, Average, Paeth)
+    undone; None, a failure recorded, otherwise."""
+    if read_png(path) is None:
+        return None
+    data = open(path, "rb").read()
+    pos, idat = 8, []
+    while pos < len(data):
+        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
+        if kind == b"IHDR":
+            w, h, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", data[pos + 8:pos + 21])
+        elif kind == b"IDAT":
+            idat.append(data[pos + 8:pos + 8 + n])
+        pos += 12 + n
+    if interlace != 0:
+        failures.append(f"{path}: interlaced")
+        return None
+    bpp = {0: 1, 2: 3, 4: 2, 6: 4}[colour]  # read_png accepted nothing else
+    raw, stride = zlib.decompress(b"".join(idat)), w * bpp
+    if len(raw) != h * (1 + stride):
+        failures.append(f"{path}: IDAT inflates to {len(raw)} bytes, not {h}x(1+{stride})")
+        return None
+    out, prev = bytearray(), bytearray(stride)
+    for y in range(h):
+        ftype, line = raw[y * (1 + stride)], bytearray(raw[y * (1 + stride) + 1:(y + 1) * (1 + stride)])
+        if ftype == 1:
+            for i in range(bpp, stride):
+                line[i] = (line[i] + line[i - bpp]) & 0xFF
+        elif ftype == 2:
+            for i in range(stride):
+                line[i] = (line[i] + prev[i]) & 0xFF
+        elif ftype == 3:
+            for i in range(stride):
+                line[i] = (line[i] + ((line[i - bpp] if i >= bpp else 0) + prev[i]) // 2) & 0xFF
+        elif ftype == 4:
+            for i in range(stride):
+                a, b = (line[i - bpp] if i >= bpp else 0), prev[i]
+                c = prev[i - bpp] if i >= bpp else 0
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 0xFF
+        elif ftype != 0:
+            failures.append(f"{path}: row {y} has filter type {ftype}")
+            return None
+        out += line
+        prev = line
+    return w, h, bpp, bytes(out)
 
 
 # --- report.md -------------------------------------------------------------------------------
@@ -332,7 +382,7 @@ def pareto(points):
 
 def check_plots(d, report):
     plots = report["plots"]
-    check(plots["made"], f"no plots: {plots.get('why')} (install python3-matplotlib)")
+    check(plots["made"], f"no plots: {plots.get('why')} (install gnuplot-nox)")
     if not plots["made"]:
         return
     check("error_vs_cycles.png" in plots["files"], "error_vs_cycles.png not made")

@@ -484,15 +484,20 @@ Plots makePlots(const json& report, const fs::path& tmp) {
     p.json = {{"made", false}, {"why", "scripts/plot_report.py is neither in this installation nor in the source tree"}};
     return p;
   }
-  // The python3 of PATH, else Debian's, where python3-matplotlib installs (a PATH python3 of
-  // pyenv or a venv may lack it): the first that imports matplotlib.
+  // The python3 of PATH, else Debian's: the first that runs (the script needs only the standard
+  // library); it draws with the gnuplot of PATH (Debian's gnuplot-nox).
   std::string python, out, err, error;
   for (const char* candidate : {"python3", "/usr/bin/python3"})
-    if (python.empty() && runProcess({candidate, "-c", "import matplotlib"}, out, err, error) == 0) python = candidate;
+    if (python.empty() && runProcess({candidate, "-c", "pass"}, out, err, error) == 0) python = candidate;
   if (python.empty()) {
     p.json = {{"made", false},
-              {"why", "no python3 with matplotlib was found (python3 of PATH, /usr/bin/python3); install the Debian "
-                      "package python3-matplotlib"}};
+              {"why", "no python3 runs (python3 of PATH, /usr/bin/python3); install the Debian package python3"}};
+    return p;
+  }
+  if (const int status = runProcess({"gnuplot", "--version"}, out, err, error); status != 0) {
+    p.json = {{"made", false},
+              {"why", fmt::format("no gnuplot of PATH runs ({}); install the Debian package gnuplot-nox",
+                                  status < 0 ? error : fmt::format("gnuplot --version: exit {}", status))}};
     return p;
   }
   fs::create_directories(tmp);

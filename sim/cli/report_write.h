@@ -39,7 +39,7 @@ ContactSheet contactSheet(const Measured& m);
 extern const std::vector<std::string> kPlotFiles;
 
 // scripts/plot_report.py run on the report (written into `tmp`, which is made and left for the
-// caller to remove): its files (name, bytes) if a python3 with matplotlib was found and it
+// caller to remove): its files (name, bytes) if a python3 that runs and gnuplot were found and it
 // succeeded, else why not. `json` is report.json's "plots".
 struct Plots {
   std::vector<std::pair<std::string, std::string>> files;
