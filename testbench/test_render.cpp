@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
@@ -16,6 +17,7 @@
 #include "render/methods.h"
 #include "render/pipeline.h"
 #include "render/render.h"
+#include "render/split_choice.h"
 #include "report/scene_use.h"
 #include "cosim/render_rtl.h"
 #include "cosim/replay.h"
@@ -1128,15 +1130,15 @@ TEST(Render, TwoThreadsSplitByRowsEqualOneThread) {
         }
   }
   EXPECT_EQ(compared, 4 * 3 * 4 * 6);
-  // Auto: phong-fixed split by rows, flat and Gouraud not. Not split: a device lobe, the
-  // full-rate unit's stream, or Split::FrontBack.
+  // Auto (measured) and Rows may split by rows, every two-thread method. Never: with a device
+  // lobe, the full-rate unit's stream, or Split::FrontBack.
   const Scene sphere = loadScene("builtin:sphere");
   ModelEngines serial("serial"), full("sierpinskifull");
   RenderOptions o;
   o.threads = 2;
   for (Method m : {Method::Flat, Method::Gouraud, Method::PhongFixed}) {
     o.method = m;
-    EXPECT_EQ(splitsByRows(sphere, o, serial.span), m == Method::PhongFixed) << toString(m);
+    EXPECT_TRUE(splitsByRows(sphere, o, serial.span)) << toString(m);
   }
   o.split = RenderOptions::Split::Rows;
   EXPECT_TRUE(splitsByRows(sphere, o, serial.span));
@@ -1146,6 +1148,75 @@ TEST(Render, TwoThreadsSplitByRowsEqualOneThread) {
   o.brdf = "";
   o.split = RenderOptions::Split::FrontBack;
   EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
+}
+
+// SplitChoice (Split::Auto): the first frame the preferred way; each cycle's last kProbe frames
+// the other way; the other way chosen for the next cycle when the fastest of those beat the
+// fastest of the kProbe chosen frames just before them. Earlier frames do not count.
+TEST(Render, SplitChoiceKeepsTheFasterWay) {
+  constexpr int C = SplitChoice::kCycle, P = SplitChoice::kProbe;
+  static_assert(C > 2 * P, "a cycle has chosen frames before the ones compared");
+  SplitChoice c;
+  // One cycle with the frame times ms(k, by rows); the ways drawn, R or F (front and back end).
+  const auto cycle = [&c](const std::function<double(int, bool)>& ms) {
+    std::string ways;
+    for (int k = 0; k < C; ++k) {
+      const bool rows = c.next(false);
+      ways += rows ? 'R' : 'F';
+      c.record(rows, ms(k, rows));
+    }
+    return ways;
+  };
+  const auto constant = [](double rows_ms, double fb_ms) {
+    return [=](int, bool rows) { return rows ? rows_ms : fb_ms; };
+  };
+  const std::string F = std::string(C - P, 'F') + std::string(P, 'R'), R = std::string(C - P, 'R') + std::string(P, 'F');
+  EXPECT_EQ(cycle(constant(2.0, 1.0)), F);  // the preferred way, faster: kept
+  EXPECT_EQ(cycle(constant(2.0, 1.0)), F);
+  EXPECT_FALSE(c.rows());
+  EXPECT_EQ(cycle(constant(0.9, 1.0)), F);  // the other way faster: chosen for the next cycle
+  EXPECT_TRUE(c.rows());
+  EXPECT_EQ(cycle(constant(1.0, 1.0)), R);  // a tie keeps the way
+  EXPECT_TRUE(c.rows());
+  // A fast chosen frame before the compared ones does not count: the other way was faster.
+  EXPECT_EQ(cycle([](int k, bool rows) { return rows ? (k == 0 ? 0.1 : 3.0) : 1.5; }), R);
+  EXPECT_FALSE(c.rows());
+  // Of the compared frames the fastest counts on each side: 0.95 against 1.0.
+  EXPECT_EQ(cycle([](int k, bool rows) { return rows ? (k == C - 1 ? 0.95 : 2.0) : (k == C - 2 * P ? 1.0 : 2.0); }), F);
+  EXPECT_TRUE(c.rows());
+  EXPECT_EQ(cycle([](int k, bool rows) { return rows ? (k == C - 2 * P + 1 ? 1.0 : 2.0) : (k == C - 2 ? 1.01 : 3.0); }),
+            R);
+  EXPECT_TRUE(c.rows());  // 1.01 did not beat 1.0
+  SplitChoice first;
+  EXPECT_TRUE(first.next(true));  // the first frame: the preferred way
+  EXPECT_TRUE(first.next(false));  // (its preference is read once)
+}
+
+// Split::Auto over the frames drawn into one RenderResult: the first frame the way the method
+// prefers (by rows for phong-fixed, front and back end for flat and Gouraud), both ways within
+// a cycle, and every frame the same bytes, triangle list and counts as one thread.
+TEST(Render, TwoThreadsAutoSplitMeasuresBothWays) {
+  const Scene s = loadScene("builtin:sphere");
+  for (Method m : {Method::Flat, Method::Gouraud, Method::PhongFixed}) {
+    ModelEngines one("serial"), two("serial");
+    RenderOptions o;
+    o.method = m;
+    const RenderResult a = render(s, o, one.span, one.view);
+    o.threads = 2;
+    RenderResult b;
+    int by_rows = 0;
+    for (int frame = 0; frame <= SplitChoice::kCycle; ++frame) {
+      const std::string what = fmt::format("{} frame {}", toString(m), frame);
+      render(s, o, two.span, two.view, b);
+      if (frame == 0) {
+        EXPECT_EQ(b.split_by_rows, m == Method::PhongFixed) << what;
+      }
+      by_rows += b.split_by_rows ? 1 : 0;
+      expectSameFrames(a, b, what);
+    }
+    EXPECT_GE(by_rows, SplitChoice::kProbe) << toString(m);
+    EXPECT_LE(by_rows, SplitChoice::kCycle + 1 - SplitChoice::kProbe) << toString(m);
+  }
 }
 
 // What cannot run on two threads is refused, naming why; an error on either thread reaches the

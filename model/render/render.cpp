@@ -28,6 +28,7 @@
 #include "render/draw.h"
 #include "render/methods.h"
 #include "render/pipeline.h"
+#include "render/split_choice.h"
 
 namespace shd {
 
@@ -105,6 +106,7 @@ struct RenderScratch {
   DrawScratch main, second;
   std::array<SplitSide, 2> sides;
   int32_t split = -1;
+  SplitChoice choice;  // Split::Auto's
 };
 ScratchBuffers::ScratchBuffers() : p_(std::make_unique<RenderScratch>()) {}
 ScratchBuffers::~ScratchBuffers() = default;
@@ -1036,9 +1038,7 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
 // thread's error.
 bool splitsByRows(const Scene& scene, const RenderOptions& opt, SpanEngine& span) {
   using Split = RenderOptions::Split;
-  const bool wanted = opt.split == Split::Rows ||
-                      (opt.split == Split::Auto && traits(opt.method).two_threads == TwoThreads::AfterWalk);
-  if (!wanted || span.walker() == nullptr || span.streamOrNull() != nullptr) return false;
+  if (opt.split == Split::FrontBack || span.walker() == nullptr || span.streamOrNull() != nullptr) return false;
   try {
     return deviceLobesUsed(scene, opt).empty();
   } catch (const std::exception&) {
@@ -1149,7 +1149,12 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   const ClearRect clear =
       prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact, opt.tags);
   span.beginFrame();
-  if (opt.threads == 2 && splitsByRows(scene, opt, span)) {
+  // Split::Auto chooses by the frames' times (SplitChoice); its first frame as the method prefers.
+  const bool may_split = opt.threads == 2 && splitsByRows(scene, opt, span);
+  const bool measured = may_split && opt.split == RenderOptions::Split::Auto;
+  SplitChoice& choice = res.scratch.get().choice;
+  res.split_by_rows = measured ? choice.next(traits(opt.method).two_threads == TwoThreads::AfterWalk) : may_split;
+  if (res.split_by_rows) {
     renderSplit(scene, opt, span, engines, clear, res);
   } else {
     Frame frame(scene, opt, span, res.fb, res.stats);
@@ -1162,6 +1167,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   }
   span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (measured) choice.record(res.split_by_rows, res.stats.ms);
 }
 
 }  // namespace shd

@@ -187,9 +187,11 @@ struct RenderOptions {
   int threads = 1;
   // How two threads split a frame. By rows only where no count depends on the order of the
   // frame's triangles (no device lobe, the paper's span unit), else into front and back end.
-  // Auto: by rows for a method walked ahead (phong-fixed, whose shading per pixel is the longer
-  // half; flat and Gouraud were faster in front and back end, docs/performance.md). Every choice
-  // gives the same bytes and counts (the tests compare each with one thread).
+  // Auto: the faster of the two, measured over the frames drawn into one RenderResult
+  // (SplitChoice, split_choice.h); its first frame by rows for a method walked ahead
+  // (phong-fixed, whose shading per pixel is the longer half), in front and back end for flat
+  // and Gouraud. Every choice gives the same bytes and counts (the tests compare each with one
+  // thread); RenderResult::split_by_rows says which way a frame went.
   enum class Split { Auto, Rows, FrontBack };
   Split split = Split::Auto;
   // A frame split by rows: the first row of the bottom side (from 0, all rows the bottom's, to
@@ -295,6 +297,7 @@ struct RenderResult {
   Framebuffer fb;
   RenderStats stats;
   std::vector<ScreenTriangleInfo> triangles;
+  bool split_by_rows = false;  // the last frame ran on two threads split by rows
   ScratchBuffers scratch;
 };
 
@@ -308,8 +311,8 @@ struct SpecEngines {
 
 // The device lobes the scene uses with these options (to build only the engines needed).
 std::vector<Lobe> deviceLobesUsed(const Scene& scene, const RenderOptions& opt);
-// Whether a two-thread frame of the scene with these options on this span unit splits by rows
-// (RenderOptions::split), else into a front and a back end.
+// Whether a two-thread frame of the scene with these options on this span unit may split by rows
+// (RenderOptions::split: Rows, or Auto where it measures), else always into a front and a back end.
 bool splitsByRows(const Scene& scene, const RenderOptions& opt, SpanEngine& span);
 
 // Throws std::invalid_argument for an unknown brdf, a shininess the specular unit's PROM does
