@@ -8,7 +8,7 @@
 #          route, the provers, plots, the mesh corpus
 #   fuzz   clang for the libFuzzer build (scripts/fuzz.sh)
 # On a fresh 2-core machine the install is mostly CPU (unpacking, byte-compiling): installing
-# the tools while the build compiled made the build that much slower (docs/verification.md).
+# the tools while the build compiled gained nothing measurable (docs/verification.md).
 set -euo pipefail
 group_packages() {
   case "$1" in

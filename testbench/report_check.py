@@ -15,7 +15,6 @@ directory against its report.json (testbench/report_test.sh):
 Only the Python standard library. Its PNG decoder (png_pixels) is also testbench/prune_test.sh's.
 """
 import csv
-import io
 import json
 import os
 import re
@@ -34,8 +33,10 @@ def check(cond, msg):
 
 # --- PNG -------------------------------------------------------------------------------------
 
-def read_png(path):
-    """(width, height, {tEXt key: text}) of a valid PNG; a failure is recorded otherwise."""
+def parse_png(path):
+    """(width, height, bytes per pixel, interlace method, the inflated IDAT, {tEXt key: text}) of
+    a valid 8-bit PNG; None, a failure recorded, otherwise (an IDAT of another size than a
+    non-interlaced image's is recorded too)."""
     data = open(path, "rb").read()
     if data[:8] != b"\x89PNG\r\n\x1a\n":
         failures.append(f"{path}: not a PNG (signature)")
@@ -56,7 +57,7 @@ def read_png(path):
     if not chunks or chunks[0][0] != b"IHDR" or chunks[-1][0] != b"IEND":
         failures.append(f"{path}: IHDR not first or IEND not last")
         return None
-    w, h, depth, colour = struct.unpack(">IIBB", chunks[0][1][:10])
+    w, h, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", chunks[0][1][:13])
     channels = {0: 1, 2: 3, 4: 2, 6: 4}.get(colour)
     if depth != 8 or channels is None:
         failures.append(f"{path}: unexpected format depth {depth} colour type {colour}")
@@ -68,32 +69,29 @@ def read_png(path):
         if k == b"tEXt":
             key, _, value = b.partition(b"\0")
             text[key.decode("latin-1")] = value.decode("latin-1")
-    return w, h, text
+    return w, h, channels, interlace, raw, text
+
+
+def read_png(path):
+    """(width, height, {tEXt key: text}) of a valid PNG; a failure is recorded otherwise."""
+    p = parse_png(path)
+    return None if p is None else (p[0], p[1], p[5])
 
 
 def png_pixels(path):
-    """(width, height, bytes per pixel, pixels) of a valid 8-bit non-interlaced PNG (read_png's
+    """(width, height, bytes per pixel, pixels) of a valid 8-bit non-interlaced PNG (parse_png's
     checks): the rows top to bottom, each of the five row filters (None, Sub, Up, Average, Paeth)
     undone; None, a failure recorded, otherwise."""
-    if read_png(path) is None:
+    p = parse_png(path)
+    if p is None:
         return None
-    data = open(path, "rb").read()
-    pos, idat = 8, []
-    while pos < len(data):
-        n, kind = struct.unpack(">I4s", data[pos:pos + 8])
-        if kind == b"IHDR":
-            w, h, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", data[pos + 8:pos + 21])
-        elif kind == b"IDAT":
-            idat.append(data[pos + 8:pos + 8 + n])
-        pos += 12 + n
+    w, h, bpp, interlace, raw, _ = p
     if interlace != 0:
         failures.append(f"{path}: interlaced")
         return None
-    bpp = {0: 1, 2: 3, 4: 2, 6: 4}[colour]  # read_png accepted nothing else
-    raw, stride = zlib.decompress(b"".join(idat)), w * bpp
+    stride = w * bpp
     if len(raw) != h * (1 + stride):
-        failures.append(f"{path}: IDAT inflates to {len(raw)} bytes, not {h}x(1+{stride})")
-        return None
+        return None  # recorded by parse_png
     out, prev = bytearray(), bytearray(stride)
     for y in range(h):
         ftype, line = raw[y * (1 + stride)], bytearray(raw[y * (1 + stride) + 1:(y + 1) * (1 + stride)])

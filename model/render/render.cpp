@@ -433,19 +433,25 @@ void markDrawn(Framebuffer& fb, const ScreenTriangleInfo& info) {
                std::max({p[0][0], p[1][0], p[2][0]}), std::max({p[0][1], p[1][1], p[2][1]}));
 }
 
-// A screen triangle that setup kept, recorded: its tag (the next index of `triangles`), where it
-// came from (object, mesh triangle ti, xy(i) its vertex i's screen position), its count, and the
-// pixels it may draw in the framebuffer's drawn rectangle.
+// A screen triangle that setup kept, described in info (where it came from: object, mesh
+// triangle ti, xy(i) its vertex i's screen position) and counted (drawn, row_spans).
 template <class XY>
-uint32_t recordTriangle(int object, uint32_t ti, XY xy, bool spans, std::vector<ScreenTriangleInfo>& triangles,
-                        RenderStats& st, Framebuffer& fb) {
-  const uint32_t tag = static_cast<uint32_t>(triangles.size());
-  ScreenTriangleInfo& info = triangles.emplace_back();  // filled in place: a local copied in
-  info.object = object;                                 // stalled on its own partial stores
+void describeTriangle(int object, uint32_t ti, XY xy, bool spans, ScreenTriangleInfo& info, RenderStats& st) {
+  info.object = object;
   info.mesh_triangle = ti;
   for (size_t i = 0; i < 3; ++i) info.xy[i] = xy(i);
   ++st.drawn;
   st.row_spans += spans;
+}
+// ... and recorded: its tag (the next index of `triangles`), and the pixels it may draw in the
+// framebuffer's drawn rectangle.
+template <class XY>
+uint32_t recordTriangle(int object, uint32_t ti, XY xy, bool spans, std::vector<ScreenTriangleInfo>& triangles,
+                        RenderStats& st, Framebuffer& fb) {
+  const uint32_t tag = static_cast<uint32_t>(triangles.size());
+  // Filled in place: a local copied in stalled on its own partial stores.
+  ScreenTriangleInfo& info = triangles.emplace_back();
+  describeTriangle(object, ti, xy, spans, info, st);
   markDrawn(fb, info);
   return tag;
 }
@@ -692,12 +698,7 @@ bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool 
   if (owner) {
     SplitSide::Record& r = side.owned.emplace_back();
     r.key = key;
-    r.info.object = f_.obj.index;
-    r.info.mesh_triangle = ti;
-    const auto xy = partXY(part);
-    for (size_t i = 0; i < 3; ++i) r.info.xy[i] = xy(i);
-    ++f_.st.drawn;
-    f_.st.row_spans += spans;
+    describeTriangle(f_.obj.index, ti, partXY(part), spans, r.info, f_.st);  // merged into the frame's later
     if (spans) f_.countRows(rows_);
   } else {
     side.foreign.push_back(key);
