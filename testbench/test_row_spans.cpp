@@ -276,12 +276,12 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
 }
 
 // The colour kernels straight from the rows' spans (fixed_simd::colourSpansAvx2 and
-// colourSpansAvx512, flat and Gouraud's where the CPU has AVX2 or AVX-512) against what they
-// replace, the rows' runs (emitRowSpans, as the walk hands them over) and the run kernel of the
-// same instructions: the same depth, tag and colour
-// buffers and the same counts, on the generator's triangles drawn one over another on a 512 x 512
-// frame (every other one with a triangle buffer), with colours around [0, 255] and depth codes
-// over the whole range.
+// colourSpansAvx512, flat and Gouraud's where the CPU has AVX2 or AVX-512, and colourSpansScalar,
+// the scalar paths') against what they replace, the rows' runs (emitRowSpans, as the walk hands
+// them over) and a run kernel (of the same instructions; AVX2's for the scalar one): the same
+// depth, tag and colour buffers and the same counts, on the generator's triangles drawn one over
+// another on a 512 x 512 frame (every other one with a triangle buffer), with colours around
+// [0, 255] (every fourth triangle of one colour, as flat's) and depth codes over the whole range.
 namespace {
 void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::ColourSpansKernel spans_kernel) {
   const RasterConfig cfg = rendererConfig("serial");
@@ -297,7 +297,7 @@ void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::Colo
   TriangleGenerator gen(41);
   fixed_simd::ColourRuns runs;
   runs.frac = 12;
-  long drawn = 0;
+  long drawn = 0, one_colour = 0;
   uint64_t fragments = 0, passed = 0, covered = 0;
   for (int32_t k = 0; k < 20000; ++k) {
     const std::array<SetupVertex, 3> sv = toSetupVertices(gen.next(), 4);
@@ -305,11 +305,13 @@ void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::Colo
     for (size_t i = 0; i < 3; ++i) {
       v[i].x = sv[i].x;
       v[i].y = sv[i].y;
-      for (size_t ch = 0; ch < 3; ++ch) v[i].attr[ch] = -20.0 + static_cast<double>(rng() % 2950) / 10;
+      for (size_t ch = 0; ch < 3; ++ch)
+        v[i].attr[ch] = k % 4 == 1 && i > 0 ? v[0].attr[ch] : -20.0 + static_cast<double>(rng() % 2950) / 10;
       v[i].attr[3] = sv[i].attr[3];
     }
     RowSpans s;
     if (setupRowSpans(v, rc, s) != RowSpansSetup::Drawn) continue;
+    one_colour += (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
     const bool tags = k % 2 == 0;
     const fixed_simd::Target ta{depth_a.data(), tags ? tri_a.data() : nullptr, k, W};
     const fixed_simd::Target tb{depth_b.data(), tags ? tri_b.data() : nullptr, k, W};
@@ -342,6 +344,8 @@ void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::Colo
   // Not vacuous: most triangles drawn, fragments that pass and fragments that fail, pixels
   // covered anew and over.
   EXPECT_GT(drawn, 15000);
+  EXPECT_GT(one_colour, drawn / 5);
+  EXPECT_LT(one_colour, drawn / 3);
   EXPECT_GT(passed, fragments / 10);
   EXPECT_LT(passed, fragments * 9 / 10);
   EXPECT_GT(covered, passed / 10);
@@ -352,6 +356,7 @@ void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::Colo
 TEST(RowSpans, ColourSpansEqualSpanRowsAndTheRunKernel) {
   if (!fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX2 here";
   colourSpansEqualRuns(fixed_simd::colourRunsAvx2, fixed_simd::colourSpansAvx2);
+  colourSpansEqualRuns(fixed_simd::colourRunsAvx2, fixed_simd::colourSpansScalar);
   if (fixed_simd::cpuHasAvx512()) colourSpansEqualRuns(fixed_simd::colourRunsAvx512, fixed_simd::colourSpansAvx512);
 }
 

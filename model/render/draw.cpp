@@ -19,7 +19,9 @@ Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Fra
       buffer_spans(buffer_run != nullptr ? fixed_simd::spansBufferKernel() : nullptr),
       colour_kernel(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::colourKernel()
                                                                                       : nullptr),
-      colour_spans(colour_kernel != nullptr ? fixed_simd::colourSpansKernel() : nullptr),
+      colour_spans(walker == nullptr || walker->AttrBits > 32 ? nullptr
+                   : opt.vector_kernel                      ? fixed_simd::colourSpansKernel()
+                                                            : fixed_simd::colourSpansScalar),
       avx2(opt.vector_kernel && fixed_simd::availableAvx2()) {}
 
 Frame::~Frame() = default;

@@ -253,8 +253,9 @@ class Frame {
   // The kernel of flat and Gouraud's colour runs, under the same conditions, AVX-512 or AVX2
   // (fixed_simd::colourKernel); null: the scalar loop.
   const fixed_simd::ColourKernel colour_kernel;
-  // The colour kernel's pass straight from the rows' spans (fixed_simd::colourSpansKernel);
-  // null where colour_kernel is.
+  // The colour kernel's pass straight from the rows' spans (fixed_simd::colourSpansKernel; the
+  // scalar one, colourSpansScalar, on the scalar paths); null without the model's span unit or
+  // where its codes exceed 32 bits.
   const fixed_simd::ColourSpansKernel colour_spans;
   // The AVX2 paths of setup: the vertex transform (transformVertexRange) and the rows' spans'
   // plane (RowSpansConfig::vector), where the CPU has AVX2 and opt.vector_kernel holds.

@@ -9,6 +9,7 @@
 
 #include "render/fixed_shading.h"
 #include "render/normalize.h"
+#include "render/pipeline.h"
 #include "render/x86_targets.h"
 
 namespace shd::fixed_simd {
@@ -536,7 +537,9 @@ SHD_AVX2_PRFCHW uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, 
 }
 
 // colourRunsAvx512's groups straight from the rows' spans, as colourSpansAvx2 does for the AVX2
-// kernel: a row's codes at its first pixel from eachSpanRow's lanes (z, c0, c1, c2).
+// kernel: a row's codes at its first pixel from eachSpanRow's lanes (z, c0, c1, c2). A triangle
+// of one colour (its colour gradients 0: flat's) has the same colour bytes in every group:
+// packed once.
 SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb,
                                       uint64_t& passed) {
   const std::array<int32_t, 3> dc = {static_cast<int32_t>(s.didx[0]), static_cast<int32_t>(s.didx[1]),
@@ -544,14 +547,28 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
   const uint32_t dz = static_cast<uint32_t>(s.didx[3]);
   const RunLanes l = runLanes(dz, dc, frac);
   uint64_t covered = 0, pass_count = 0;
-  eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
-    GroupCodes g(at);
-    for (size_t k = 0; k < count; k += 8, g.next(dz, dc)) {
-      const __mmask8 pass = zTest8(t, p + k, count - k, g.zk, l.dz, covered);
-      pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
-      if (pass != 0) storeColours8(colourBytes8(l, g.ck), pass, rgb + 3 * (p + k));
-    }
-  });
+  const bool one_colour = (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
+  if (one_colour) {
+    const __m256i bytes = colourBytes8(l, {static_cast<uint32_t>(s.a0[0]), static_cast<uint32_t>(s.a0[1]),
+                                           static_cast<uint32_t>(s.a0[2])});
+    eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
+      uint32_t zk = static_cast<uint32_t>(_mm_cvtsi128_si32(at));
+      for (size_t k = 0; k < count; k += 8, zk += 8 * dz) {
+        const __mmask8 pass = zTest8(t, p + k, count - k, zk, l.dz, covered);
+        pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
+        if (pass != 0) storeColours8(bytes, pass, rgb + 3 * (p + k));
+      }
+    });
+  } else {
+    eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
+      GroupCodes g(at);
+      for (size_t k = 0; k < count; k += 8, g.next(dz, dc)) {
+        const __mmask8 pass = zTest8(t, p + k, count - k, g.zk, l.dz, covered);
+        pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
+        if (pass != 0) storeColours8(colourBytes8(l, g.ck), pass, rgb + 3 * (p + k));
+      }
+    });
+  }
   passed += pass_count;
   return covered;
 }
@@ -897,6 +914,88 @@ bool bufferSpansAvx2(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_
 
 #endif
 
+// colourSpansAvx2's rows pixel by pixel in plain C++ (no intrinsics): the same codes (RowSpans::at
+// mod 2^32, in 32-bit lanes), the same z-test of int32_t codes and the same colour bytes. The
+// codes of a triangle's pixels are exact in int32_t (setupRowSpans checks the plane there) and
+// affine along a row: where both ends of a row lie in [0, 255 2^frac], so do all between, and
+// unorm8FromCode is the rounding shift alone. A triangle of one colour (flat's) has its bytes
+// found once. Frac: the fraction bits, as an int or a constant.
+namespace {
+template <bool kTags, class Frac>
+uint64_t colourSpansPlain(const RowSpans& s, size_t W, Frac frac, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  // The codes (z, c0, c1, c2) as 32-bit lanes: attribute 3 first, as eachSpanRow's.
+  auto lanes = [](const std::array<int64_t, 4>& v) {
+    return std::array<uint32_t, 4>{static_cast<uint32_t>(v[3]), static_cast<uint32_t>(v[0]),
+                                   static_cast<uint32_t>(v[1]), static_cast<uint32_t>(v[2])};
+  };
+  const std::array<uint32_t, 4> dx = lanes(s.didx), dy = lanes(s.didy);
+  std::array<uint32_t, 4> left = lanes(s.a0);  // at column x0 of row y0 + i
+  const int32_t top = int32_t{255} << frac, half = int32_t{1} << (frac - 1);
+  auto clamped = [&](uint32_t code) {
+    return static_cast<uint8_t>((std::clamp(static_cast<int32_t>(code), 0, top) + half) >> frac);
+  };
+  auto shifted = [&](uint32_t code) { return static_cast<uint8_t>((static_cast<int32_t>(code) + half) >> frac); };
+  const bool one_colour = (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
+  const std::array<uint8_t, 3> colour = {clamped(left[1]), clamped(left[2]), clamped(left[3])};
+  uint64_t covered = 0, pass_count = 0;
+  // A row's count pixels from p, with the codes c at its first, unorm8 giving the colour bytes
+  // (null: the triangle's one colour).
+  auto row = [&](size_t p, size_t count, std::array<uint32_t, 4> c, auto unorm8) {
+    int32_t* const depth = t.depth + p;
+    uint8_t* const out = rgb + 3 * p;
+    for (size_t k = 0; k < count; ++k) {
+      const int32_t z = static_cast<int32_t>(c[0]), old = depth[k];
+      if (z > old) {
+        covered += old == 0 ? 1 : 0;
+        ++pass_count;
+        depth[k] = z;
+        if constexpr (kTags) t.tri[p + k] = t.tag;
+        for (size_t ch = 0; ch < 3; ++ch) {
+          if constexpr (std::is_same_v<decltype(unorm8), std::nullptr_t>) out[3 * k + ch] = colour[ch];
+          else out[3 * k + ch] = unorm8(c[ch + 1]);
+        }
+      }
+      c[0] += dx[0];
+      if constexpr (!std::is_same_v<decltype(unorm8), std::nullptr_t>)
+        for (size_t ch = 1; ch < 4; ++ch) c[ch] += dx[ch];
+    }
+  };
+  size_t at = static_cast<size_t>(s.y0) * W;
+  for (int32_t i = 0; i < s.rows; ++i, at += W) {
+    const int32_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo <= hi) {
+      std::array<uint32_t, 4> c;
+      bool in_range = true;
+      for (size_t k = 0; k < 4; ++k) {
+        c[k] = left[k] + dx[k] * static_cast<uint32_t>(lo - s.x0);
+        const int32_t a = static_cast<int32_t>(c[k]), b = static_cast<int32_t>(c[k] + dx[k] * static_cast<uint32_t>(hi - lo));
+        in_range = in_range && (k == 0 || (std::min(a, b) >= 0 && std::max(a, b) <= top));
+      }
+      const size_t p = at + static_cast<size_t>(lo), count = static_cast<size_t>(hi - lo + 1);
+      __builtin_prefetch(t.depth + p + 2 * W, 1);  // the row after next, as the vector kernels
+      __builtin_prefetch(rgb + 3 * (p + 2 * W), 1);
+      if (one_colour) row(p, count, c, nullptr);
+      else if (in_range) row(p, count, c, shifted);
+      else row(p, count, c, clamped);
+    }
+    for (size_t k = 0; k < 4; ++k) left[k] += dy[k];
+  }
+  passed += pass_count;
+  return covered;
+}
+template <bool kTags>
+uint64_t colourSpansFrac(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  // The renderer's colour codes (kColourFrac) with constant shifts.
+  if (frac == kColourFrac) return colourSpansPlain<kTags>(s, W, std::integral_constant<int, kColourFrac>{}, t, rgb, passed);
+  return colourSpansPlain<kTags>(s, W, frac, t, rgb, passed);
+}
+}  // namespace
+
+uint64_t colourSpansScalar(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed) {
+  return t.tri != nullptr ? colourSpansFrac<true>(s, W, frac, t, rgb, passed)
+                          : colourSpansFrac<false>(s, W, frac, t, rgb, passed);
+}
+
 // Each kernel's choice: the AVX-512 one where available(), else the AVX2 one where
 // availableAvx2(), else null (the scalar path; always without SHD_X86_KERNELS).
 namespace {
@@ -906,7 +1005,10 @@ Kernel byCpu(Kernel avx512, Kernel avx2) {
 }
 }  // namespace
 ColourKernel colourKernel() { return byCpu<ColourKernel>(colourRunsAvx512, colourRunsAvx2); }
-ColourSpansKernel colourSpansKernel() { return byCpu<ColourSpansKernel>(colourSpansAvx512, colourSpansAvx2); }
+ColourSpansKernel colourSpansKernel() {
+  const ColourSpansKernel vector = byCpu<ColourSpansKernel>(colourSpansAvx512, colourSpansAvx2);
+  return vector != nullptr ? vector : colourSpansScalar;
+}
 NhKernel nhKernel() { return byCpu<NhKernel>(shadeNh, shadeNhAvx2); }
 BufferKernel bufferKernel() { return byCpu<BufferKernel>(bufferRun, bufferRunAvx2); }
 SpansBufferKernel spansBufferKernel() { return byCpu<SpansBufferKernel>(bufferSpans, bufferSpansAvx2); }

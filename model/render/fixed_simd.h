@@ -146,7 +146,10 @@ ColourKernel colourKernel();
 uint64_t colourSpansAvx2(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
 // The same with colourRunsAvx512's operations.
 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
-// The one of colourKernel()'s instructions (Frame::colour_spans), null where that is.
+// The same pixel by pixel in plain C++: the colour kernel of the scalar paths.
+uint64_t colourSpansScalar(const RowSpans& s, size_t W, int frac, const Target& t, uint8_t* rgb, uint64_t& passed);
+// The one of colourKernel()'s instructions (Frame::colour_spans), colourSpansScalar where that is
+// null.
 using ColourSpansKernel = uint64_t (*)(const RowSpans&, size_t, int, const Target&, uint8_t*, uint64_t&);
 ColourSpansKernel colourSpansKernel();
 
