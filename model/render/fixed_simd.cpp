@@ -257,11 +257,9 @@ SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_
 // written (where t has a tag buffer). Returns the passing lanes; adds to fresh those whose
 // depth was 0. The accesses are 8 lanes wide (32 bytes): wider ones, even with their lanes
 // masked off, would overlap the next step's and stall its load behind this store.
-SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, uint32_t zk, __m256i dz_lanes,
-                                  uint64_t& fresh) {
+SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, __m256i z, uint64_t& fresh) {
   int32_t* const depth = t.depth + p;
   const __mmask8 valid = static_cast<__mmask8>((1u << std::min<size_t>(8, left)) - 1);
-  const __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), dz_lanes);
   // The row after next, most likely this triangle's: its depth in the cache by then.
   __builtin_prefetch(depth + 2 * t.width);
   __builtin_prefetch(depth + 2 * t.width + 7);
@@ -271,6 +269,10 @@ SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, uint32
   _mm256_mask_storeu_epi32(depth, pass, z);
   if (t.tri != nullptr) _mm256_mask_storeu_epi32(t.tri + p, pass, _mm256_set1_epi32(t.tag));
   return pass;
+}
+SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, uint32_t zk, __m256i dz_lanes,
+                                  uint64_t& fresh) {
+  return zTest8(t, p, left, _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), dz_lanes), fresh);
 }
 
 // shadeNh's loop: the groups of 8 of n fragments, group(i, count) shading fragments i .. i +
@@ -560,12 +562,19 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
       }
     });
   } else {
-    eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
-      GroupCodes g(at);
-      for (size_t k = 0; k < count; k += 8, g.next(dz, dc)) {
-        const __mmask8 pass = zTest8(t, p + k, count - k, g.zk, l.dz, covered);
+    // The codes kept in lanes (as colourRunAvx2's), stepped by 8 steps a group.
+    const RunSteps step = runSteps(dz, dc);
+    eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at4) SHD_AVX512 {
+      const __m256i at = _mm256_castsi128_si256(at4);
+      __m256i z = _mm256_add_epi32(_mm256_broadcastd_epi32(at4), l.dz), code[3];
+      for (size_t ch = 0; ch < 3; ++ch)
+        code[ch] = _mm256_add_epi32(_mm256_permutexvar_epi32(_mm256_set1_epi32(static_cast<int32_t>(ch + 1)), at), l.dc[ch]);
+      for (size_t k = 0; k < count; k += 8) {
+        const __mmask8 pass = zTest8(t, p + k, count - k, z, covered);
         pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
-        if (pass != 0) storeColours8(colourBytes8(l, g.ck), pass, rgb + 3 * (p + k));
+        if (pass != 0) storeColours8(colourBytesOf(l, code), pass, rgb + 3 * (p + k));
+        z = _mm256_add_epi32(z, step.z);
+        for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(code[ch], step.c[ch]);
       }
     });
   }
