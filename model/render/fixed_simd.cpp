@@ -330,19 +330,25 @@ SHD_AVX512 [[gnu::always_inline]] inline size_t bufferRunIn(const Run& r, size_t
   const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
   const __m512i l0 = _mm512_set1_epi64(static_cast<int64_t>(r.l)), dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl));
   const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
-  const __m256i dz_lanes = laneSteps(r.px.dz);
   size_t n = b.n, k = first;
   uint64_t covered = 0;
+  // Fragments k .. k + 7 in 64-bit lanes (k < 2^32): the quadratic, l and h there (mod 2^64), then
+  // stepped by 8 fragments a group with adds (the same values mod 2^64): sq by its difference
+  // dsq = sq(k + 8) - sq(k) = 16 b + c (16 k + 64), itself stepped by 128 c.
+  const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
+  __m512i sq = _mm512_add_epi64(_mm512_add_epi64(a, _mm512_mullo_epi64(kv, two_b)),
+                                _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
+  __m512i dsq = _mm512_add_epi64(_mm512_slli_epi64(two_b, 3),
+                                 _mm512_mullo_epi64(c, _mm512_add_epi64(_mm512_slli_epi64(kv, 4), _mm512_set1_epi64(64))));
+  const __m512i ddsq = _mm512_slli_epi64(c, 7);
+  __m512i l = _mm512_add_epi64(l0, _mm512_mullo_epi64(kv, dl)), h = _mm512_add_epi64(h0, _mm512_mullo_epi64(kv, dh));
+  const __m512i dl8 = _mm512_slli_epi64(dl, 3), dh8 = _mm512_slli_epi64(dh, 3);
+  __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * r.px.dz)),
+                               laneSteps(r.px.dz));
+  const __m256i dz8 = _mm256_set1_epi32(static_cast<int32_t>(8 * r.px.dz));
+  __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.p + k)), lanes8());
   for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
-    const __mmask8 pass =
-        zTest8(t, r.px.p + k, r.px.count - k, r.px.z + static_cast<uint32_t>(k) * r.px.dz, dz_lanes, covered);
-    // Fragments k .. k + 7 in 64-bit lanes (k < 2^32).
-    const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
-    const __m512i sq =
-        _mm512_add_epi64(_mm512_add_epi64(a, _mm512_mullo_epi64(kv, two_b)), _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
-    const __m512i l = _mm512_add_epi64(l0, _mm512_mullo_epi64(kv, dl));
-    const __m512i h = _mm512_add_epi64(h0, _mm512_mullo_epi64(kv, dh));
-    const __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.p + k)), lanes8());
+    const __mmask8 pass = zTest8(t, r.px.p + k, r.px.count - k, z, covered);
     // The passing lanes, packed (the register forms of compress: the memory forms are slow on
     // some CPUs), stored 8 entries wide.
     _mm512_storeu_si512(b.sq.data() + n, _mm512_maskz_compress_epi64(pass, sq));
@@ -350,6 +356,12 @@ SHD_AVX512 [[gnu::always_inline]] inline size_t bufferRunIn(const Run& r, size_t
     _mm512_storeu_si512(b.h.data() + n, _mm512_maskz_compress_epi64(pass, h));
     _mm256_storeu_si256(reinterpret_cast<__m256i*>(b.pixel.data() + n), _mm256_maskz_compress_epi32(pass, pixel));
     n += static_cast<size_t>(__builtin_popcount(pass));
+    sq = _mm512_add_epi64(sq, dsq);
+    dsq = _mm512_add_epi64(dsq, ddsq);
+    l = _mm512_add_epi64(l, dl8);
+    h = _mm512_add_epi64(h, dh8);
+    z = _mm256_add_epi32(z, dz8);
+    pixel = _mm256_add_epi32(pixel, _mm256_set1_epi32(8));
   }
   b.n = n;
   fresh += covered;
