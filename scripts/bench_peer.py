@@ -3,7 +3,7 @@
 
   scripts/bench_peer.py --pair METHOD 'PEER COMMAND' [--pair ...] [--rounds R] [--frames N]
                         [--threads 1,2] [--scene SCENE | --segments 32,64,...] [--shadesim BIN]
-                        [--peer-pattern REGEX] [--json-out FILE]
+                        [--peer-pattern REGEX] [--cpu N] [--json-out FILE]
 
 Each --pair names a shadesim method (`shadesim render --method`) and a shell command that prints
 the peer's time per frame in milliseconds. Every round runs, for every pair, shadesim
@@ -21,6 +21,11 @@ stands for N, so that the peer draws the same sphere (e.g. 'PEER_SEG={seg} PEER 
 
 --peer-pattern: a regular expression whose first group is the peer's ms per frame, searched in
 its output; the last match counts (default: a number followed by "ms").
+
+--cpu N: the one-thread runs of both programs pinned to CPU N (its affinity, inherited by the
+peer's threads); two-thread runs keep every CPU. On a VM whose CPUs do not run at the same
+speed (one of this project's 2-core VMs had one 1.4-1.5 times slower than the other at times),
+an unpinned run lands on either, and the ratio of two runs then mixes the CPUs' speeds.
 
 Prints, per pair, every round's two times and their ratio, then the median of the rounds'
 ratios (shadesim / peer: below 1, shadesim is faster) with its range, and the ratio of the two
@@ -46,8 +51,9 @@ class BenchError(Exception):
     pass
 
 
-def run(cmd, shell=False):
-    p = subprocess.run(cmd, shell=shell, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+def run(cmd, shell=False, cpu=None):
+    pin = None if cpu is None else (lambda: os.sched_setaffinity(0, {cpu}))
+    p = subprocess.run(cmd, shell=shell, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=pin)
     if p.returncode != 0:
         tail = "\n".join((p.stdout + p.stderr).strip().splitlines()[-10:])
         raise BenchError(f"{cmd if shell else ' '.join(cmd)}: exit {p.returncode}\n{tail}")
@@ -57,13 +63,14 @@ def run(cmd, shell=False):
 def shadesim_ms(a, scene, method, threads, work):
     js = os.path.join(work, "render.json")
     run([a.shadesim, "render", "--scene", scene, "--method", method, "--bench", str(a.frames), "--quiet",
-         "--threads", str(threads), "-o", os.path.join(work, "render.png"), "--json", js])
+         "--threads", str(threads), "-o", os.path.join(work, "render.png"), "--json", js],
+        cpu=a.cpu if threads == 1 else None)
     with open(js, encoding="utf-8") as f:
         return float(json.load(f)["ms"])
 
 
-def peer_ms(a, cmd):
-    out = run(cmd, shell=True)
+def peer_ms(a, cmd, threads):
+    out = run(cmd, shell=True, cpu=a.cpu if threads == 1 else None)
     found = re.findall(a.peer_pattern, out)
     if not found:
         tail = "\n".join(out.strip().splitlines()[-5:])
@@ -95,7 +102,7 @@ def measure(a):
                 for who in order:
                     t[who] = (shadesim_ms(a, scenes[res["segments"]], res["method"], res["threads"], work)
                               if who == "shadesim"
-                              else peer_ms(a, res["peer"]))
+                              else peer_ms(a, res["peer"], res["threads"]))
                 t["ratio"] = t["shadesim"] / t["peer"]
                 res["rounds"].append(t)
                 print(f"bench_peer: round {r + 1}/{a.rounds} {label(res)}: "
@@ -119,7 +126,9 @@ def label(res):
 def report(a, results):
     env = " SHD_SCALAR=1" if os.environ.get("SHD_SCALAR") else ""
     scene = f"builtin:sphere of {a.segments} segments" if a.segments else a.scene
-    print(f"{scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds; ratio = shadesim / peer")
+    pinned = "" if a.cpu is None else f", one-thread runs on CPU {a.cpu}"
+    print(f"{scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds{pinned}; "
+          "ratio = shadesim / peer")
     for res in results:
         print(f"\n{label(res)}, against: {res['peer']}")
         print(f"{'round':>5} {'shadesim ms':>12} {'peer ms':>10} {'ratio':>7}")
@@ -140,6 +149,7 @@ def main(argv):
     p.add_argument("--segments")
     p.add_argument("--shadesim", default=os.path.join(ROOT, "build", "sim", "shadesim"))
     p.add_argument("--peer-pattern", default=DEFAULT_PATTERN)
+    p.add_argument("--cpu", type=int)
     p.add_argument("--json-out")
     a = p.parse_args(argv)
     try:
@@ -160,6 +170,8 @@ def main(argv):
                 a.segments = []
             if not a.segments or any(n < 4 or n > 1024 for n in a.segments) or a.scene != "builtin:sphere":
                 raise BenchError(f"--segments '{given}': segment counts 4..1024 (builtin:sphere(1,N)), comma-separated, without --scene")
+        if a.cpu is not None and a.cpu not in os.sched_getaffinity(0):
+            raise BenchError(f"--cpu {a.cpu}: not one of this process's CPUs {sorted(os.sched_getaffinity(0))}")
         if not os.access(a.shadesim, os.X_OK):
             raise BenchError(f"{a.shadesim}: no shadesim binary (--shadesim)")
         try:
@@ -174,7 +186,8 @@ def main(argv):
     report(a, results)
     if a.json_out:
         with open(a.json_out + ".tmp", "w", encoding="utf-8") as f:
-            json.dump({"scene": a.scene, "segments": a.segments, "frames": a.frames, "rounds": a.rounds, "pairs": results}, f, indent=1)
+            json.dump({"scene": a.scene, "segments": a.segments, "frames": a.frames, "rounds": a.rounds, "cpu": a.cpu,
+                       "pairs": results}, f, indent=1)
         os.replace(a.json_out + ".tmp", a.json_out)
     return 0
 

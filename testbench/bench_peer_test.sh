@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # bench_peer_test.sh SHADESIM WORK: scripts/bench_peer.py against a stand-in peer that prints a
 # given time (no figure is checked, only the plumbing): the ratios are shadesim's times over the
-# peer's, "{seg}" reaches the peer command with each sphere size of --segments, the JSON holds
-# every round, and bad input or a peer without a time exits 2 naming the cause.
+# peer's, "{seg}" reaches the peer command with each sphere size of --segments, --cpu pins the
+# one-thread runs, the JSON holds every round, and bad input or a peer without a time exits 2
+# naming the cause.
 set -euo pipefail
 shadesim=$(realpath "$1")
 work=$2
@@ -34,6 +35,22 @@ PY
 grep -q "^gouraud (1 thread(s), 9 segments), against: echo \"frame 9.0 ms\"" out.txt
 grep -q "^median ratio " out.txt
 grep -q "^fastest rounds: shadesim [0-9.]* ms, peer 9.000 ms, ratio " out.txt
+# --cpu: the one-thread rounds' peer runs on that CPU alone, the two-thread rounds' on all (the
+# peer's time here: the count of CPUs it may run on).
+first=$(python3 -c 'import os; print(min(os.sched_getaffinity(0)))')
+all=$(python3 -c 'import os; print(len(os.sched_getaffinity(0)))')
+"${bench[@]}" --cpu "$first" --threads 1,2 --json-out cpu.json \
+  --pair flat 'echo "$(python3 -c "import os; print(len(os.sched_getaffinity(0)))").0 ms"' > cpu.txt
+grep -q "one-thread runs on CPU $first" cpu.txt
+python3 - "$first" "$all" <<'PY'
+import json, sys
+r = json.load(open("cpu.json"))
+assert r["cpu"] == int(sys.argv[1]), r["cpu"]
+for p in r["pairs"]:
+    want = 1 if p["threads"] == 1 else int(sys.argv[2])
+    assert all(t["peer"] == want for t in p["rounds"]), (p["threads"], p["rounds"])
+print("bench_peer --cpu: ok")
+PY
 expect2() {  # expect2 WHAT ARGS...: exit 2 with WHAT in stderr
   local what=$1; shift
   set +e
@@ -48,4 +65,5 @@ expect2 "segment counts 4..1024" --segments 64 --scene builtin:torus --pair flat
 expect2 "distinct thread counts" --threads 1,3 --pair flat 'echo 1 ms'
 expect2 "no time per frame" --pair flat 'echo none'
 expect2 "exit 3" --pair flat 'exit 3'
+expect2 "not one of this process's CPUs" --cpu 100000 --pair flat 'echo 1 ms'
 echo "bench_peer: ok"
