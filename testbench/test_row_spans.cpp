@@ -281,9 +281,11 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
 // them over) and a run kernel (of the same instructions; AVX2's for the scalar one): the same
 // depth, tag and colour buffers and the same counts, on the generator's triangles drawn one over
 // another on a 512 x 512 frame (every other one with a triangle buffer), with colours around
-// [0, 255] (every fourth triangle of one colour, as flat's) and depth codes over the whole range.
+// [0, 255] (every fourth triangle of one colour, as flat's) and depth codes over the whole range;
+// the colour codes with the renderer's 12 fraction bits, and 9 (the scalar kernel's other path).
 namespace {
-void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::ColourSpansKernel spans_kernel) {
+void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::ColourSpansKernel spans_kernel,
+                          int frac = 12) {
   const RasterConfig cfg = rendererConfig("serial");
   const RowSpansConfig rc(cfg);
   const size_t W = 512, n = W * 512;
@@ -296,7 +298,7 @@ void colourSpansEqualRuns(fixed_simd::ColourKernel runs_kernel, fixed_simd::Colo
   std::vector<uint8_t> rgb_b = rgb_a;
   TriangleGenerator gen(41);
   fixed_simd::ColourRuns runs;
-  runs.frac = 12;
+  runs.frac = frac;
   long drawn = 0, one_colour = 0;
   uint64_t fragments = 0, passed = 0, covered = 0;
   for (int32_t k = 0; k < 20000; ++k) {
@@ -357,6 +359,7 @@ TEST(RowSpans, ColourSpansEqualSpanRowsAndTheRunKernel) {
   if (!fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX2 here";
   colourSpansEqualRuns(fixed_simd::colourRunsAvx2, fixed_simd::colourSpansAvx2);
   colourSpansEqualRuns(fixed_simd::colourRunsAvx2, fixed_simd::colourSpansScalar);
+  colourSpansEqualRuns(fixed_simd::colourRunsAvx2, fixed_simd::colourSpansScalar, 9);  // its shifts at run time
   if (fixed_simd::cpuHasAvx512()) colourSpansEqualRuns(fixed_simd::colourRunsAvx512, fixed_simd::colourSpansAvx512);
 }
 

@@ -221,11 +221,6 @@ struct GroupCodes {
   std::array<uint32_t, 3> ck;
   explicit GroupCodes(const ColourRuns::Row& row)
       : zk(row.z), ck{static_cast<uint32_t>(row.c[0]), static_cast<uint32_t>(row.c[1]), static_cast<uint32_t>(row.c[2])} {}
-  // From eachSpanRow's lanes (z, c0, c1, c2).
-  SHD_AVX2 explicit GroupCodes(__m128i at)
-      : zk(static_cast<uint32_t>(_mm_extract_epi32(at, 0))),
-        ck{static_cast<uint32_t>(_mm_extract_epi32(at, 1)), static_cast<uint32_t>(_mm_extract_epi32(at, 2)),
-           static_cast<uint32_t>(_mm_extract_epi32(at, 3))} {}
   void next(uint32_t dz, const std::array<int32_t, 3>& dc) {
     zk += 8 * dz;
     for (size_t ch = 0; ch < 3; ++ch) ck[ch] += 8 * static_cast<uint32_t>(dc[ch]);
