@@ -3,7 +3,9 @@
 //
 // Both interpolate colour codes (flat's constant) and write them as they are: per fragment the
 // z-test and the codes straight to unorm8 (what combine() gives them); per run of a row the
-// same in a loop of its own, or in AVX-512 or AVX2 (fixed_simd::colourKernel).
+// same in a loop of its own, or in AVX-512 or AVX2 (fixed_simd::colourKernel); a triangle's
+// rows' spans in one call of fixed_simd::colourSpansKernel (AVX-512, AVX2, or plain C++ on the
+// scalar paths).
 #include <algorithm>
 #include <type_traits>
 
@@ -132,7 +134,7 @@ struct ColourRunLoop {
   }
 };
 
-// A triangle's rows' spans (raster/row_spans.h) to the vector kernel with one call, without the
+// A triangle's rows' spans (raster/row_spans.h) to the colour kernel with one call, without the
 // walk (Frame::colour_spans).
 // A side of a frame split by rows draws the rows of its RowShare: the slice of them, where the
 // triangle has rows of the other side's.
