@@ -1163,7 +1163,7 @@ TEST(Render, SplitChoiceKeepsTheFasterWay) {
     for (int k = 0; k < C; ++k) {
       const bool rows = c.next(false);
       ways += rows ? 'R' : 'F';
-      c.record(rows, ms(k, rows));
+      c.record(ms(k, rows));
     }
     return ways;
   };

@@ -5,6 +5,11 @@
 
 namespace shd {
 
+namespace {
+// The model's span unit, whose depth and colour codes fit the kernels' int32_t lanes.
+bool codesFit32(const SpanParams* walker) { return walker != nullptr && walker->AttrBits <= 32; }
+}  // namespace
+
 Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Framebuffer& fb, RenderStats& st)
     : opt(opt),
       fb(fb),
@@ -15,13 +20,12 @@ Frame::Frame(const Scene& scene, const RenderOptions& opt, SpanEngine& span, Fra
       ctx(makeShadeContext(scene)),
       span(span),
       walker(span.walker()),
-      buffer_run(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::bufferKernel() : nullptr),
+      buffer_run(opt.vector_kernel && codesFit32(walker) ? fixed_simd::bufferKernel() : nullptr),
       buffer_spans(buffer_run != nullptr ? fixed_simd::spansBufferKernel() : nullptr),
-      colour_kernel(opt.vector_kernel && walker != nullptr && walker->AttrBits <= 32 ? fixed_simd::colourKernel()
-                                                                                      : nullptr),
-      colour_spans(walker == nullptr || walker->AttrBits > 32 ? nullptr
-                   : opt.vector_kernel                      ? fixed_simd::colourSpansKernel()
-                                                            : fixed_simd::colourSpansScalar),
+      colour_kernel(opt.vector_kernel && codesFit32(walker) ? fixed_simd::colourKernel() : nullptr),
+      colour_spans(!codesFit32(walker)     ? nullptr
+                   : opt.vector_kernel ? fixed_simd::colourSpansKernel()
+                                       : fixed_simd::colourSpansScalar),
       avx2(opt.vector_kernel && fixed_simd::availableAvx2()) {}
 
 Frame::~Frame() = default;

@@ -14,6 +14,13 @@
 
 namespace shd::fixed_simd {
 
+namespace {
+// A triangle of one colour (flat's): its colour codes' gradients 0.
+bool oneColour(const RowSpans& s) {
+  return (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
+}
+}  // namespace
+
 #ifdef SHD_X86_KERNELS
 
 // GCC 12's AVX-512 headers pass _mm512_undefined_epi32() as the unused merge source of the
@@ -248,7 +255,7 @@ SHD_AVX2 inline __m256i colourBytes8(const RunLanes& l, const std::array<uint32_
 }
 
 // The z-test of the 8 fragments at pixels p + 0 .. 7 (those below `left`), fragment i with the
-// depth code zk + dz_lanes[i]: against the buffer's, and where they pass the codes and the tag
+// depth code z[i]: against the buffer's, and where they pass the codes and the tag
 // written (where t has a tag buffer). Returns the passing lanes; adds to fresh those whose
 // depth was 0. The accesses are 8 lanes wide (32 bytes): wider ones, even with their lanes
 // masked off, would overlap the next step's and stall its load behind this store.
@@ -264,10 +271,6 @@ SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, __m256
   _mm256_mask_storeu_epi32(depth, pass, z);
   if (t.tri != nullptr) _mm256_mask_storeu_epi32(t.tri + p, pass, _mm256_set1_epi32(t.tag));
   return pass;
-}
-SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, uint32_t zk, __m256i dz_lanes,
-                                  uint64_t& fresh) {
-  return zTest8(t, p, left, _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(zk)), dz_lanes), fresh);
 }
 
 // shadeNh's loop: the groups of 8 of n fragments, group(i, count) shading fragments i .. i +
@@ -494,7 +497,8 @@ SHD_AVX512 uint64_t colourRunsAvx512(const ColourRuns& r, const Target& t, uint8
     const ColourRuns::Row& row = r.rows[i];
     GroupCodes g(row);
     for (size_t k = 0; k < row.count; k += 8, g.next(r)) {
-      const __mmask8 pass = zTest8(t, row.p + k, row.count - k, g.zk, l.dz, covered);
+      const __mmask8 pass =
+          zTest8(t, row.p + k, row.count - k, _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(g.zk)), l.dz), covered);
       pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
       if (pass != 0) storeColours8(colourBytes8(l, g.ck), pass, rgb + 3 * (row.p + k));
     }
@@ -556,21 +560,12 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
   const uint32_t dz = static_cast<uint32_t>(s.didx[3]);
   const RunLanes l = runLanes(dz, dc, frac);
   uint64_t covered = 0, pass_count = 0;
-  const bool one_colour = (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
-  if (one_colour) {
-    const __m256i bytes = colourBytes8(l, {static_cast<uint32_t>(s.a0[0]), static_cast<uint32_t>(s.a0[1]),
-                                           static_cast<uint32_t>(s.a0[2])});
-    eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at) SHD_AVX512 {
-      uint32_t zk = static_cast<uint32_t>(_mm_cvtsi128_si32(at));
-      for (size_t k = 0; k < count; k += 8, zk += 8 * dz) {
-        const __mmask8 pass = zTest8(t, p + k, count - k, zk, l.dz, covered);
-        pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
-        if (pass != 0) storeColours8(bytes, pass, rgb + 3 * (p + k));
-      }
-    });
-  } else {
-    // The codes kept in lanes (as colourRunAvx2's), stepped by 8 steps a group.
-    const RunSteps step = runSteps(dz, dc);
+  // The codes kept in lanes (as colourRunAvx2's), stepped by 8 steps a group; a triangle of one
+  // colour has its bytes packed once (one: std::true_type).
+  const RunSteps step = runSteps(dz, dc);
+  const __m256i bytes = colourBytes8(l, {static_cast<uint32_t>(s.a0[0]), static_cast<uint32_t>(s.a0[1]),
+                                         static_cast<uint32_t>(s.a0[2])});
+  auto rows = [&](auto one) SHD_AVX512 {
     eachSpanRow(s, W, [&](size_t p, size_t count, size_t, __m128i at4) SHD_AVX512 {
       const __m256i at = _mm256_castsi128_si256(at4);
       __m256i z = _mm256_add_epi32(_mm256_broadcastd_epi32(at4), l.dz), code[3];
@@ -579,12 +574,15 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
       for (size_t k = 0; k < count; k += 8) {
         const __mmask8 pass = zTest8(t, p + k, count - k, z, covered);
         pass_count += static_cast<uint64_t>(__builtin_popcount(pass));
-        if (pass != 0) storeColours8(colourBytesOf(l, code), pass, rgb + 3 * (p + k));
+        if (pass != 0) storeColours8(decltype(one)::value ? bytes : colourBytesOf(l, code), pass, rgb + 3 * (p + k));
         z = _mm256_add_epi32(z, step.z);
-        for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(code[ch], step.c[ch]);
+        if constexpr (!decltype(one)::value)
+          for (size_t ch = 0; ch < 3; ++ch) code[ch] = _mm256_add_epi32(code[ch], step.c[ch]);
       }
     });
-  }
+  };
+  if (oneColour(s)) rows(std::true_type{});
+  else rows(std::false_type{});
   passed += pass_count;
   return covered;
 }
@@ -951,7 +949,7 @@ uint64_t colourSpansPlain(const RowSpans& s, size_t W, Frac frac, const Target& 
     return static_cast<uint8_t>((std::clamp(static_cast<int32_t>(code), 0, top) + half) >> frac);
   };
   auto shifted = [&](uint32_t code) { return static_cast<uint8_t>((static_cast<int32_t>(code) + half) >> frac); };
-  const bool one_colour = (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
+  const bool one_colour = oneColour(s);
   const std::array<uint8_t, 3> colour = {clamped(left[1]), clamped(left[2]), clamped(left[3])};
   uint64_t covered = 0, pass_count = 0;
   // A row's count pixels from p, with the codes c at its first, unorm8 giving the colour bytes

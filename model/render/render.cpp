@@ -1168,7 +1168,7 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   }
   span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (measured) choice.record(res.split_by_rows, res.stats.ms);
+  if (measured) choice.record(res.stats.ms);
 }
 
 }  // namespace shd

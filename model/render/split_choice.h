@@ -29,10 +29,10 @@ class SplitChoice {
     return k_ >= kCycle - kProbe ? !rows_ : rows_;
   }
   // The time of the frame next() gave the way of, drawn that way.
-  void record(bool by_rows, double ms) {
+  void record(double ms) {
     if (k_ < 0) return;
     if (k_ >= kCycle - 2 * kProbe) {
-      double& best = by_rows == rows_ ? chosen_ : probe_;
+      double& best = k_ >= kCycle - kProbe ? probe_ : chosen_;
       if (ms < best) best = ms;
     }
     if (++k_ < kCycle) return;
