@@ -7,6 +7,7 @@
 #include "raster/span_unit.h"
 #include "raster/span_walk.h"
 #include "raster/desc_stream.h"
+#include "raster/exact_int.h"
 #include "raster/trigen.h"
 
 #include <gtest/gtest.h>
@@ -646,6 +647,70 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
       EXPECT_GT(fragment_rows, 0u) << m;
     }
   }
+}
+
+// Setup's divisions (raster/exact_int.h) against 128-bit integer arithmetic: operands around
+// 2^53 and at the edges of int64_t, quotients just below, at and above integers, exact halves
+// (round half to even, the parity base's plus the quotient's), random ones of every magnitude.
+TEST(ExactInt, DivisionsEqualThe128BitOnes) {
+  using i128 = __int128;
+  auto floorRef = [](i128 n, i128 d) {
+    i128 q = n / d, r = n % d;
+    if (r < 0) {
+      q -= 1;
+      r += d;
+    }
+    return std::pair<i128, i128>{q, r};
+  };
+  auto roundRef = [&](i128 n, i128 d) {
+    auto [q, r] = floorRef(n, d);
+    return 2 * r > d || (2 * r == d && (q & 1) != 0) ? q + 1 : q;
+  };
+  std::vector<int64_t> ds = {1, 2, 3, 7, 1000003};
+  std::vector<int64_t> ns;
+  const int64_t k53 = int64_t{1} << 53;
+  for (int64_t e : {k53, int64_t{1} << 62, INT64_MAX}) {
+    for (int64_t k = 0; k < 4; ++k) {
+      ds.push_back(e - k);
+      ns.push_back(e - k);
+      ns.push_back(-(e - k));
+    }
+  }
+  ds.push_back(k53 + 1);
+  ns.push_back(k53 + 1);
+  ns.push_back(-k53 - 1);
+  ns.push_back(INT64_MIN);
+  std::mt19937_64 rng(7);
+  for (int i = 0; i < 200000; ++i) {
+    const int bits = 1 + static_cast<int>(rng() % 62);
+    ds.push_back(static_cast<int64_t>(rng() >> (64 - bits)) + 1);
+    const int64_t q = static_cast<int64_t>(rng() >> (64 - static_cast<int>(rng() % 54))) * (rng() % 2 != 0 ? 1 : -1);
+    const int64_t d = ds.back();
+    int64_t n = 0;
+    // Just below, at, above an integer quotient and at a half: n = q d + {-1, 0, 1, d / 2}.
+    if (!__builtin_mul_overflow(q, d, &n) && n > INT64_MIN + d) {
+      for (int64_t off : {int64_t{-1}, int64_t{0}, int64_t{1}, d / 2}) ns.push_back(n + off);
+    }
+    ns.push_back(static_cast<int64_t>(rng()));
+  }
+  uint64_t checked = 0;
+  for (size_t i = 0; i < ns.size(); ++i) {
+    const int64_t n = ns[i];
+    for (int64_t d : {ds[i % ds.size()], ds[(i * 7 + 3) % ds.size()], int64_t{1}, k53 - 1}) {
+      const auto [qr, rr] = floorRef(n, d);
+      ASSERT_EQ(exact::ceilDiv64(n, d), static_cast<int64_t>(rr != 0 ? qr + 1 : qr)) << n << " / " << d;
+      ASSERT_EQ(exact::floorDiv(n, d), static_cast<int64_t>(qr)) << n << " / " << d;
+      ASSERT_EQ(static_cast<int64_t>(exact::roundDiv(n, d)), static_cast<int64_t>(roundRef(n, d))) << n << " / " << d;
+      if (n > -(int64_t{1} << 61) && n < (int64_t{1} << 61)) {
+        const int64_t base = static_cast<int64_t>(rng() % (uint64_t{1} << 40)) - (int64_t{1} << 39);
+        // round-half-even(base + n / d): the parity at a half is base's plus the quotient's
+        ASSERT_EQ(exact::roundDivPlus(base, n, d), static_cast<int64_t>(roundRef(static_cast<i128>(base) * d + n, d)))
+            << base << " + " << n << " / " << d;
+      }
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 1000000u);
 }
 
 // The plane codes are the exact rationals of setup.h rounded half to even: didx = 2^S nx / det,
