@@ -99,7 +99,7 @@ inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, co
 #ifdef SHD_X86_KERNELS
 // Four vertices at a time in AVX2 lanes: each lane runs transformVertex's operations on one
 // vertex, the same IEEE operations in the same order (products, sums, divisions and square roots
-// correctly rounded, as the scalar ones; no FMA: target avx2 alone, and ISO C++ does not contract),
+// correctly rounded, as the scalar ones; no FMA: target avx2 alone, and the build's -ffp-contract=off),
 // so every field equals transformVertex's bit for bit (test RenderPipeline.VectorTransformEqualsTheScalarOne).
 namespace avx2 {
 
@@ -178,9 +178,22 @@ SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const
 }
 
 }  // namespace avx2
+
 #endif
 
 }  // namespace
+
+size_t keptTriangles(const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris, double z_near,
+                     std::vector<uint32_t>& kept) {
+  kept.resize(tris.size());
+  size_t n = 0;
+  for (size_t i = 0; i < tris.size(); ++i) {
+    kept[n] = static_cast<uint32_t>(i);
+    n += culledEarly(viewTriangle(verts, tris[i], z_near)) ? 0 : 1;  // without a branch
+  }
+  kept.resize(n);
+  return tris.size() - n;
+}
 
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                           PVertex* verts, size_t begin, size_t end, bool vector, bool normals) {

@@ -107,6 +107,10 @@ inline TriangleView viewTriangle(const std::vector<PVertex>& verts, const std::a
 }
 // Back faces: a triangle wholly in front of the near plane is culled before anything is copied.
 inline bool culledEarly(const TriangleView& t) { return t.all_in && !(area2(*t.v0, *t.v1, *t.v2) < 0); }
+// The indices of an object's mesh triangles (its vertices transformed) that culledEarly keeps,
+// in order, into kept; returns how many it culls.
+size_t keptTriangles(const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris, double z_near,
+                     std::vector<uint32_t>& kept);
 
 // The visible part of a triangle that is not culledEarly as a fan: its own three vertices (the
 // common case, nothing copied), or the polygon clipped by the near plane (camera space) and the

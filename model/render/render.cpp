@@ -33,10 +33,12 @@
 namespace shd {
 
 // A drawer's buffers kept in a frame's result: the current object's vertices, which of them
-// have their colour, and its triangles' face colours (lightFaces).
+// have their colour, the triangles culledEarly keeps (keptTriangles) and their face colours
+// (lightFaces).
 struct alignas(64) DrawScratch {  // in lines of its own: each side of a split frame writes its own
   std::vector<PVertex> verts;
   std::vector<uint8_t> lit;
+  std::vector<uint32_t> kept;
   std::vector<std::array<double, 3>> faces;
 };
 
@@ -147,16 +149,16 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
 }
 
 // The face colours (Frame::faceColour) of an object's triangles, its vertices transformed: of
-// those wholly in front of the near plane and not culled early, the polygons the drawer will
-// draw as the triangles themselves unless the guard band clips them (the others' are not set).
-// A side of a frame split by rows lights those it takes.
+// those wholly in front of the near plane and not culled early (kept: keptTriangles's), the
+// polygons the drawer will draw as the triangles themselves unless the guard band clips them
+// (the others' are not set). A side of a frame split by rows lights those it takes.
 void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris,
-                std::vector<std::array<double, 3>>& faces, const SplitSide* side) {
+                const std::vector<uint32_t>& kept, std::vector<std::array<double, 3>>& faces, const SplitSide* side) {
   faces.resize(tris.size());
   auto light = [&](auto takes) {
-    for (size_t i = 0; i < tris.size(); ++i) {
+    for (const uint32_t i : kept) {
       const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
-      if (tv.all_in && !culledEarly(tv) && takes(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
+      if (tv.all_in && takes(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
     }
   };
   if (side == nullptr) light([](const TriangleView&) { return true; });
@@ -414,6 +416,7 @@ class SceneDrawer {
   TriangleSetup setup_config_;
   std::vector<PVertex>& verts_;       // the object's (the result's scratch)
   std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
+  std::vector<uint32_t>& kept_;       // the object's triangles not culled early (the result's scratch)
   std::vector<std::array<double, 3>>& faces_;  // the face colours lit ahead (the result's scratch)
   bool faces_lit_ = false;            // this object's faces_ (MethodTraits::face_colours)
   Poly poly_;                         // a clipped triangle
@@ -474,6 +477,7 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
       verts_(scratch.verts),
       lit_(scratch.lit),
+      kept_(scratch.kept),
       faces_(scratch.faces),
       queue_(queue),
       cleared_(cleared),
@@ -516,7 +520,6 @@ void SceneDrawer::drawObject(size_t oi) {
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
   if (queue_ == nullptr) {
     transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, !face_colours_);
-    if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, faces_, side_);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -536,10 +539,20 @@ void SceneDrawer::drawObject(size_t oi) {
     t.work();
     t.waitAll();
   }
+  // The back faces culled early, counted at once (on a side of a frame split by rows, the top
+  // side's); the others drawn in order.
+  const size_t culled = keptTriangles(verts_, obj.mesh.triangles, f_.proj.z_near, kept_);
+  RenderStats& culled_st = side_ != nullptr && !side_->top ? side_->others : f_.st;
+  culled_st.triangles += culled;
+  culled_st.culled_back += culled;
+  if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, kept_, faces_, side_);
   lit_.assign(verts_.size(), 0);
-  size_t ti = 0;
+  uint32_t ti = 0;
   try {
-    for (; ti < obj.mesh.triangles.size(); ++ti) drawMeshTriangle(obj.mesh.triangles[ti], static_cast<uint32_t>(ti));
+    for (const uint32_t k : kept_) {
+      ti = k;
+      drawMeshTriangle(obj.mesh.triangles[k], k);
+    }
   } catch (const std::range_error& e) {
     throw std::range_error(fmt::format("{}: object '{}' triangle {}: {}", scene_.name, obj.name, ti, e.what()));
   }
@@ -561,17 +574,11 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
     }
 }
 
-// A mesh triangle on a side of a frame split by rows: one culled early is the top side's to
-// count, any other its owner's (SplitSide::takes).
+// A mesh triangle not culled early on a side of a frame split by rows: its owner's to count
+// (SplitSide::takes).
 void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
   bool owner = side_->top;
-  if (culledEarly(tv)) {
-    RenderStats& st = owner ? f_.st : side_->others;
-    ++st.triangles;
-    ++st.culled_back;
-    return;
-  }
   if (!side_->takes(tv, owner)) return;  // the other side's alone
   RenderStats& st = owner ? f_.st : side_->others;
   ++st.triangles;
@@ -590,10 +597,6 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   RenderStats& st = f_.st;
   ++st.triangles;
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
-  if (culledEarly(tv)) {
-    ++st.culled_back;
-    return;
-  }
   if (vertex_colours_) lightVertices(tri);
   if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
   // Lit ahead: a triangle drawn as itself (a clipped one's fan points into poly_).
