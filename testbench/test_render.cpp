@@ -628,6 +628,24 @@ TEST(RenderPipeline, VectorTransformEqualsTheScalarOne) {
   EXPECT_GT(zero_normals, 100u);
 }
 
+#if defined(__x86_64__) && defined(__GNUC__)
+namespace {
+// a b - c d in a function whose target has FMA, as the AVX-512 kernels' do.
+__attribute__((target("fma"), noinline)) double differenceOfProducts(double a, double b, double c, double d) {
+  return a * b - c * d;
+}
+}  // namespace
+
+// The build contracts no a b - c d into a fused multiply-add (-ffp-contract=off, CMakeLists.txt),
+// even where the function's target has FMA: (1 + 2^-30)(1 - 2^-30) = 1 - 2^-60 rounds to 1, so
+// the difference with 1 * 1 is 0, where an FMA would give -2^-60.
+TEST(Build, NoProductFusedIntoASum) {
+  if (!__builtin_cpu_supports("fma")) GTEST_SKIP() << "no FMA on this CPU";
+  volatile double a = 1 + std::ldexp(1.0, -30), b = 1 - std::ldexp(1.0, -30), one = 1;
+  EXPECT_EQ(differenceOfProducts(a, b, one, one), 0.0);
+}
+#endif
+
 TEST(EdgeMaximum, MatchesDenseSamplingOfTheNormalisedCosine) {
   // paper 4.4 as corrected (docs/paper-corrections.md): the root t1 maximises (N_A + t (N_B - N_A)).H / |N_A + t (N_B - N_A)| on (0, 1)
   // when cos alpha + cos chi > 0; otherwise the maximum is at an end.
