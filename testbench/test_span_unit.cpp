@@ -684,13 +684,16 @@ TEST(ExactInt, DivisionsEqualThe128BitOnes) {
   for (int i = 0; i < 200000; ++i) {
     const int bits = 1 + static_cast<int>(rng() % 62);
     ds.push_back(static_cast<int64_t>(rng() >> (64 - bits)) + 1);
-    const int64_t q = static_cast<int64_t>(rng() >> (64 - static_cast<int>(rng() % 54))) * (rng() % 2 != 0 ? 1 : -1);
+    const int q_bits = static_cast<int>(rng() % 54);  // the quotient below 2^q_bits
+    const int64_t q = (q_bits == 0 ? 0 : static_cast<int64_t>(rng() >> (64 - q_bits))) * (rng() % 2 != 0 ? 1 : -1);
     const int64_t d = ds.back();
     int64_t n = 0;
     // Just below, at, above an integer quotient and at a half: n = q d + {-1, 0, 1, d / 2}.
-    if (!__builtin_mul_overflow(q, d, &n) && n > INT64_MIN + d) {
-      for (int64_t off : {int64_t{-1}, int64_t{0}, int64_t{1}, d / 2}) ns.push_back(n + off);
-    }
+    if (!__builtin_mul_overflow(q, d, &n))
+      for (int64_t off : {int64_t{-1}, int64_t{0}, int64_t{1}, d / 2}) {
+        int64_t v = 0;
+        if (!__builtin_add_overflow(n, off, &v)) ns.push_back(v);
+      }
     ns.push_back(static_cast<int64_t>(rng()));
   }
   uint64_t checked = 0;

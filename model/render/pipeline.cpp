@@ -178,7 +178,6 @@ SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const
 }
 
 }  // namespace avx2
-
 #endif
 
 }  // namespace
