@@ -31,8 +31,8 @@ Prints, per pair, every round's two times and their ratio, then the median of th
 ratios (shadesim / peer: below 1, shadesim is faster) with its range, and the ratio of the two
 sides' fastest rounds (each side's least disturbed frame time: on a machine whose load comes and
 goes, the median of the ratios moves with the rounds a burst hit). The environment is
-passed on (SHD_SCALAR=1 measures the scalar paths). Exit status: 0, or 2 on bad input or a
-command that fails or prints no time.
+passed on (SHD_SCALAR=1 measures the scalar paths, SHD_NO_AVX512=1 the AVX2 ones; the report
+names them). Exit status: 0, or 2 on bad input or a command that fails or prints no time.
 """
 import argparse
 import json
@@ -124,7 +124,8 @@ def label(res):
 
 
 def report(a, results):
-    env = " SHD_SCALAR=1" if os.environ.get("SHD_SCALAR") else ""
+    # Set at all, as the model reads them (fixed_simd's envSet).
+    env = "".join(f" {v}={os.environ[v]}" for v in ("SHD_SCALAR", "SHD_NO_AVX512") if v in os.environ)
     scene = f"builtin:sphere of {a.segments} segments" if a.segments else a.scene
     pinned = "" if a.cpu is None else f", one-thread runs on CPU {a.cpu}"
     print(f"{scene}, shadesim render --bench {a.frames}{env}, {a.rounds} interleaved rounds{pinned}; "

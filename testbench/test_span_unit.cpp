@@ -26,6 +26,22 @@ using shd::testutil::paperSpanModes;
 
 namespace {
 
+// floor(n / d) and the remainder in [0, d), d > 0, in 128-bit arithmetic: the tests' reference
+// for setup's divisions (results within int64_t).
+std::pair<int64_t, int64_t> floorDivRef(__int128 n, __int128 d) {
+  __int128 q = n / d, r = n % d;
+  if (r < 0) {
+    q -= 1;
+    r += d;
+  }
+  return {static_cast<int64_t>(q), static_cast<int64_t>(r)};
+}
+// round-half-even(n / d), d > 0, the same way.
+int64_t roundHalfEvenRef(__int128 n, __int128 d) {
+  const auto [q, r] = floorDivRef(n, d);
+  return 2 * static_cast<__int128>(r) > d || (2 * static_cast<__int128>(r) == d && (q & 1) != 0) ? q + 1 : q;
+}
+
 RasterConfig configFor(const std::string& m, int w = 64, int h = 48) {
   RasterConfig c;
   c.width = w;
@@ -653,19 +669,6 @@ TEST(SpanUnitModel, WalkerWrapsLikeTheCycleModelBeyondSetupsBound) {
 // 2^53 and at the edges of int64_t, quotients just below, at and above integers, exact halves
 // (round half to even, the parity base's plus the quotient's), random ones of every magnitude.
 TEST(ExactInt, DivisionsEqualThe128BitOnes) {
-  using i128 = __int128;
-  auto floorRef = [](i128 n, i128 d) {
-    i128 q = n / d, r = n % d;
-    if (r < 0) {
-      q -= 1;
-      r += d;
-    }
-    return std::pair<i128, i128>{q, r};
-  };
-  auto roundRef = [&](i128 n, i128 d) {
-    auto [q, r] = floorRef(n, d);
-    return 2 * r > d || (2 * r == d && (q & 1) != 0) ? q + 1 : q;
-  };
   std::vector<int64_t> ds = {1, 2, 3, 7, 1000003};
   std::vector<int64_t> ns;
   const int64_t k53 = int64_t{1} << 53;
@@ -700,14 +703,14 @@ TEST(ExactInt, DivisionsEqualThe128BitOnes) {
   for (size_t i = 0; i < ns.size(); ++i) {
     const int64_t n = ns[i];
     for (int64_t d : {ds[i % ds.size()], ds[(i * 7 + 3) % ds.size()], int64_t{1}, k53 - 1}) {
-      const auto [qr, rr] = floorRef(n, d);
-      ASSERT_EQ(exact::ceilDiv64(n, d), static_cast<int64_t>(rr != 0 ? qr + 1 : qr)) << n << " / " << d;
-      ASSERT_EQ(exact::floorDiv(n, d), static_cast<int64_t>(qr)) << n << " / " << d;
-      ASSERT_EQ(static_cast<int64_t>(exact::roundDiv(n, d)), static_cast<int64_t>(roundRef(n, d))) << n << " / " << d;
+      const auto [qr, rr] = floorDivRef(n, d);
+      ASSERT_EQ(exact::ceilDiv64(n, d), rr != 0 ? qr + 1 : qr) << n << " / " << d;
+      ASSERT_EQ(exact::floorDiv(n, d), qr) << n << " / " << d;
+      ASSERT_EQ(static_cast<int64_t>(exact::roundDiv(n, d)), roundHalfEvenRef(n, d)) << n << " / " << d;
       if (n > -(int64_t{1} << 61) && n < (int64_t{1} << 61)) {
         const int64_t base = static_cast<int64_t>(rng() % (uint64_t{1} << 40)) - (int64_t{1} << 39);
         // round-half-even(base + n / d): the parity at a half is base's plus the quotient's
-        ASSERT_EQ(exact::roundDivPlus(base, n, d), static_cast<int64_t>(roundRef(static_cast<i128>(base) * d + n, d)))
+        ASSERT_EQ(exact::roundDivPlus(base, n, d), roundHalfEvenRef(static_cast<__int128>(base) * d + n, d))
             << base << " + " << n << " / " << d;
       }
       ++checked;
@@ -723,15 +726,6 @@ TEST(ExactInt, DivisionsEqualThe128BitOnes) {
 // (numerators beyond 2^52: its exact division).
 TEST(TriangleSetup, PlaneCodesAreTheExactRationalsRoundedHalfToEven) {
   using i128 = __int128;
-  auto roundHalfEven = [](i128 n, i128 d) {  // d > 0
-    i128 q = n / d, r = n % d;
-    if (r < 0) {
-      q -= 1;
-      r += d;
-    }
-    if (2 * r > d || (2 * r == d && (q & 1) != 0)) q += 1;
-    return static_cast<int64_t>(q);
-  };
   for (const std::vector<int>& frac : {std::vector<int>{12, 12, 12, 28}, std::vector<int>{40, 40, 40, 28}}) {
     RasterConfig c;  // 512 x 512
     c.unit = spanParams("serial");
@@ -750,11 +744,11 @@ TEST(TriangleSetup, PlaneCodesAreTheExactRationalsRoundedHalfToEven) {
         const i128 nx = static_cast<i128>(a[1] - a[0]) * (t.Y[2] - t.Y[0]) - static_cast<i128>(a[2] - a[0]) * (t.Y[1] - t.Y[0]);
         const i128 ny = static_cast<i128>(t.X[1] - t.X[0]) * (a[2] - a[0]) - static_cast<i128>(t.X[2] - t.X[0]) * (a[1] - a[0]);
         const i128 one = i128{1} << S;  // multiplied, not shifted: nx, ny may be negative
-        ASSERT_EQ(s.plane.didx[k], roundHalfEven(nx * one, t.det)) << g.kind() << " attribute " << k;
-        ASSERT_EQ(s.plane.didy[k], roundHalfEven(ny * one, t.det)) << g.kind() << " attribute " << k;
+        ASSERT_EQ(s.plane.didx[k], roundHalfEvenRef(nx * one, t.det)) << g.kind() << " attribute " << k;
+        ASSERT_EQ(s.plane.didy[k], roundHalfEvenRef(ny * one, t.det)) << g.kind() << " attribute " << k;
         const i128 cx = (2 * static_cast<i128>(s.plane.xref) + 1) << S, cy = (2 * static_cast<i128>(s.plane.yref) + 1) << S;
         const i128 num = 2 * static_cast<i128>(t.det) * a[0] + nx * (cx - 2 * t.X[0]) + ny * (cy - 2 * t.Y[0]);
-        ASSERT_EQ(s.plane.iref[k], roundHalfEven(num, 2 * static_cast<i128>(t.det))) << g.kind() << " attribute " << k;
+        ASSERT_EQ(s.plane.iref[k], roundHalfEvenRef(num, 2 * static_cast<i128>(t.det))) << g.kind() << " attribute " << k;
         ++planes;
         const i128 lim = i128{1} << 52;
         wide += nx * one >= lim || nx * one <= -lim || num >= lim || num <= -lim ? 1 : 0;
