@@ -103,6 +103,18 @@ struct Part {
   const std::array<double, 3>* colour = nullptr;  // colour attributes: every vertex's (flat), or null: its own
 };
 using Parts = std::vector<Part>;
+// Appends a part, its fields written in place: `out.push_back({...})` built the part on the stack
+// from stores of 4 and 8 bytes and copied it with 16-byte loads, which the processor cannot
+// forward from those stores (a stall of a dozen cycles per part, 2 % of a frame of small
+// triangles: docs/performance.md).
+inline void addPart(Parts& out, const PVertex* a, const PVertex* b, const PVertex* c, MethodUnit* unit, Method method,
+                    const std::array<double, 3>* colour = nullptr) {
+  Part& p = out.emplace_back();
+  p.v = {a, b, c};
+  p.unit = unit;
+  p.method = method;
+  p.colour = colour;
+}
 
 // One shading method's drawing (render/methods/*.cpp, chosen by Method in the table of
 // render/methods.cpp). Per frame one unit per method in use; per object beginObject, then per
@@ -116,7 +128,7 @@ class MethodUnit {
   // The screen triangles to draw of a polygon (a clipped triangle's fan; 3 vertices unless
   // clipped), in order: by default each fan triangle, by this unit.
   virtual void parts(const Fan& fan, Parts& out) {
-    for (size_t k = 1; k + 1 < fan.size(); ++k) out.push_back({{fan[0], fan[k], fan[k + 1]}, this, method_});
+    for (size_t k = 1; k + 1 < fan.size(); ++k) addPart(out, fan[0], fan[k], fan[k + 1], this, method_);
   }
   // The fragments of a screen triangle: walked, z-tested, shaded and written.
   virtual void draw(const SpanTriangle& t) = 0;

@@ -20,7 +20,7 @@ class AdaptiveUnit final : public MethodUnit {
   void parts(const Fan& fan, Parts& out) override {
     for (size_t k = 1; k + 1 < fan.size(); ++k) {
       const std::array<const PVertex*, 3> t{fan[0], fan[k], fan[k + 1]};
-      out.push_back({t, this, gouraudWill(t) ? Method::Gouraud : Method::Phong});
+      addPart(out, t[0], t[1], t[2], this, gouraudWill(t) ? Method::Gouraud : Method::Phong);
     }
   }
   void draw(const SpanTriangle& t) override {

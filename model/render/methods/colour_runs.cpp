@@ -185,7 +185,7 @@ class FlatUnit final : public MethodUnit {
   // ahead): the colour attributes of all its triangles.
   void parts(const Fan& fan, Parts& out) override {
     colour_ = f_.face_colour != nullptr ? *f_.face_colour : f_.faceColour(*fan[0], *fan[1], *fan[2]);
-    for (size_t k = 1; k + 1 < fan.size(); ++k) out.push_back({{fan[0], fan[k], fan[k + 1]}, this, method(), &colour_});
+    for (size_t k = 1; k + 1 < fan.size(); ++k) addPart(out, fan[0], fan[k], fan[k + 1], this, method(), &colour_);
   }
   void draw(const SpanTriangle& t) override { drawColourRuns(f_, t, runs_); }
 

@@ -37,7 +37,7 @@ class ModifiedGouraudUnit final : public MethodUnit {
       split({*fan[0], *fan[k], *fan[k + 1]});
       if (splits_.size() - first > 1) f_.st.split_parts += splits_.size() - first;
       for (size_t i = first; i < splits_.size(); ++i)
-        out.push_back({{&splits_[i][0], &splits_[i][1], &splits_[i][2]}, &gouraud_, Method::Gouraud});
+        addPart(out, &splits_[i][0], &splits_[i][1], &splits_[i][2], &gouraud_, Method::Gouraud);
     }
   }
   void draw(const SpanTriangle&) override {
