@@ -888,6 +888,7 @@ void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::s
   for (size_t i = 0; i < a.triangles.size(); ++i) {
     ASSERT_EQ(a.triangles[i].object, b.triangles[i].object) << what;
     ASSERT_EQ(a.triangles[i].mesh_triangle, b.triangles[i].mesh_triangle) << what;
+    ASSERT_EQ(a.triangles[i].xy, b.triangles[i].xy) << what << ": triangle " << i;
   }
   RenderStats sa = a.stats, sb = b.stats;  // every count: 8-byte fields, no padding
   sa.ms = sb.ms = 0;
@@ -1166,6 +1167,37 @@ TEST(Render, TwoThreadsSplitByRowsEqualOneThread) {
   o.brdf = "";
   o.split = RenderOptions::Split::FrontBack;
   EXPECT_FALSE(splitsByRows(sphere, o, serial.span));
+}
+
+// Frames split by rows place their triangles into the list the frame before left (renderSplit):
+// frame after frame into one result, over scenes of more and fewer triangles and over frames
+// drawn on one thread, each equals a frame drawn afresh on one thread (image, triangle list
+// with positions, counts) and has its drawn rectangle.
+TEST(Render, SplitFramesOverOtherFramesEqualFreshOnes) {
+  ModelEngines one("serial"), two("serial");
+  RenderResult reused;
+  int compared = 0;
+  for (const char* name : {"builtin:sphere", "builtin:plane", "builtin:torus", "builtin:sphere", "builtin:materials"})
+    for (int threads : {2, 1, 2}) {
+      const Scene s = loadScene(name);
+      const std::string what = fmt::format("{} on {} thread(s), frame {}", name, threads, compared);
+      RenderOptions o;
+      o.method = Method::Gouraud;
+      o.brdf = "blinn";
+      o.split = RenderOptions::Split::Rows;
+      o.split_row = s.camera.height / 2;
+      o.threads = 1;
+      const RenderResult fresh = render(s, o, one.span, one.view);
+      o.threads = threads;
+      render(s, o, two.span, two.view, reused);
+      EXPECT_EQ(reused.split_by_rows, threads == 2) << what;
+      expectSameFrames(fresh, reused, what);
+      EXPECT_EQ(std::make_tuple(fresh.fb.drawn_x0, fresh.fb.drawn_y0, fresh.fb.drawn_x1, fresh.fb.drawn_y1),
+                std::make_tuple(reused.fb.drawn_x0, reused.fb.drawn_y0, reused.fb.drawn_x1, reused.fb.drawn_y1))
+          << what;
+      ++compared;
+    }
+  EXPECT_EQ(compared, 5 * 3);
 }
 
 // SplitChoice (Split::Auto): the first frame the preferred way; each cycle's last kProbe frames

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <condition_variable>
 #include <exception>
@@ -59,14 +60,14 @@ struct PartKey {
 // kForeignTag plus its index in `foreign`, and made the frame's after both sides end.
 struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
   static constexpr uint32_t kForeignTag = uint32_t{1} << 30;
-  struct Record {
-    PartKey key;
-    ScreenTriangleInfo info;
-  };
   RowShare rows{RowShare::Side::Rows};  // its rows, y0 .. y1 - 1
   int32_t H = 0;                        // the frame's rows
   bool top = true;
-  std::vector<Record> owned;        // in key order
+  // The triangles it owns, in key order: their keys, apart from the rest (the other side reads
+  // them to rank both sides' triangles, rankSides), and their descriptions.
+  std::vector<PartKey> keys;
+  std::vector<ScreenTriangleInfo> owned;
+  Framebuffer drawn;                // no buffers: the rectangle its owned triangles may draw
   std::vector<PartKey> foreign;     // drawn here, owned by the other side, in key order
   std::vector<uint32_t> global;     // the frame's index of owned[i], then of foreign[i]
   RenderStats stats;                // the bottom side's counts (the top counts into the frame's)
@@ -692,16 +693,17 @@ bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool 
   const bool meets = side.rows.anyIn(lo, hi);
   if (!owner && !meets) return false;
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
-  const uint32_t tag = owner ? static_cast<uint32_t>(side.owned.size())
+  const uint32_t tag = owner ? static_cast<uint32_t>(side.keys.size())
                              : SplitSide::kForeignTag + static_cast<uint32_t>(side.foreign.size());
   bool spans = false;
   if (!setup_config_.run(setupInput(part, colour_attrs), part.method, colour_attrs, tag, rows_, setup_, spans))
     return false;  // no pixel centre inside
   const PartKey key{static_cast<uint32_t>(f_.obj.index), ti, k};
   if (owner) {
-    SplitSide::Record& r = side.owned.emplace_back();
-    r.key = key;
-    describeTriangle(f_.obj.index, ti, partXY(part), spans, r.info, f_.st);  // merged into the frame's later
+    side.keys.push_back(key);
+    ScreenTriangleInfo& info = side.owned.emplace_back();
+    describeTriangle(f_.obj.index, ti, partXY(part), spans, info, f_.st);  // placed among the frame's later
+    markDrawn(side.drawn, info);
     if (spans) f_.countRows(rows_);
   } else {
     side.foreign.push_back(key);
@@ -934,34 +936,49 @@ int32_t nextSplit(const std::array<SplitSide, 2>& sides, int32_t y0, int32_t y1)
   return std::clamp(static_cast<int32_t>(std::lround(0.5 * (split + even))), y0 + 1, y1);
 }
 
-// The sides' screen triangles as the frame's: RenderResult::triangles in PartKey order (one
-// thread's), the rectangle they drew, and each side's tags in the triangle buffer made the
-// frame's (SplitSide::global).
-void mergeSides(std::array<SplitSide, 2>& sides, RenderResult& res) {
-  for (SplitSide& s : sides) s.global.resize(s.owned.size() + s.foreign.size());
+// The frame's index of each side's triangles (SplitSide::global): those it owns ranked among
+// both sides' by their keys (PartKey order, one thread's), those it drew for the other side
+// looked up there. Returns how many triangles the frame has.
+size_t rankSides(std::array<SplitSide, 2>& sides) {
+  for (SplitSide& s : sides) s.global.resize(s.keys.size() + s.foreign.size());
   size_t at[2] = {0, 0};
-  while (at[0] < sides[0].owned.size() || at[1] < sides[1].owned.size()) {
-    const size_t i = at[1] == sides[1].owned.size() ||
-                             (at[0] < sides[0].owned.size() && sides[0].owned[at[0]].key < sides[1].owned[at[1]].key)
-                         ? 0 : 1;
-    SplitSide& s = sides[i];
-    s.global[at[i]] = static_cast<uint32_t>(res.triangles.size());
-    res.triangles.push_back(s.owned[at[i]].info);
-    markDrawn(res.fb, s.owned[at[i]].info);
-    ++at[i];
+  const size_t n[2] = {sides[0].keys.size(), sides[1].keys.size()};
+  for (uint32_t g = 0; at[0] < n[0] || at[1] < n[1]; ++g) {
+    const size_t i = at[1] == n[1] || (at[0] < n[0] && sides[0].keys[at[0]] < sides[1].keys[at[1]]) ? 0 : 1;
+    sides[i].global[at[i]++] = g;
   }
   for (size_t i = 0; i < 2; ++i) {
     SplitSide& s = sides[i];
     const SplitSide& owner = sides[1 - i];
     size_t k = 0;
     for (size_t j = 0; j < s.foreign.size(); ++j) {
-      while (k < owner.owned.size() && owner.owned[k].key < s.foreign[j]) ++k;
-      if (k == owner.owned.size() || s.foreign[j] < owner.owned[k].key)
+      while (k < owner.keys.size() && owner.keys[k] < s.foreign[j]) ++k;
+      if (k == owner.keys.size() || s.foreign[j] < owner.keys[k])
         throw std::logic_error("render: a triangle drawn by one side of a split frame was not recorded by the other");
-      s.global[s.owned.size() + j] = owner.global[k];
+      s.global[s.keys.size() + j] = owner.global[k];
     }
   }
-  Framebuffer& fb = res.fb;
+  return n[0] + n[1];
+}
+
+// A side's triangles placed at their ranks in the frame's list (sized by then), by the side's
+// own thread: the descriptions stay in the cache of the core that wrote them. (The calling
+// thread reading the back thread's too passed their lines to its core and back every frame:
+// docs/performance.md, "Two threads".)
+void placeOwned(const SplitSide& s, std::vector<ScreenTriangleInfo>& triangles) {
+  for (size_t j = 0; j < s.owned.size(); ++j) triangles[s.global[j]] = s.owned[j];
+}
+
+// The sides' rectangles and tags made the frame's: the rectangle their triangles drew (the
+// same min and max as one thread's markDrawn in any order), and each side's tags in the
+// triangle buffer (SplitSide::global).
+void joinSides(const std::array<SplitSide, 2>& sides, Framebuffer& fb) {
+  for (const SplitSide& s : sides) {
+    fb.drawn_x0 = std::min(fb.drawn_x0, s.drawn.drawn_x0);
+    fb.drawn_y0 = std::min(fb.drawn_y0, s.drawn.drawn_y0);
+    fb.drawn_x1 = std::max(fb.drawn_x1, s.drawn.drawn_x1);
+    fb.drawn_y1 = std::max(fb.drawn_y1, s.drawn.drawn_y1);
+  }
   if (fb.tri.empty()) return;
   for (const SplitSide& s : sides)
     for (int32_t y = std::max(s.rows.y0, fb.drawn_y0); y <= std::min(s.rows.y1 - 1, fb.drawn_y1); ++y)
@@ -969,7 +986,7 @@ void mergeSides(std::array<SplitSide, 2>& sides, RenderResult& res) {
         int32_t& tag = fb.tri[static_cast<size_t>(y) * static_cast<size_t>(fb.width) + static_cast<size_t>(x)];
         if (tag < 0) continue;
         const uint32_t t = static_cast<uint32_t>(tag);
-        tag = static_cast<int32_t>(s.global[t >= SplitSide::kForeignTag ? s.owned.size() + (t - SplitSide::kForeignTag) : t]);
+        tag = static_cast<int32_t>(s.global[t >= SplitSide::kForeignTag ? s.keys.size() + (t - SplitSide::kForeignTag) : t]);
       }
 }
 
@@ -990,8 +1007,13 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     s.H = H;
     s.rows.y0 = s.top ? 0 : split;
     s.rows.y1 = s.top ? split : H;
+    s.keys.clear();
     s.owned.clear();
     s.foreign.clear();
+    s.drawn.width = res.fb.width;
+    s.drawn.height = res.fb.height;
+    s.drawn.drawn_x0 = s.drawn.drawn_y0 = INT_MAX;
+    s.drawn.drawn_x1 = s.drawn.drawn_y1 = INT_MIN;
     s.stats = s.others = RenderStats{};
     s.error = nullptr;
   }
@@ -1002,6 +1024,14 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
   };
   const std::unique_ptr<BottomFrame> bottom(new BottomFrame{Frame(scene, opt, span, res.fb, sides[1].stats)});
   BackThread& worker = BackThread::instance();
+  // Once both sides have drawn, each places its own triangles in the frame's list
+  // (placeOwned): the back thread says it has drawn, and waits for this one's word (kPlace, or
+  // kSkip after an error).
+  enum : int { kDrawing, kDrawn, kPlace, kSkip };
+  struct alignas(64) Handoff {
+    std::atomic<int> state{kDrawing};
+  } handoff;
+  std::exception_ptr error;
   {
     const std::lock_guard<std::mutex> one_frame(worker.frame);
     const std::function<void()> job = [&] {
@@ -1010,6 +1040,10 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
       } catch (...) {
         sides[1].error = std::current_exception();
       }
+      handoff.state.store(kDrawn, std::memory_order_release);
+      int word;
+      for (unsigned spin = 0; (word = handoff.state.load(std::memory_order_acquire)) == kDrawn; ++spin) spinPause(spin);
+      if (word == kPlace) placeOwned(sides[1], res.triangles);
     };
     worker.start(job);
     try {
@@ -1017,19 +1051,29 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     } catch (...) {
       sides[0].error = std::current_exception();
     }
+    for (unsigned spin = 0; handoff.state.load(std::memory_order_acquire) != kDrawn; ++spin) spinPause(spin);
+    error = sides[0].error ? sides[0].error : sides[1].error;
+    if (!error) try {
+        res.triangles.resize(rankSides(sides));  // kept from the frame before: mostly nothing to fill
+      } catch (...) {
+        error = std::current_exception();
+      }
+    handoff.state.store(error ? kSkip : kPlace, std::memory_order_release);
+    if (!error) placeOwned(sides[0], res.triangles);
     worker.wait();
   }
-  if (sides[0].error || sides[1].error) {
-    // The sides marked nothing drawn (mergeSides does), so the framebuffer's drawn rectangle is
+  if (error) {
+    // The sides marked nothing drawn (joinSides does), so the framebuffer's drawn rectangle is
     // still prepareClear's empty one, as one thread starts with.
     res.stats = RenderStats{};
+    res.triangles.clear();
     clearRect(res.fb, ClearRect{0, 0, res.fb.width - 1, res.fb.height - 1, traits(opt.method).exact});
     Frame one(scene, opt, span, res.fb, res.stats);
     drawScene(one, scene, engines, res, scratch.main);
-    std::rethrow_exception(sides[0].error ? sides[0].error : sides[1].error);  // one thread drew it
+    std::rethrow_exception(error);  // one thread drew it
   }
   res.stats += sides[1].stats;
-  mergeSides(sides, res);
+  joinSides(sides, res.fb);
   if (res.fb.drawn_y0 <= res.fb.drawn_y1) scratch.split = nextSplit(sides, res.fb.drawn_y0, res.fb.drawn_y1);
 }
 
@@ -1142,7 +1186,6 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     opt.phong_widths->validate();
   }
   res.stats = RenderStats{};
-  res.triangles.clear();
   if (opt.threads != 1 && opt.threads != 2)
     throw std::invalid_argument(fmt::format("render: threads {}: 1 or 2", opt.threads));
   if (opt.threads == 2 && traits(opt.method).two_threads == TwoThreads::No)
@@ -1158,6 +1201,8 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   const bool measured = may_split && opt.split == RenderOptions::Split::Auto;
   SplitChoice& choice = res.scratch.get().choice;
   res.split_by_rows = measured ? choice.next(traits(opt.method).two_threads == TwoThreads::AfterWalk) : may_split;
+  // A frame split by rows places its triangles into the list the frame before left (renderSplit).
+  if (!res.split_by_rows) res.triangles.clear();
   if (res.split_by_rows) {
     renderSplit(scene, opt, span, engines, clear, res);
   } else {
