@@ -568,7 +568,8 @@ TEST(RenderPipeline, ProjectionBeyondTheClippersRangeIsAnErrorNamingTheTriangle)
 // vertex the same bits, on random meshes (zero, tiny and huge normals among them; vertices on
 // both sides of the near plane and at Z = 0), under a mirroring transform and others, over
 // ranges that start and end off a multiple of four; and without normals (flat), the same with
-// the normal left 0 both ways.
+// the normal left 0 both ways; and triangleNormals after that, vector and scalar, the normals
+// with normals of the listed triangles' vertices alone.
 TEST(RenderPipeline, VectorTransformEqualsTheScalarOne) {
   if (!fixed_simd::availableAvx2()) GTEST_SKIP() << "no AVX2 here (or SHD_SCALAR set): only the scalar path runs";
   std::mt19937_64 rng(20261129);
@@ -621,6 +622,35 @@ TEST(RenderPipeline, VectorTransformEqualsTheScalarOne) {
           projected += scalar[i].w != 0;
           zero_normals += scalar[i].n.x == 0 && scalar[i].n.y == 0 && scalar[i].n.z == 0;
         }
+        if (b != 0 || e != n) continue;
+        // triangleNormals, after a transform without normals: the normals of the vertices of
+        // the listed triangles (every other one of some random triangles), as with normals,
+        // vector or not; the other vertices' left 0.
+        std::uniform_int_distribution<uint32_t> vertex(0, static_cast<uint32_t>(n - 1));
+        obj.mesh.triangles.assign(1501, {});
+        std::vector<uint32_t> kept;
+        std::vector<uint8_t> used(n, 0);
+        for (uint32_t t = 0; t < obj.mesh.triangles.size(); ++t) {
+          obj.mesh.triangles[t] = {vertex(rng), vertex(rng), vertex(rng)};
+          if (t % 2 == 1) continue;
+          kept.push_back(t);
+          for (const uint32_t i : obj.mesh.triangles[t]) used[i] = 1;
+        }
+        for (const bool vector : {true, false}) {
+          std::vector<PVertex> v = vector ? vec_nn : scalar_nn;
+          std::vector<uint8_t> mark(3, 7);  // scratch with garbage in it
+          std::vector<uint32_t> idx(5, 9);
+          triangleNormals(obj, basis, kept, v.data(), mark, idx, vector);
+          for (size_t i = 0; i < n; ++i) {
+            PVertex want = scalar_nn[i];
+            if (used[i]) want.n = scalar[i].n;
+            ASSERT_EQ(std::memcmp(&v[i], &want, sizeof(PVertex)), 0)
+                << "vertex " << i << (used[i] ? " (used)" : " (not used)") << (vector ? ", vector" : ", scalar")
+                << ": n " << v[i].n.x << " " << want.n.x;
+          }
+        }
+        EXPECT_GT(std::count(used.begin(), used.end(), 1), 1000) << "the listed triangles' vertices";
+        EXPECT_GT(std::count(used.begin(), used.end(), 0), 1000) << "vertices of no listed triangle";
       }
     }
   EXPECT_GT(behind, 1000u);

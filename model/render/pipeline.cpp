@@ -89,10 +89,15 @@ namespace {
 
 // Vertex i of obj in camera space and, in front of the near plane, projected (v as PVertex{}
 // leaves it: the colour is the method's).
+// Vertex i's normal in camera space, unit length (a zero normal stays 0).
+inline Vec3 cameraNormal(const SceneObject& obj, const CameraBasis& basis, const NormalTransform& to_world, size_t i) {
+  return normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
+}
+
 inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                             const NormalTransform& to_world, size_t i, bool normals, PVertex& v) {
   v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
-  v.n = normals ? normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i]))) : Vec3{0, 0, 0};
+  v.n = normals ? cameraNormal(obj, basis, to_world, i) : Vec3{0, 0, 0};
   if (v.cam.z >= cam.z_near) proj.project(v);
 }
 
@@ -127,6 +132,10 @@ SHD_AVX2 inline V3 load(const Vec3* p) {
   return {_mm256_set_pd(p[3].x, p[2].x, p[1].x, p[0].x), _mm256_set_pd(p[3].y, p[2].y, p[1].y, p[0].y),
           _mm256_set_pd(p[3].z, p[2].z, p[1].z, p[0].z)};
 }
+SHD_AVX2 inline V3 loadAt(const Vec3* p, const uint32_t* idx) {  // p[idx[0]] .. p[idx[3]]
+  const Vec3 &a = p[idx[0]], &b = p[idx[1]], &c = p[idx[2]], &d = p[idx[3]];
+  return {_mm256_set_pd(d.x, c.x, b.x, a.x), _mm256_set_pd(d.y, c.y, b.y, a.y), _mm256_set_pd(d.z, c.z, b.z, a.z)};
+}
 SHD_AVX2 inline void store(const V3& v, double (&x)[4], double (&y)[4], double (&z)[4]) {
   _mm256_storeu_pd(x, v.x);
   _mm256_storeu_pd(y, v.y);
@@ -137,6 +146,26 @@ SHD_AVX2 inline __m256d pointLessEye(const double* row, const V3& p, double eye)
   return _mm256_sub_pd(_mm256_add_pd(dot(Vec3{row[0], row[1], row[2]}, p), _mm256_set1_pd(row[3])), _mm256_set1_pd(eye));
 }
 
+// cameraNormal of the 4 mesh normals in the lanes: NormalTransform, then toCameraDirection and
+// normalize.
+SHD_AVX2 inline V3 cameraNormals(const CameraBasis& basis, const NormalTransform& to_world, const V3& mesh_normals) {
+  V3 r = rows(to_world.c, mesh_normals);
+  if (to_world.mirror) {
+    const __m256d sign = _mm256_set1_pd(-0.0);
+    r = {_mm256_xor_pd(r.x, sign), _mm256_xor_pd(r.y, sign), _mm256_xor_pd(r.z, sign)};
+  }
+  const V3 w = normalize(r);
+  return normalize(V3{dot(basis.right, w), dot(basis.up, w), dot(basis.forward, w)});
+}
+
+// The normals of the vertices idx[0] .. idx[3].
+SHD_AVX2 void normals4(const SceneObject& obj, const CameraBasis& basis, const NormalTransform& to_world,
+                       const uint32_t* idx, PVertex* verts) {
+  double nx[4], ny[4], nz[4];
+  store(cameraNormals(basis, to_world, loadAt(obj.mesh.normals.data(), idx)), nx, ny, nz);
+  for (size_t k = 0; k < 4; ++k) verts[idx[k]].n = {nx[k], ny[k], nz[k]};
+}
+
 template <bool kNormals>
 SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                             const NormalTransform& to_world, size_t i, PVertex* out) {
@@ -145,17 +174,9 @@ SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const
   // Mat4::point: direction(p) + translation, then toCameraSpace: the basis's dots with it - eye.
   const V3 rel{pointLessEye(m[0], p, cam.eye.x), pointLessEye(m[1], p, cam.eye.y), pointLessEye(m[2], p, cam.eye.z)};
   const V3 c{dot(basis.right, rel), dot(basis.up, rel), dot(basis.forward, rel)};
-  // NormalTransform, then toCameraDirection and normalize (without kNormals, 0).
+  // Without kNormals, 0.
   V3 n{_mm256_setzero_pd(), _mm256_setzero_pd(), _mm256_setzero_pd()};
-  if constexpr (kNormals) {
-    V3 r = rows(to_world.c, load(&obj.mesh.normals[i]));
-    if (to_world.mirror) {
-      const __m256d sign = _mm256_set1_pd(-0.0);
-      r = {_mm256_xor_pd(r.x, sign), _mm256_xor_pd(r.y, sign), _mm256_xor_pd(r.z, sign)};
-    }
-    const V3 w = normalize(r);
-    n = normalize(V3{dot(basis.right, w), dot(basis.up, w), dot(basis.forward, w)});
-  }
+  if constexpr (kNormals) n = cameraNormals(basis, to_world, load(&obj.mesh.normals[i]));
   // Projection::project where Z >= z_near; elsewhere x, y and w stay 0.
   const __m256d f = _mm256_set1_pd(proj.f);
   const __m256d in = _mm256_cmp_pd(c.z, _mm256_set1_pd(cam.z_near), _CMP_GE_OQ);
@@ -215,6 +236,29 @@ void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, cons
     v.colour = {};
     transformVertex(obj, basis, cam, proj, to_world, i, normals, v);
   }
+}
+
+void triangleNormals(const SceneObject& obj, const CameraBasis& basis, const std::vector<uint32_t>& kept,
+                     PVertex* verts, std::vector<uint8_t>& mark, std::vector<uint32_t>& idx, bool vector) {
+  const size_t n = obj.mesh.positions.size();
+  mark.assign(n, 0);
+  for (const uint32_t t : kept)
+    for (const uint32_t i : obj.mesh.triangles[t]) mark[i] = 1;
+  idx.resize(n);
+  size_t m = 0;
+  for (size_t i = 0; i < n; ++i) {
+    idx[m] = static_cast<uint32_t>(i);
+    m += mark[i];  // without a branch
+  }
+  const NormalTransform to_world(obj.transform);
+  size_t j = 0;
+#ifdef SHD_X86_KERNELS
+  if (vector && fixed_simd::availableAvx2())
+    for (; j + 4 <= m; j += 4) avx2::normals4(obj, basis, to_world, idx.data() + j, verts);
+#else
+  (void)vector;
+#endif
+  for (; j < m; ++j) verts[idx[j]].n = cameraNormal(obj, basis, to_world, idx[j]);
 }
 
 bool clipToFan(const TriangleView& t, const Projection& proj, int W, int H, Poly& poly, Fan& fan, RenderStats& st) {

@@ -96,6 +96,14 @@ void clearRect(Framebuffer& fb, const ClearRect& r);
 void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                           PVertex* verts, size_t begin, size_t end, bool vector = true, bool normals = true);
 
+// The normals of the vertices of the mesh triangles kept lists (its indices into
+// obj.mesh.triangles), each as transformVertexRange computes it with normals (the same bits,
+// vector or not), into verts; the other vertices' are left as they are. mark and idx: scratch
+// (one entry per vertex). A frame transforms its vertices without normals and then computes
+// those of the triangles it draws alone (render.cpp).
+void triangleNormals(const SceneObject& obj, const CameraBasis& basis, const std::vector<uint32_t>& kept,
+                     PVertex* verts, std::vector<uint8_t>& mark, std::vector<uint32_t>& idx, bool vector = true);
+
 // Where a mesh triangle goes before it is clipped.
 struct TriangleView {
   const PVertex *v0, *v1, *v2;

@@ -40,7 +40,10 @@ struct alignas(64) DrawScratch {  // in lines of its own: each side of a split f
   std::vector<PVertex> verts;
   std::vector<uint8_t> lit;
   std::vector<uint32_t> kept;
+  std::vector<uint8_t> owner;  // on a side of a frame split by rows: whether it owns kept[i]
   std::vector<std::array<double, 3>> faces;
+  std::vector<uint8_t> mark;   // triangleNormals's scratch
+  std::vector<uint32_t> normal_idx;
 };
 
 // The frame's key of a screen triangle: its object, its mesh triangle and which part of it.
@@ -150,20 +153,16 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
 }
 
 // The face colours (Frame::faceColour) of an object's triangles, its vertices transformed: of
-// those wholly in front of the near plane and not culled early (kept: keptTriangles's), the
-// polygons the drawer will draw as the triangles themselves unless the guard band clips them
-// (the others' are not set). A side of a frame split by rows lights those it takes.
+// those the drawer will draw (kept: keptTriangles's, on a side of a frame split by rows those
+// it takes) wholly in front of the near plane, the polygons it will draw as the triangles
+// themselves unless the guard band clips them (the others' are not set).
 void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris,
-                const std::vector<uint32_t>& kept, std::vector<std::array<double, 3>>& faces, const SplitSide* side) {
+                const std::vector<uint32_t>& kept, std::vector<std::array<double, 3>>& faces) {
   faces.resize(tris.size());
-  auto light = [&](auto takes) {
-    for (const uint32_t i : kept) {
-      const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
-      if (tv.all_in && takes(tv)) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
-    }
-  };
-  if (side == nullptr) light([](const TriangleView&) { return true; });
-  else light([side](const TriangleView& tv) { return side->takes(tv); });
+  for (const uint32_t i : kept) {
+    const TriangleView tv = viewTriangle(verts, tris[i], f.proj.z_near);
+    if (tv.all_in) faces[i] = f.faceColour(*tv.v0, *tv.v1, *tv.v2);
+  }
 }
 
 // An object's vertices transformed by both threads of a two-thread frame: each claims chunks
@@ -397,8 +396,9 @@ class SceneDrawer {
  private:
   void lightVertices(const std::array<uint32_t, 3>& tri);
   void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
+  void keepTaken(const std::vector<std::array<uint32_t, 3>>& tris);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
-  void drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
+  void drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner);
   bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
   bool drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner);
   bool queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off);
@@ -418,6 +418,8 @@ class SceneDrawer {
   std::vector<PVertex>& verts_;       // the object's (the result's scratch)
   std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
   std::vector<uint32_t>& kept_;       // the object's triangles not culled early (the result's scratch)
+  std::vector<uint8_t>& owner_;       // on a side of a frame split by rows: whether it owns kept_[i]
+  DrawScratch& scratch_;
   std::vector<std::array<double, 3>>& faces_;  // the face colours lit ahead (the result's scratch)
   bool faces_lit_ = false;            // this object's faces_ (MethodTraits::face_colours)
   Poly poly_;                         // a clipped triangle
@@ -479,6 +481,8 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       verts_(scratch.verts),
       lit_(scratch.lit),
       kept_(scratch.kept),
+      owner_(scratch.owner),
+      scratch_(scratch),
       faces_(scratch.faces),
       queue_(queue),
       cleared_(cleared),
@@ -520,7 +524,7 @@ void SceneDrawer::drawObject(size_t oi) {
   // it, the pass shared between both threads, docs/performance.md.)
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
   if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, !face_colours_);
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, false);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -546,13 +550,19 @@ void SceneDrawer::drawObject(size_t oi) {
   RenderStats& culled_st = side_ != nullptr && !side_->top ? side_->others : f_.st;
   culled_st.triangles += culled;
   culled_st.culled_back += culled;
-  if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, kept_, faces_, side_);
+  if (side_ != nullptr) keepTaken(obj.mesh.triangles);
+  // The normals of the vertices drawn (transformed without them above), where the method reads
+  // them; the two-thread frame's shared transform gave every vertex its normal.
+  if (queue_ == nullptr && !face_colours_)
+    triangleNormals(obj, basis_, kept_, verts_.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
+  if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, kept_, faces_);
   lit_.assign(verts_.size(), 0);
   uint32_t ti = 0;
   try {
-    for (const uint32_t k : kept_) {
-      ti = k;
-      drawMeshTriangle(obj.mesh.triangles[k], k);
+    for (size_t j = 0; j < kept_.size(); ++j) {
+      ti = kept_[j];
+      if (side_ != nullptr) drawSplitTriangle(obj.mesh.triangles[ti], ti, owner_[j] != 0);
+      else drawMeshTriangle(obj.mesh.triangles[ti], ti);
     }
   } catch (const std::range_error& e) {
     throw std::range_error(fmt::format("{}: object '{}' triangle {}: {}", scene_.name, obj.name, ti, e.what()));
@@ -575,12 +585,27 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
     }
 }
 
-// A mesh triangle not culled early on a side of a frame split by rows: its owner's to count
-// (SplitSide::takes).
-void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
+// On a side of a frame split by rows: of the triangles not culled early (kept_), those the side
+// takes (SplitSide::takes), in order, and whether it owns each (owner_).
+void SceneDrawer::keepTaken(const std::vector<std::array<uint32_t, 3>>& tris) {
+  owner_.resize(kept_.size());
+  size_t n = 0;
+  for (size_t j = 0; j < kept_.size(); ++j) {
+    const uint32_t k = kept_[j];
+    bool owner = false;
+    const bool takes = side_->takes(viewTriangle(verts_, tris[k], f_.proj.z_near), owner);
+    kept_[n] = k;  // n <= j: an entry read already
+    owner_[n] = owner;
+    n += takes;
+  }
+  kept_.resize(n);
+  owner_.resize(n);
+}
+
+// A mesh triangle not culled early that a side of a frame split by rows takes (keepTaken): its
+// owner's to count.
+void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner) {
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
-  bool owner = side_->top;
-  if (!side_->takes(tv, owner)) return;  // the other side's alone
   RenderStats& st = owner ? f_.st : side_->others;
   ++st.triangles;
   if (vertex_colours_) lightVertices(tri);
@@ -594,7 +619,6 @@ void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t
 }
 
 void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
-  if (side_ != nullptr) return drawSplitTriangle(tri, ti);
   RenderStats& st = f_.st;
   ++st.triangles;
   const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
