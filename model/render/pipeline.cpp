@@ -87,13 +87,13 @@ void clearRect(Framebuffer& fb, const ClearRect& r) {
 
 namespace {
 
-// Vertex i of obj in camera space and, in front of the near plane, projected (v as PVertex{}
-// leaves it: the colour is the method's).
 // Vertex i's normal in camera space, unit length (a zero normal stays 0).
 inline Vec3 cameraNormal(const SceneObject& obj, const CameraBasis& basis, const NormalTransform& to_world, size_t i) {
   return normalize(toCameraDirection(basis, to_world(obj.mesh.normals[i])));
 }
 
+// Vertex i of obj in camera space and, in front of the near plane, projected (v as PVertex{}
+// leaves it: the colour is the method's).
 inline void transformVertex(const SceneObject& obj, const CameraBasis& basis, const Camera& cam, const Projection& proj,
                             const NormalTransform& to_world, size_t i, bool normals, PVertex& v) {
   v.cam = toCameraSpace(basis, cam, obj.transform.point(obj.mesh.positions[i]));
