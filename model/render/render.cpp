@@ -1048,43 +1048,36 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
   };
   const std::unique_ptr<BottomFrame> bottom(new BottomFrame{Frame(scene, opt, span, res.fb, sides[1].stats)});
   BackThread& worker = BackThread::instance();
-  // Once both sides have drawn, each places its own triangles in the frame's list
-  // (placeOwned): the back thread says it has drawn, and waits for this one's word (kPlace, or
-  // kSkip after an error).
-  enum : int { kDrawing, kDrawn, kPlace, kSkip };
-  struct alignas(64) Handoff {
-    std::atomic<int> state{kDrawing};
-  } handoff;
   std::exception_ptr error;
   {
     const std::lock_guard<std::mutex> one_frame(worker.frame);
-    const std::function<void()> job = [&] {
+    const std::function<void()> draw = [&] {
       try {
         drawSide(scene, engines, bottom->f, res, scratch.second, sides[1], clear);
       } catch (...) {
         sides[1].error = std::current_exception();
       }
-      handoff.state.store(kDrawn, std::memory_order_release);
-      int word;
-      for (unsigned spin = 0; (word = handoff.state.load(std::memory_order_acquire)) == kDrawn; ++spin) spinPause(spin);
-      if (word == kPlace) placeOwned(sides[1], res.triangles);
     };
-    worker.start(job);
+    worker.start(draw);
     try {
       drawSide(scene, engines, top, res, scratch.main, sides[0], clear);
     } catch (...) {
       sides[0].error = std::current_exception();
     }
-    for (unsigned spin = 0; handoff.state.load(std::memory_order_acquire) != kDrawn; ++spin) spinPause(spin);
+    worker.wait();
+    // Once both sides have drawn, each places its own triangles in the frame's list.
     error = sides[0].error ? sides[0].error : sides[1].error;
     if (!error) try {
         res.triangles.resize(rankSides(sides));  // kept from the frame before: mostly nothing to fill
       } catch (...) {
         error = std::current_exception();
       }
-    handoff.state.store(error ? kSkip : kPlace, std::memory_order_release);
-    if (!error) placeOwned(sides[0], res.triangles);
-    worker.wait();
+    if (!error) {
+      const std::function<void()> place = [&] { placeOwned(sides[1], res.triangles); };
+      worker.start(place);
+      placeOwned(sides[0], res.triangles);
+      worker.wait();
+    }
   }
   if (error) {
     // The sides marked nothing drawn (joinSides does), so the framebuffer's drawn rectangle is
