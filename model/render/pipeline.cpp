@@ -48,8 +48,7 @@ ClearRect prepareClear(Framebuffer& fb, int W, int H, bool exact, bool tags) {
   const bool same = fb.width == W && fb.height == H && fb.rgb.size() == 3 * n && fb.tri.size() == (tags ? n : 0) &&
                     fb.depth.size() == n && fb.lsb.size() == n_lsb && fb.spec_lsb.size() == n_lsb;
   const ClearRect r{fb.drawn_x0, fb.drawn_y0, fb.drawn_x1, fb.drawn_y1, exact};
-  fb.drawn_x0 = fb.drawn_y0 = INT_MAX;  // nothing drawn
-  fb.drawn_x1 = fb.drawn_y1 = INT_MIN;
+  fb.markNothingDrawn();
   // The same frame again (a benchmark, an animation): the buffers are clear outside the
   // rectangle drawn since the last clear.
   if (same) return r;
@@ -128,14 +127,11 @@ SHD_AVX2 inline V3 normalize(const V3& a) {  // vec.h's normalize: (1 / len) a, 
   return {_mm256_blendv_pd(_mm256_mul_pd(inv, a.x), a.x, zero), _mm256_blendv_pd(_mm256_mul_pd(inv, a.y), a.y, zero),
           _mm256_blendv_pd(_mm256_mul_pd(inv, a.z), a.z, zero)};
 }
-SHD_AVX2 inline V3 load(const Vec3* p) {
-  return {_mm256_set_pd(p[3].x, p[2].x, p[1].x, p[0].x), _mm256_set_pd(p[3].y, p[2].y, p[1].y, p[0].y),
-          _mm256_set_pd(p[3].z, p[2].z, p[1].z, p[0].z)};
-}
-SHD_AVX2 inline V3 loadAt(const Vec3* p, const uint32_t* idx) {  // p[idx[0]] .. p[idx[3]]
-  const Vec3 &a = p[idx[0]], &b = p[idx[1]], &c = p[idx[2]], &d = p[idx[3]];
+SHD_AVX2 inline V3 load(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {  // a in lane 0
   return {_mm256_set_pd(d.x, c.x, b.x, a.x), _mm256_set_pd(d.y, c.y, b.y, a.y), _mm256_set_pd(d.z, c.z, b.z, a.z)};
 }
+SHD_AVX2 inline V3 load(const Vec3* p) { return load(p[0], p[1], p[2], p[3]); }
+SHD_AVX2 inline V3 loadAt(const Vec3* p, const uint32_t* idx) { return load(p[idx[0]], p[idx[1]], p[idx[2]], p[idx[3]]); }
 SHD_AVX2 inline void store(const V3& v, double (&x)[4], double (&y)[4], double (&z)[4]) {
   _mm256_storeu_pd(x, v.x);
   _mm256_storeu_pd(y, v.y);

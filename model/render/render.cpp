@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <climits>
 #include <cmath>
 #include <condition_variable>
 #include <exception>
@@ -417,9 +416,7 @@ class SceneDrawer {
   TriangleSetup setup_config_;
   std::vector<PVertex>& verts_;       // the object's (the result's scratch)
   std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
-  std::vector<uint32_t>& kept_;       // the object's triangles not culled early (the result's scratch)
-  std::vector<uint8_t>& owner_;       // on a side of a frame split by rows: whether it owns kept_[i]
-  DrawScratch& scratch_;
+  DrawScratch& scratch_;              // its kept triangles (and a side's owner flags), the normals' scratch
   std::vector<std::array<double, 3>>& faces_;  // the face colours lit ahead (the result's scratch)
   bool faces_lit_ = false;            // this object's faces_ (MethodTraits::face_colours)
   Poly poly_;                         // a clipped triangle
@@ -480,8 +477,6 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
       verts_(scratch.verts),
       lit_(scratch.lit),
-      kept_(scratch.kept),
-      owner_(scratch.owner),
       scratch_(scratch),
       faces_(scratch.faces),
       queue_(queue),
@@ -546,7 +541,8 @@ void SceneDrawer::drawObject(size_t oi) {
   }
   // The back faces culled early, counted at once (on a side of a frame split by rows, the top
   // side's); the others drawn in order.
-  const size_t culled = keptTriangles(verts_, obj.mesh.triangles, f_.proj.z_near, kept_);
+  std::vector<uint32_t>& kept = scratch_.kept;
+  const size_t culled = keptTriangles(verts_, obj.mesh.triangles, f_.proj.z_near, kept);
   RenderStats& culled_st = side_ != nullptr && !side_->top ? side_->others : f_.st;
   culled_st.triangles += culled;
   culled_st.culled_back += culled;
@@ -554,14 +550,14 @@ void SceneDrawer::drawObject(size_t oi) {
   // The normals of the vertices drawn (transformed without them above), where the method reads
   // them; the two-thread frame's shared transform gave every vertex its normal.
   if (queue_ == nullptr && !face_colours_)
-    triangleNormals(obj, basis_, kept_, verts_.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
-  if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, kept_, faces_);
+    triangleNormals(obj, basis_, kept, verts_.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
+  if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, kept, faces_);
   lit_.assign(verts_.size(), 0);
   uint32_t ti = 0;
   try {
-    for (size_t j = 0; j < kept_.size(); ++j) {
-      ti = kept_[j];
-      if (side_ != nullptr) drawSplitTriangle(obj.mesh.triangles[ti], ti, owner_[j] != 0);
+    for (size_t j = 0; j < kept.size(); ++j) {
+      ti = kept[j];
+      if (side_ != nullptr) drawSplitTriangle(obj.mesh.triangles[ti], ti, scratch_.owner[j] != 0);
       else drawMeshTriangle(obj.mesh.triangles[ti], ti);
     }
   } catch (const std::range_error& e) {
@@ -585,21 +581,23 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
     }
 }
 
-// On a side of a frame split by rows: of the triangles not culled early (kept_), those the side
-// takes (SplitSide::takes), in order, and whether it owns each (owner_).
+// On a side of a frame split by rows: of the triangles not culled early (DrawScratch::kept),
+// those the side takes (SplitSide::takes), in order, and whether it owns each (owner).
 void SceneDrawer::keepTaken(const std::vector<std::array<uint32_t, 3>>& tris) {
-  owner_.resize(kept_.size());
+  std::vector<uint32_t>& kept = scratch_.kept;
+  std::vector<uint8_t>& owners = scratch_.owner;
+  owners.resize(kept.size());
   size_t n = 0;
-  for (size_t j = 0; j < kept_.size(); ++j) {
-    const uint32_t k = kept_[j];
+  for (size_t j = 0; j < kept.size(); ++j) {
+    const uint32_t k = kept[j];
     bool owner = false;
     const bool takes = side_->takes(viewTriangle(verts_, tris[k], f_.proj.z_near), owner);
-    kept_[n] = k;  // n <= j: an entry read already
-    owner_[n] = owner;
+    kept[n] = k;  // n <= j: an entry read already
+    owners[n] = owner;
     n += takes;
   }
-  kept_.resize(n);
-  owner_.resize(n);
+  kept.resize(n);
+  owners.resize(n);
 }
 
 // A mesh triangle not culled early that a side of a frame split by rows takes (keepTaken): its
@@ -997,12 +995,7 @@ void placeOwned(const SplitSide& s, std::vector<ScreenTriangleInfo>& triangles) 
 // same min and max as one thread's markDrawn in any order), and each side's tags in the
 // triangle buffer (SplitSide::global).
 void joinSides(const std::array<SplitSide, 2>& sides, Framebuffer& fb) {
-  for (const SplitSide& s : sides) {
-    fb.drawn_x0 = std::min(fb.drawn_x0, s.drawn.drawn_x0);
-    fb.drawn_y0 = std::min(fb.drawn_y0, s.drawn.drawn_y0);
-    fb.drawn_x1 = std::max(fb.drawn_x1, s.drawn.drawn_x1);
-    fb.drawn_y1 = std::max(fb.drawn_y1, s.drawn.drawn_y1);
-  }
+  for (const SplitSide& s : sides) fb.markDrawn(s.drawn);
   if (fb.tri.empty()) return;
   for (const SplitSide& s : sides)
     for (int32_t y = std::max(s.rows.y0, fb.drawn_y0); y <= std::min(s.rows.y1 - 1, fb.drawn_y1); ++y)
@@ -1036,8 +1029,7 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     s.foreign.clear();
     s.drawn.width = res.fb.width;
     s.drawn.height = res.fb.height;
-    s.drawn.drawn_x0 = s.drawn.drawn_y0 = INT_MAX;
-    s.drawn.drawn_x1 = s.drawn.drawn_y1 = INT_MIN;
+    s.drawn.markNothingDrawn();
     s.stats = s.others = RenderStats{};
     s.error = nullptr;
   }
@@ -1218,11 +1210,10 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   const bool measured = may_split && opt.split == RenderOptions::Split::Auto;
   SplitChoice& choice = res.scratch.get().choice;
   res.split_by_rows = measured ? choice.next(traits(opt.method).two_threads == TwoThreads::AfterWalk) : may_split;
-  // A frame split by rows places its triangles into the list the frame before left (renderSplit).
-  if (!res.split_by_rows) res.triangles.clear();
   if (res.split_by_rows) {
-    renderSplit(scene, opt, span, engines, clear, res);
+    renderSplit(scene, opt, span, engines, clear, res);  // into the list the frame before left
   } else {
+    res.triangles.clear();
     Frame frame(scene, opt, span, res.fb, res.stats);
     if (opt.threads == 1) {
       clearRect(res.fb, clear);

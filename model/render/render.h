@@ -33,6 +33,7 @@
 // raster/row_spans.h, instead of a descriptor and its walk: the same fragments and cycles.)
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <climits>
 #include <cstdint>
@@ -256,6 +257,17 @@ struct Framebuffer {
   alignas(64) int drawn_x0 = INT_MAX, drawn_y0 = INT_MAX, drawn_x1 = INT_MIN, drawn_y1 = INT_MIN;
   // Adds the pixels whose centres lie within [xmin, xmax] x [ymin, ymax] (screen pixels).
   void markDrawn(double xmin, double ymin, double xmax, double ymax);
+  // Adds another buffer's drawn rectangle (of the same size: a side of a frame split by rows).
+  void markDrawn(const Framebuffer& o) {
+    drawn_x0 = std::min(drawn_x0, o.drawn_x0);
+    drawn_y0 = std::min(drawn_y0, o.drawn_y0);
+    drawn_x1 = std::max(drawn_x1, o.drawn_x1);
+    drawn_y1 = std::max(drawn_y1, o.drawn_y1);
+  }
+  void markNothingDrawn() {
+    drawn_x0 = drawn_y0 = INT_MAX;
+    drawn_x1 = drawn_y1 = INT_MIN;
+  }
 };
 
 // A frame as an image (its rgb), the mask of its covered pixels, and the reference method's
