@@ -99,10 +99,6 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
     owner = owns(lo);
     return owner || rows.anyIn(lo, hi);
   }
-  bool takes(const TriangleView& tv) const {
-    bool owner;
-    return takes(tv, owner);
-  }
 };
 
 // A frame's buffers kept in its result (ScratchBuffers): the drawers' buffers (second: the
@@ -414,11 +410,11 @@ class SceneDrawer {
   // A two-thread frame of a TwoThreads::AfterSetup method: the back end records the triangles.
   const bool back_records_;
   TriangleSetup setup_config_;
-  std::vector<PVertex>& verts_;       // the object's (the result's scratch)
-  std::vector<uint8_t>& lit_;         // verts_[i].colour is computed (the result's scratch)
-  DrawScratch& scratch_;              // its kept triangles (and a side's owner flags), the normals' scratch
-  std::vector<std::array<double, 3>>& faces_;  // the face colours lit ahead (the result's scratch)
-  bool faces_lit_ = false;            // this object's faces_ (MethodTraits::face_colours)
+  // The result's buffers (DrawScratch): the object's vertices, which of their colours are
+  // computed (lit), its triangles not culled early (kept, and a side's owner flags), its face
+  // colours lit ahead (faces), the normals' scratch.
+  DrawScratch& scratch_;
+  bool faces_lit_ = false;            // this object's scratch_.faces (MethodTraits::face_colours)
   Poly poly_;                         // a clipped triangle
   Fan fan_;                           // the polygon to draw
   Parts parts_;                       // its screen triangles
@@ -475,10 +471,7 @@ SceneDrawer::SceneDrawer(Frame& f, const Scene& scene, const SpecEngines& engine
       vertex_colours_(traits(f.opt.method).vertex_colours),
       face_colours_(traits(f.opt.method).face_colours),
       back_records_(queue != nullptr && traits(f.opt.method).two_threads == TwoThreads::AfterSetup),
-      verts_(scratch.verts),
-      lit_(scratch.lit),
       scratch_(scratch),
-      faces_(scratch.faces),
       queue_(queue),
       cleared_(cleared),
       side_(side) {
@@ -513,13 +506,14 @@ void SceneDrawer::drawObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   lightObject(f_, scene_, engines_, oi);
   for (const auto& u : f_.units()) u.second->beginObject();
-  verts_.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
+  scratch_.verts.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
   // On one thread, where no specular unit counts the lighting (Frame::shadeNow). (On two, the
   // pass delays the back end's first triangles: flat's frame took 1.03-1.06 times as long with
   // it, the pass shared between both threads, docs/performance.md.)
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
   if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, verts_.data(), 0, verts_.size(), f_.avx2, false);
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, scratch_.verts.data(), 0, scratch_.verts.size(), f_.avx2,
+                         false);
   } else {
     DrawJob& j = queue_->slot();
     j.kind = DrawJob::Kind::BeginObject;
@@ -529,8 +523,8 @@ void SceneDrawer::drawObject(size_t oi) {
     t.basis = &basis_;
     t.cam = &scene_.camera;
     t.proj = &f_.proj;
-    t.verts = verts_.data();
-    t.n = verts_.size();
+    t.verts = scratch_.verts.data();
+    t.n = scratch_.verts.size();
     t.vector = f_.avx2;
     t.normals = !face_colours_;
     t.next.store(0, std::memory_order_relaxed);
@@ -542,7 +536,7 @@ void SceneDrawer::drawObject(size_t oi) {
   // The back faces culled early, counted at once (on a side of a frame split by rows, the top
   // side's); the others drawn in order.
   std::vector<uint32_t>& kept = scratch_.kept;
-  const size_t culled = keptTriangles(verts_, obj.mesh.triangles, f_.proj.z_near, kept);
+  const size_t culled = keptTriangles(scratch_.verts, obj.mesh.triangles, f_.proj.z_near, kept);
   RenderStats& culled_st = side_ != nullptr && !side_->top ? side_->others : f_.st;
   culled_st.triangles += culled;
   culled_st.culled_back += culled;
@@ -550,9 +544,9 @@ void SceneDrawer::drawObject(size_t oi) {
   // The normals of the vertices drawn (transformed without them above), where the method reads
   // them; the two-thread frame's shared transform gave every vertex its normal.
   if (queue_ == nullptr && !face_colours_)
-    triangleNormals(obj, basis_, kept, verts_.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
-  if (faces_lit_) lightFaces(f_, verts_, obj.mesh.triangles, kept, faces_);
-  lit_.assign(verts_.size(), 0);
+    triangleNormals(obj, basis_, kept, scratch_.verts.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
+  if (faces_lit_) lightFaces(f_, scratch_.verts, obj.mesh.triangles, kept, scratch_.faces);
+  scratch_.lit.assign(scratch_.verts.size(), 0);
   uint32_t ti = 0;
   try {
     for (size_t j = 0; j < kept.size(); ++j) {
@@ -575,9 +569,9 @@ void SceneDrawer::drawObject(size_t oi) {
 // Gouraud vertex colours: computed when a triangle that is not culled first needs them.
 void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
   for (const uint32_t i : tri)
-    if (!lit_[i]) {
-      verts_[i].colour = f_.shadeNow(verts_[i].n, verts_[i].cam);
-      lit_[i] = 1;
+    if (!scratch_.lit[i]) {
+      scratch_.verts[i].colour = f_.shadeNow(scratch_.verts[i].n, scratch_.verts[i].cam);
+      scratch_.lit[i] = 1;
     }
 }
 
@@ -591,7 +585,7 @@ void SceneDrawer::keepTaken(const std::vector<std::array<uint32_t, 3>>& tris) {
   for (size_t j = 0; j < kept.size(); ++j) {
     const uint32_t k = kept[j];
     bool owner = false;
-    const bool takes = side_->takes(viewTriangle(verts_, tris[k], f_.proj.z_near), owner);
+    const bool takes = side_->takes(viewTriangle(scratch_.verts, tris[k], f_.proj.z_near), owner);
     kept[n] = k;  // n <= j: an entry read already
     owners[n] = owner;
     n += takes;
@@ -603,13 +597,13 @@ void SceneDrawer::keepTaken(const std::vector<std::array<uint32_t, 3>>& tris) {
 // A mesh triangle not culled early that a side of a frame split by rows takes (keepTaken): its
 // owner's to count.
 void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner) {
-  const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
+  const TriangleView tv = viewTriangle(scratch_.verts, tri, f_.proj.z_near);
   RenderStats& st = owner ? f_.st : side_->others;
   ++st.triangles;
   if (vertex_colours_) lightVertices(tri);
   if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
   parts_.clear();
-  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
+  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &scratch_.faces[ti] : nullptr;
   unit_.parts(fan_, parts_);
   bool drawn = false;
   for (size_t k = 0; k < parts_.size(); ++k) drawn |= drawSplitPart(parts_[k], ti, static_cast<uint32_t>(k), owner);
@@ -619,11 +613,11 @@ void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t
 void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
   RenderStats& st = f_.st;
   ++st.triangles;
-  const TriangleView tv = viewTriangle(verts_, tri, f_.proj.z_near);
+  const TriangleView tv = viewTriangle(scratch_.verts, tri, f_.proj.z_near);
   if (vertex_colours_) lightVertices(tri);
   if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
   // Lit ahead: a triangle drawn as itself (a clipped one's fan points into poly_).
-  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &faces_[ti] : nullptr;
+  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &scratch_.faces[ti] : nullptr;
   // The screen triangles to draw (a fan of the polygon), each with the unit that draws it:
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
