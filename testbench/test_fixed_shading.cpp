@@ -222,6 +222,9 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
               Vec3 v{g(rng), g(rng), g(rng)};
               if (t % 2 != 0) v = normalize(normalize(v) + 3.0 * ctx.lights[0].half);
               if (t % 10 == 1) v = ctx.lights[0].half;  // N.H at 1 and a hair either side (the clamp at 2^32)
+              // N.L at 1 and a hair either side: a scaled N.L of 2^32 and more has a high word, which
+              // the diffuse products multiply by each channel's diffuse factor.
+              if (t % 10 == 3) v = ctx.lights[0].dir;
               v = (len / length(v)) * v;
               const NormalCode c(v);
               std::array<int64_t, 3> dn{};

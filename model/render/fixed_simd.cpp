@@ -598,13 +598,19 @@ SHD_AVX2 inline __m256i mulLo64(__m256i a, __m256i b) {
                                          _mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)));
   return _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64(cross, 32));
 }
-// mulHiU64's operations.
-SHD_AVX2 inline __m256i mulHiU64x4(__m256i a, __m256i b) {
+// The low 64 bits of a b for 0 <= a < 2^32 (any b): a's high word's product is 0.
+SHD_AVX2 inline __m256i mulLo64By32(__m256i a, __m256i b) {
+  return _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64(_mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)), 32));
+}
+// mulHiU64's operations, and the top bit of the low word of a b (bits 32 .. 63 of the low word
+// are v mod 2^32: the sum of al bh, ah bl and al bl's high half, mod 2^32) in lo_top.
+SHD_AVX2 inline __m256i mulHiU64x4(__m256i a, __m256i b, __m256i& lo_top) {
   const __m256i low32 = _mm256_set1_epi64x(0xFFFFFFFF);
   const __m256i ah = _mm256_srli_epi64(a, 32), bh = _mm256_srli_epi64(b, 32);
   const __m256i t = _mm256_mul_epu32(a, b);
   const __m256i u = _mm256_add_epi64(_mm256_mul_epu32(ah, b), _mm256_srli_epi64(t, 32));
   const __m256i v = _mm256_add_epi64(_mm256_mul_epu32(a, bh), _mm256_and_si256(u, low32));
+  lo_top = _mm256_srli_epi64(_mm256_slli_epi64(v, 32), 63);
   return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(ah, bh), _mm256_srli_epi64(u, 32)),
                           _mm256_srli_epi64(v, 32));
 }
@@ -623,8 +629,24 @@ SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(
 // scaleCosines' operations.
 SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
   const __m256i neg = _mm256_cmpgt_epi64(_mm256_setzero_si256(), d);
-  const __m256i hi = _mm256_sub_epi64(mulHiU64x4(d, r64), _mm256_and_si256(neg, r64));
-  return _mm256_add_epi64(hi, _mm256_srli_epi64(mulLo64(d, r64), 63));
+  __m256i carry;
+  const __m256i hi = _mm256_sub_epi64(mulHiU64x4(d, r64, carry), _mm256_and_si256(neg, r64));
+  return _mm256_add_epi64(hi, carry);
+}
+
+// The bit length of each lane's value v > 0 (64 less its count of leading zeros, which AVX2
+// lacks): that of its high word plus 32 where the high word is not 0, else that of its low
+// word. A word y below 2^32 is exact in a double, d = (2^52 + y) - 2^52 (the sum's bits are
+// y's with 2^52's exponent), whose exponent field is 1023 + floor(log2 y) for y > 0.
+SHD_AVX2 inline __m256i bitLength4(__m256i v) {
+  const __m256i hi = _mm256_srli_epi64(v, 32);
+  const __m256i low_word = _mm256_cmpeq_epi64(hi, _mm256_setzero_si256());
+  const __m256i y = _mm256_blendv_epi8(hi, _mm256_and_si256(v, _mm256_set1_epi64x(0xFFFFFFFF)), low_word);
+  const __m256d two52 = _mm256_set1_pd(4503599627370496.0);
+  const __m256d d = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(y, _mm256_castpd_si256(two52))), two52);
+  const __m256i exponent = _mm256_srli_epi64(_mm256_castpd_si256(d), 52);
+  return _mm256_add_epi64(_mm256_sub_epi64(exponent, _mm256_set1_epi64x(1022)),
+                          _mm256_andnot_si256(low_word, _mm256_set1_epi64x(32)));
 }
 
 // scaleGroup's datapath on the 4 squared norms at sq (`valid`: the lanes that are fragments),
@@ -632,9 +654,8 @@ SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
 // scalar path.
 SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m256i valid, uint64_t* r64_out) {
   const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sq));
-  // rsqrtCore<10>: the bit length (lane by lane: AVX2 has no count of leading zeros), shift.
-  auto bitsOf = [](uint64_t x) { return x == 0 ? int64_t{0} : int64_t{64 - __builtin_clzll(x)}; };
-  const __m256i bits = _mm256_set_epi64x(bitsOf(sq[3]), bitsOf(sq[2]), bitsOf(sq[1]), bitsOf(sq[0]));
+  // rsqrtCore<10>: the bit length (bitLength4: not of 0, which goes to the scalar path), shift.
+  const __m256i bits = bitLength4(v);
   const __m256i up = _mm256_cmpgt_epi64(_mm256_set1_epi64x(63), bits);  // bits <= 62
   const __m256i shift = _mm256_blendv_epi8(_mm256_set1_epi64x(-1),
                                            _mm256_srli_epi64(_mm256_sub_epi64(_mm256_set1_epi64x(62), bits), 1), up);
@@ -652,15 +673,23 @@ SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m2
   const __m256i r0sq = _mm256_mul_epu32(r0, r0);
   const __m256i mr = _mm256_add_epi64(_mm256_mul_epu32(mq, _mm256_srli_epi64(r0sq, 32)),
                                       _mm256_srli_epi64(_mm256_mul_epu32(mq, r0sq), 32));
-  const __m256i r = sra64<17>(mulLo64(r0, _mm256_sub_epi64(_mm256_set1_epi64x(int64_t{3} << 32), mr)));
+  const __m256i r = sra64<17>(mulLo64By32(r0, _mm256_sub_epi64(_mm256_set1_epi64x(int64_t{3} << 32), mr)));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(r64_out), _mm256_sllv_epi64(r, _mm256_add_epi64(shift, _mm256_set1_epi64x(3))));
   return true;
 }
 
-// shadeGroup's datapath on the 4 fragments at r64 (scaleLanes4's), l, h (`valid`: the lanes
-// that are fragments), up to the 12-fraction-bit codes.
-SHD_AVX2 [[gnu::always_inline]] inline void shadeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
-                                                        const uint64_t* h, __m256i valid, __m256i (&code)[3]) {
+// shadeGroup's datapath on 4 fragments, in two parts:
+//   lobeLanes4   from the cosine scales r64 (scaleLanes4's) and the dot products, the scaled N.L
+//                (nl), the lobe table's pair of entries at N.H and the step to the next (frac),
+//                stored at the lanes' entries of a LobeLanes;
+//   codeLanes4   from those, the 12-fraction-bit codes.
+// As shadeNh's two passes (above), each is a pass over the groups of its own: the table's
+// gather ends a short chain, and the groups behind it in the pass overlap its wait.
+struct LobeLanes {
+  uint64_t nl[kMaxBatch], frac[kMaxBatch], pair[kMaxBatch];
+};
+SHD_AVX2 [[gnu::always_inline]] inline void lobeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
+                                                       const uint64_t* h, __m256i valid, LobeLanes& out, size_t i) {
   const __m256i r64 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r64s));
   const __m256i dot_l = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l));
   const __m256i dot_h = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h));
@@ -669,24 +698,41 @@ SHD_AVX2 [[gnu::always_inline]] inline void shadeLanes4(const NhParams& p, const
   const __m256i nh = scaleCosines4(dot_h, r64);
   const __m256i c = min64(max64(nh, _mm256_setzero_si256()), _mm256_set1_epi64x(int64_t{1} << 32));
   const __m256i ti = _mm256_srli_epi64(c, 16);
-  const __m256i frac = _mm256_and_si256(c, _mm256_set1_epi64x(0xFFFF));
   const __m256i reads = _mm256_and_si256(
       _mm256_and_si256(valid, lit), _mm256_cmpgt_epi64(ti, _mm256_set1_epi64x(static_cast<int64_t>(p.zero_below) - 1)));
   const __m256i pair = _mm256_mask_i64gather_epi64(_mm256_setzero_si256(), reinterpret_cast<const long long*>(p.table),
                                                    ti, reads, 4);
-  const __m256i t0 = _mm256_and_si256(pair, _mm256_set1_epi64x(0xFFFFFFFF));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.nl + i), nl);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.frac + i), _mm256_and_si256(c, _mm256_set1_epi64x(0xFFFF)));
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.pair + i), pair);
+}
+SHD_AVX2 [[gnu::always_inline]] inline void codeLanes4(const NhParams& p, const LobeLanes& in, size_t i,
+                                                       __m256i (&code)[3]) {
+  const __m256i nl = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.nl + i));
+  const __m256i frac = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.frac + i));
+  const __m256i pair = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.pair + i));
+  const __m256i lit = _mm256_cmpgt_epi64(nl, _mm256_setzero_si256());
+  // f = t0 + ((t1 - t0) frac + 2^15) >> 16 (arithmetic), which is (t0 (2^16 - frac) + t1 frac +
+  // 2^15) >> 16: t0 and t1 are below 2^32 and frac below 2^16, so the sum is not negative and
+  // below 2^48, the shift is logical, and f <= max(t0, t1) < 2^32 needs no cast to 32 bits.
+  // _mm256_mul_epu32 reads the low word of pair: t0.
   const __m256i t1 = _mm256_srli_epi64(pair, 32);
-  const __m256i f = _mm256_and_si256(
-      _mm256_add_epi64(t0, roundShift64<16>(mulLo64(_mm256_sub_epi64(t1, t0), frac))), _mm256_set1_epi64x(0xFFFFFFFF));
+  const __m256i f = _mm256_srli_epi64(
+      _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(pair, _mm256_sub_epi64(_mm256_set1_epi64x(1 << 16), frac)),
+                                        _mm256_mul_epu32(t1, frac)),
+                       _mm256_set1_epi64x(1 << 15)),
+      16);
   // The factor codes are below 2^30 and not negative (fixed_shading.cpp's factorCode), and in
   // the lanes where they count (lit) nl > 0 (below 2^34, a Q2.32 cosine) and 0 <= f < 2^32:
   // the products are not negative, diffuse nl is the sum of two 32 x 32 products, specular f
-  // one, and the rounding shifts are logical.
+  // one, and the rounding shifts are logical. With nl = nh 2^32 + nlo: (kd nl + 2^31) >> 32 is
+  // kd nh + ((kd nlo + 2^31) >> 32).
   const __m256i nl_high = _mm256_srli_epi64(nl, 32);
   for (size_t k = 0; k < 3; ++k) {
     const __m256i kd = _mm256_set1_epi64x(p.diffuse[k]), ks = _mm256_set1_epi64x(p.specular[k]);
-    const __m256i dnl = _mm256_add_epi64(_mm256_mul_epu32(kd, nl), _mm256_slli_epi64(_mm256_mul_epu32(kd, nl_high), 32));
-    const __m256i diffuse = _mm256_srli_epi64(_mm256_add_epi64(dnl, _mm256_set1_epi64x(int64_t{1} << 31)), 32);
+    const __m256i diffuse = _mm256_add_epi64(
+        _mm256_mul_epu32(kd, nl_high),
+        _mm256_srli_epi64(_mm256_add_epi64(_mm256_mul_epu32(kd, nl), _mm256_set1_epi64x(int64_t{1} << 31)), 32));
     const __m256i specular = _mm256_srli_epi64(_mm256_add_epi64(_mm256_mul_epu32(ks, f), _mm256_set1_epi64x(1 << 23)), 24);
     code[k] = _mm256_add_epi64(_mm256_set1_epi64x(p.ambient[k]), _mm256_and_si256(lit, _mm256_add_epi64(diffuse, specular)));
   }
@@ -707,13 +753,18 @@ SHD_AVX2 inline __m256i validLanes4(int n, int half) {
 SHD_AVX2 inline bool scaleGroupAvx2(const uint64_t* sq, int n, uint64_t* r64_out) {
   return scaleLanes4(sq, validLanes4(n, 0), r64_out) && scaleLanes4(sq + 4, validLanes4(n, 1), r64_out + 4);
 }
+SHD_AVX2 inline void lobeGroupAvx2(const NhParams& p, const uint64_t* r64, const uint64_t* l, const uint64_t* h, int n,
+                                   size_t i, LobeLanes& out) {
+  lobeLanes4(p, r64 + i, l + i, h + i, validLanes4(n, 0), out, i);
+  lobeLanes4(p, r64 + i + 4, l + i + 4, h + i + 4, validLanes4(n, 1), out, i + 4);
+}
 template <bool kCodes>
-SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const uint64_t* r64, const uint64_t* l, const uint64_t* h, int n,
-                                    size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
+SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const LobeLanes& in, size_t i, uint8_t* const rgb[3],
+                                    int64_t* const codes[3]) {
   __m256i a[3], b[3];
-  shadeLanes4(p, r64, l, h, validLanes4(n, 0), a);
-  shadeLanes4(p, r64 + 4, l + 4, h + 4, validLanes4(n, 1), b);
-  // Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
+  codeLanes4(p, in, i, a);
+  codeLanes4(p, in, i + 4, b);
+// Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
   const __m256i pick_a = _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
                                           -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
   const __m256i pick_b = _mm256_setr_epi8(-1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
@@ -734,11 +785,18 @@ SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const uint64_t* r64, cons
 SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                               uint8_t* const rgb[3], int64_t* const codes[3]) {
   uint64_t r64[kMaxBatch];  // as shadeNh's
-  return twoPasses(
-      n, codes != nullptr, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); },
-      [&](size_t i, int count, auto with_codes) SHD_AVX2 {
-        shadeGroupAvx2<decltype(with_codes)::value>(p, r64 + i, l + i, h + i, count, i, rgb, codes);
-      });
+  LobeLanes lobe;           // each group's written by lobeGroupAvx2 before shadeGroupAvx2 reads it
+  const uint64_t declined = twoPasses(
+      n, false, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); },
+      [&](size_t i, int count, auto) SHD_AVX2 { lobeGroupAvx2(p, r64, l, h, count, i, lobe); });
+  auto shade = [&](size_t i, int, auto with_codes) SHD_AVX2 {
+    shadeGroupAvx2<decltype(with_codes)::value>(p, lobe, i, rgb, codes);
+  };
+  if (codes != nullptr)
+    shadePass<true>(n, declined, shade);
+  else
+    shadePass<false>(n, declined, shade);
+  return declined;
 }
 
 // ---- bufferRun in AVX2 ----
