@@ -149,28 +149,42 @@ SHD_AVX512 inline bool scaleGroup(const uint64_t* sq, int n, uint64_t* r64_out) 
   return true;
 }
 
-// The colours of the n <= 8 fragments at offset i of shadeNh's arrays from their cosine scales
-// (scaleGroup's) and dot products. kCodes: codes is not null (a compile-time case: the
-// renderer's loop, without the test and the code stores, runs some 20 % faster).
-template <bool kCodes>
-SHD_AVX512 inline void shadeGroup(const NhParams& p, const uint64_t* r64s, const uint64_t* l, const uint64_t* h, int n,
-                                  size_t i, uint8_t* const rgb[3], int64_t* const codes[3]) {
+// The lobe lookups and colours of a group, in two passes over the groups (as shadeNhAvx2's,
+// below): lobeGroup from the cosine scales (scaleGroup's) and dot products, the scaled N.L,
+// the lobe table's pair of entries at N.H and the step to the next, stored in a LobeLanes;
+// colourGroup from those, the colours. The table's gather ends the first pass's short chain,
+// and the groups behind it overlap its wait.
+struct LobeLanes {
+  uint64_t nl[kMaxBatch], frac[kMaxBatch], pair[kMaxBatch];
+};
+SHD_AVX512 inline void lobeGroup(const NhParams& p, const uint64_t* r64s, const uint64_t* l, const uint64_t* h, int n,
+                                 size_t i, LobeLanes& out) {
   const __mmask8 valid = static_cast<__mmask8>((1u << n) - 1);
-  const __m512i r64 = _mm512_loadu_si512(r64s);
-  const __m512i dot_l = _mm512_loadu_si512(l), dot_h = _mm512_loadu_si512(h);
+  const __m512i r64 = _mm512_loadu_si512(r64s + i);
+  const __m512i dot_l = _mm512_loadu_si512(l + i), dot_h = _mm512_loadu_si512(h + i);
   const __m512i nl = scaleCosines(dot_l, r64);
   const __mmask8 lit = _mm512_cmpgt_epi64_mask(nl, _mm512_setzero_si512());
   const __m512i nh = scaleCosines(dot_h, r64);
   // lobeAt: c = clamp(nh, 0, 2^32), entry c >> 16 and the step to the next with c's low 16 bits.
   const __m512i c = _mm512_min_epi64(_mm512_max_epi64(nh, _mm512_setzero_si512()), _mm512_set1_epi64(int64_t{1} << 32));
   const __m512i ti = _mm512_srli_epi64(c, 16);
-  const __m512i frac = _mm512_and_si512(c, _mm512_set1_epi64(0xFFFF));
   // One 8-byte gather per lane at entry ti: t[ti] in the low half, t[ti + 1] in the high half
   // (the table has the copy of its last entry, so ti + 1 <= 2^16 + 1 is inside it).
   // Lanes that are unlit or below zero_below (both entries 0, so f = 0) read nothing.
   const __mmask8 reads = valid & lit & _mm512_cmpge_epi64_mask(ti, _mm512_set1_epi64(p.zero_below));
-  const __m512i pair =
-      _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), reads, ti, reinterpret_cast<const long long*>(p.table), 4);
+  _mm512_storeu_si512(out.nl + i, nl);
+  _mm512_storeu_si512(out.frac + i, _mm512_and_si512(c, _mm512_set1_epi64(0xFFFF)));
+  _mm512_storeu_si512(out.pair + i, _mm512_mask_i64gather_epi64(_mm512_setzero_si512(), reads, ti,
+                                                               reinterpret_cast<const long long*>(p.table), 4));
+}
+// kCodes: codes is not null (a compile-time case: the renderer's loop, without the test and the
+// code stores, runs some 20 % faster).
+template <bool kCodes>
+SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_t i, uint8_t* const rgb[3],
+                                   int64_t* const codes[3]) {
+  const __m512i nl = _mm512_loadu_si512(in.nl + i);
+  const __m512i frac = _mm512_loadu_si512(in.frac + i), pair = _mm512_loadu_si512(in.pair + i);
+  const __mmask8 lit = _mm512_cmpgt_epi64_mask(nl, _mm512_setzero_si512());
   const __m512i t0 = _mm512_and_si512(pair, _mm512_set1_epi64(0xFFFFFFFF));
   const __m512i t1 = _mm512_srli_epi64(pair, 32);
   const __m512i f = _mm512_and_si512(  // static_cast<uint32_t>
@@ -310,12 +324,19 @@ template <class Scale, class Shade>
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
-  uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before shadeGroup reads it
-  return twoPasses(
-      n, codes != nullptr, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); },
-      [&](size_t i, int count, auto with_codes) SHD_AVX512 {
-        shadeGroup<decltype(with_codes)::value>(p, r64 + i, l + i, h + i, count, i, rgb, codes);
-      });
+  uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before lobeGroup reads it
+  LobeLanes lobe;           // each group's written by lobeGroup before colourGroup reads it
+  const uint64_t declined = twoPasses(
+      n, false, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); },
+      [&](size_t i, int count, auto) SHD_AVX512 { lobeGroup(p, r64, l, h, count, i, lobe); });
+  auto colours = [&](size_t i, int, auto with_codes) SHD_AVX512 {
+    colourGroup<decltype(with_codes)::value>(p, lobe, i, rgb, codes);
+  };
+  if (codes != nullptr)
+    shadePass<true>(n, declined, colours);
+  else
+    shadePass<false>(n, declined, colours);
+  return declined;
 }
 
 namespace {
@@ -685,9 +706,6 @@ SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m2
 //   codeLanes4   from those, the 12-fraction-bit codes.
 // As shadeNh's two passes (above), each is a pass over the groups of its own: the table's
 // gather ends a short chain, and the groups behind it in the pass overlap its wait.
-struct LobeLanes {
-  uint64_t nl[kMaxBatch], frac[kMaxBatch], pair[kMaxBatch];
-};
 SHD_AVX2 [[gnu::always_inline]] inline void lobeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
                                                        const uint64_t* h, __m256i valid, LobeLanes& out, size_t i) {
   const __m256i r64 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r64s));
