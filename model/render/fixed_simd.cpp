@@ -185,15 +185,18 @@ SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_
   const __m512i nl = _mm512_loadu_si512(in.nl + i);
   const __m512i frac = _mm512_loadu_si512(in.frac + i), pair = _mm512_loadu_si512(in.pair + i);
   const __mmask8 lit = _mm512_cmpgt_epi64_mask(nl, _mm512_setzero_si512());
-  const __m512i t0 = _mm512_and_si512(pair, _mm512_set1_epi64(0xFFFFFFFF));
+  // f = t0 + ((t1 - t0) frac + 2^15) >> 16 as (t0 (2^16 - frac) + t1 frac + 2^15) >> 16 (see
+  // codeLanes4 below); _mm512_mul_epu32 reads the low word of pair: t0.
   const __m512i t1 = _mm512_srli_epi64(pair, 32);
-  const __m512i f = _mm512_and_si512(  // static_cast<uint32_t>
-      _mm512_add_epi64(t0, roundShift<16>(_mm512_mullo_epi64(_mm512_sub_epi64(t1, t0), frac))),
-      _mm512_set1_epi64(0xFFFFFFFF));
+  const __m512i f = _mm512_srli_epi64(
+      _mm512_add_epi64(_mm512_add_epi64(_mm512_mul_epu32(pair, _mm512_sub_epi64(_mm512_set1_epi64(1 << 16), frac)),
+                                        _mm512_mul_epu32(t1, frac)),
+                       _mm512_set1_epi64(1 << 15)),
+      16);
 
   for (size_t k = 0; k < 3; ++k) {
     const __m512i diffuse = roundShift<32>(_mm512_mullo_epi64(_mm512_set1_epi64(p.diffuse[k]), nl));
-    const __m512i specular = roundShift<24>(_mm512_mullo_epi64(_mm512_set1_epi64(p.specular[k]), f));
+    const __m512i specular = roundShift<24>(_mm512_mul_epu32(_mm512_set1_epi64(p.specular[k]), f));  // both below 2^32
     // The sum of non-negative terms: unorm8FromCode's clamp at 0 never acts.
     const __m512i code = _mm512_mask_add_epi64(_mm512_set1_epi64(p.ambient[k]), lit, _mm512_set1_epi64(p.ambient[k]),
                                                _mm512_add_epi64(diffuse, specular));
