@@ -90,18 +90,21 @@ constexpr std::array<uint16_t, 16> kSpread3 = [] {
   return t;
 }();
 
-// shadeNh works in two passes over its fragments, each group of 8 in each:
-//   scaleGroup  the squared norm's cosine scale r64 (rsqrtCore and cosineScale), or the group
-//               declined;
-//   shadeGroup  from r64 and the dot products, the colours.
-// One pass doing both left the processor waiting on the lobe table's gather (a third of the
+// shadeNh works in three passes over its fragments, each group of 8 in each:
+//   scaleGroup   the squared norm's cosine scale r64 (rsqrtCore and cosineScale), or the group
+//                declined;
+//   lobeGroup    from r64 and the dot products, the scaled N.L and the lobe table's entries
+//                at N.H (its gather);
+//   colourGroup  from those, the colours.
+// One pass doing all left the processor waiting on the lobe table's gather (a third of the
 // kernel's samples on the instruction after it): a group's chain of dependent operations, from
 // its squared norm through the seed's lookup, the products with r64 and the gather to its
 // stores, is longer than the out-of-order window holds of the groups behind it. Split, each
-// pass's groups overlap: on an AMD EPYC (family 26) the kernel took 0.64-0.84 of its samples, a
-// phong-fixed frame of builtin:sphere 0.89 of its time; the AVX2 kernel's frame 0.91
-// (docs/performance.md, "What makes a frame fast").
-// Both inline into shadeNh's loops, where the compiler keeps the broadcast constants out of
+// pass's groups overlap: on an AMD EPYC (family 26) the first split (scales, then the rest)
+// took a phong-fixed frame of builtin:sphere to 0.89 of its time, the AVX2 kernel's frame to
+// 0.91; the gather ending a pass of its own took the AVX2 frame to 0.93 of that, the
+// AVX-512 one to 0.96-0.98 (docs/performance.md, "What makes a frame fast").
+// Each inlines into its pass's loop, where the compiler keeps the broadcast constants out of
 // the loop. Lanes past n compute on whatever their entries hold; they read no table (masked
 // gathers) and their results are not stored.
 
@@ -301,7 +304,7 @@ template <class Group>
   return declined;
 }
 
-// The second pass of shadeNh's: shade(i, count, codes) for each group not declined, codes a
+// A later pass of shadeNh's: shade(i, count, codes) for each group not declined, codes a
 // std::bool_constant (kCodes: the kernel stores the codes).
 template <bool kCodes, class Shade>
 [[gnu::always_inline]] inline void shadePass(size_t n, uint64_t declined, Shade& shade) {
@@ -309,17 +312,19 @@ template <bool kCodes, class Shade>
     if (((declined >> g) & 1) == 0)
       shade(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)), std::bool_constant<kCodes>{});
 }
-// shadeNh's two passes: scale(i, count) for every group (eachGroup's group), then shadePass
-// (with codes: the caller wants the codes). Returns the groups declined. n is at most kMaxBatch
-// (the kernels' arrays of cosine scales).
-template <class Scale, class Shade>
-[[gnu::always_inline]] inline uint64_t twoPasses(size_t n, bool codes, Scale scale, Shade shade) {
+// shadeNh's three passes: scale(i, count) for every group (eachGroup's group), then, each for
+// every group not declined (shadePass), lobe(i, count, std::false_type) and colour(i, count,
+// codes) (codes: with codes, the caller wants them). Returns the groups declined. n is at most
+// kMaxBatch (the kernels' arrays).
+template <class Scale, class Lobe, class Colour>
+[[gnu::always_inline]] inline uint64_t threePasses(size_t n, bool codes, Scale scale, Lobe lobe, Colour colour) {
   if (n > kMaxBatch) throw std::logic_error("fixed_simd: a batch of more than kMaxBatch fragments");
   const uint64_t declined = eachGroup(n, scale);
+  shadePass<false>(n, declined, lobe);
   if (codes)
-    shadePass<true>(n, declined, shade);
+    shadePass<true>(n, declined, colour);
   else
-    shadePass<false>(n, declined, shade);
+    shadePass<false>(n, declined, colour);
   return declined;
 }
 
@@ -329,17 +334,12 @@ SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_
                             uint8_t* const rgb[3], int64_t* const codes[3]) {
   uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before lobeGroup reads it
   LobeLanes lobe;           // each group's written by lobeGroup before colourGroup reads it
-  const uint64_t declined = twoPasses(
-      n, false, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); },
-      [&](size_t i, int count, auto) SHD_AVX512 { lobeGroup(p, r64, l, h, count, i, lobe); });
-  auto colours = [&](size_t i, int, auto with_codes) SHD_AVX512 {
-    colourGroup<decltype(with_codes)::value>(p, lobe, i, rgb, codes);
-  };
-  if (codes != nullptr)
-    shadePass<true>(n, declined, colours);
-  else
-    shadePass<false>(n, declined, colours);
-  return declined;
+  return threePasses(
+      n, codes != nullptr, [&](size_t i, int count) SHD_AVX512 { return scaleGroup(sq + i, count, r64 + i); },
+      [&](size_t i, int count, auto) SHD_AVX512 { lobeGroup(p, r64, l, h, count, i, lobe); },
+      [&](size_t i, int, auto with_codes) SHD_AVX512 {
+        colourGroup<decltype(with_codes)::value>(p, lobe, i, rgb, codes);
+      });
 }
 
 namespace {
@@ -612,7 +612,7 @@ SHD_AVX512 uint64_t colourSpansAvx512(const RowSpans& s, size_t W, int frac, con
 }
 
 
-// ---- shadeNh in AVX2: shadeGroup's operations on 4 64-bit lanes, two per group of 8 ----
+// ---- shadeNh in AVX2: its groups' operations on 4 64-bit lanes, two per group of 8 ----
 
 namespace {
 
@@ -702,13 +702,11 @@ SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m2
   return true;
 }
 
-// shadeGroup's datapath on 4 fragments, in two parts:
+// lobeGroup's and colourGroup's datapaths on 4 fragments:
 //   lobeLanes4   from the cosine scales r64 (scaleLanes4's) and the dot products, the scaled N.L
 //                (nl), the lobe table's pair of entries at N.H and the step to the next (frac),
 //                stored at the lanes' entries of a LobeLanes;
 //   codeLanes4   from those, the 12-fraction-bit codes.
-// As shadeNh's two passes (above), each is a pass over the groups of its own: the table's
-// gather ends a short chain, and the groups behind it in the pass overlap its wait.
 SHD_AVX2 [[gnu::always_inline]] inline void lobeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
                                                        const uint64_t* h, __m256i valid, LobeLanes& out, size_t i) {
   const __m256i r64 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r64s));
@@ -759,7 +757,7 @@ SHD_AVX2 [[gnu::always_inline]] inline void codeLanes4(const NhParams& p, const 
   }
 }
 
-// The output byte of each channel's code (as shadeGroup's out) in the low byte of the 64-bit lanes.
+// The output byte of each channel's code (as colourGroup's out) in the low byte of the 64-bit lanes.
 SHD_AVX2 inline __m256i outputs4(__m256i code) {
   return _mm256_srli_epi64(
       _mm256_add_epi64(min64(code, _mm256_set1_epi64x(int64_t{255} << 12)), _mm256_set1_epi64x(1 << 11)), 12);
@@ -770,7 +768,7 @@ SHD_AVX2 inline __m256i validLanes4(int n, int half) {
   return _mm256_cmpgt_epi64(_mm256_set1_epi64x(n - 4 * half), _mm256_setr_epi64x(0, 1, 2, 3));
 }
 
-// scaleGroup and shadeGroup on two groups of 4 lanes each.
+// scaleGroup, lobeGroup and colourGroup on two groups of 4 lanes each.
 SHD_AVX2 inline bool scaleGroupAvx2(const uint64_t* sq, int n, uint64_t* r64_out) {
   return scaleLanes4(sq, validLanes4(n, 0), r64_out) && scaleLanes4(sq + 4, validLanes4(n, 1), r64_out + 4);
 }
@@ -780,12 +778,12 @@ SHD_AVX2 inline void lobeGroupAvx2(const NhParams& p, const uint64_t* r64, const
   lobeLanes4(p, r64 + i + 4, l + i + 4, h + i + 4, validLanes4(n, 1), out, i + 4);
 }
 template <bool kCodes>
-SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const LobeLanes& in, size_t i, uint8_t* const rgb[3],
-                                    int64_t* const codes[3]) {
+SHD_AVX2 inline void colourGroupAvx2(const NhParams& p, const LobeLanes& in, size_t i, uint8_t* const rgb[3],
+                                     int64_t* const codes[3]) {
   __m256i a[3], b[3];
   codeLanes4(p, in, i, a);
   codeLanes4(p, in, i + 4, b);
-// Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
+  // Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
   const __m256i pick_a = _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
                                           -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
   const __m256i pick_b = _mm256_setr_epi8(-1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
@@ -806,18 +804,13 @@ SHD_AVX2 inline void shadeGroupAvx2(const NhParams& p, const LobeLanes& in, size
 SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                               uint8_t* const rgb[3], int64_t* const codes[3]) {
   uint64_t r64[kMaxBatch];  // as shadeNh's
-  LobeLanes lobe;           // each group's written by lobeGroupAvx2 before shadeGroupAvx2 reads it
-  const uint64_t declined = twoPasses(
-      n, false, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); },
-      [&](size_t i, int count, auto) SHD_AVX2 { lobeGroupAvx2(p, r64, l, h, count, i, lobe); });
-  auto shade = [&](size_t i, int, auto with_codes) SHD_AVX2 {
-    shadeGroupAvx2<decltype(with_codes)::value>(p, lobe, i, rgb, codes);
-  };
-  if (codes != nullptr)
-    shadePass<true>(n, declined, shade);
-  else
-    shadePass<false>(n, declined, shade);
-  return declined;
+  LobeLanes lobe;           // each group's written by lobeGroupAvx2 before colourGroupAvx2 reads it
+  return threePasses(
+      n, codes != nullptr, [&](size_t i, int count) SHD_AVX2 { return scaleGroupAvx2(sq + i, count, r64 + i); },
+      [&](size_t i, int count, auto) SHD_AVX2 { lobeGroupAvx2(p, r64, l, h, count, i, lobe); },
+      [&](size_t i, int, auto with_codes) SHD_AVX2 {
+        colourGroupAvx2<decltype(with_codes)::value>(p, lobe, i, rgb, codes);
+      });
 }
 
 // ---- bufferRun in AVX2 ----

@@ -15,8 +15,8 @@
 //                  a number below 3072 as a multiply and shift (exact below 2^15).
 // AVX2 lacks AVX-512's 64-bit multiply, arithmetic shift, minimum and maximum, count of
 // leading zeros and compress: there the low 64 bits of a product come from three 32 x 32
-// products, the shifts and clamps from compares, the bit length from the scalar count per
-// lane, the packing from a permutation table.
+// products (fewer where an operand is known to be below 2^32), the shifts and clamps from
+// compares, the bit length from a double's exponent, the packing from a permutation table.
 // Test FixedSimd.* compares the lanes with shade() on random and extreme inputs.
 #pragma once
 
@@ -54,7 +54,7 @@ struct NhParams {
 // (those past n are read and ignored), the outputs as many writable ones.
 // Two kernels, each for a CPU with its instructions: AVX-512 (8 64-bit lanes) and AVX2 (4 lanes,
 // two per group; the 64-bit products, shifts and the bit length that AVX2 lacks made of its
-// 32 x 32 products, shifts and compares, and the scalar count of leading zeros).
+// 32 x 32 products, shifts, compares and double subtraction).
 constexpr size_t kMaxBatch = 512;
 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                  uint8_t* const rgb[3], int64_t* const codes[3] = nullptr);
