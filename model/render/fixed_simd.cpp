@@ -644,10 +644,6 @@ SHD_AVX2 inline __m256i sra64(__m256i x) {
   const __m256i sign = _mm256_cmpgt_epi64(_mm256_setzero_si256(), x);
   return _mm256_or_si256(_mm256_srli_epi64(x, S), _mm256_slli_epi64(sign, 64 - S));
 }
-template <int S>
-SHD_AVX2 inline __m256i roundShift64(__m256i x) {
-  return sra64<S>(_mm256_add_epi64(x, _mm256_set1_epi64x(int64_t{1} << (S - 1))));
-}
 SHD_AVX2 inline __m256i max64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(b, a)); }
 SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(a, b)); }
 // scaleCosines' operations.
@@ -744,8 +740,8 @@ SHD_AVX2 [[gnu::always_inline]] inline void codeLanes4(const NhParams& p, const 
   // The factor codes are below 2^30 and not negative (fixed_shading.cpp's factorCode), and in
   // the lanes where they count (lit) nl > 0 (below 2^34, a Q2.32 cosine) and 0 <= f < 2^32:
   // the products are not negative, diffuse nl is the sum of two 32 x 32 products, specular f
-  // one, and the rounding shifts are logical. With nl = nh 2^32 + nlo: (kd nl + 2^31) >> 32 is
-  // kd nh + ((kd nlo + 2^31) >> 32).
+  // one, and the rounding shifts are logical. With nl = nl_high 2^32 + nl_low, (kd nl + 2^31) >>
+  // 32 is kd nl_high + ((kd nl_low + 2^31) >> 32).
   const __m256i nl_high = _mm256_srli_epi64(nl, 32);
   for (size_t k = 0; k < 3; ++k) {
     const __m256i kd = _mm256_set1_epi64x(p.diffuse[k]), ks = _mm256_set1_epi64x(p.specular[k]);
