@@ -285,7 +285,7 @@ class FixedPointShader {
     uint64_t dotH() const { return h_[0]; }
     uint64_t stepL() const { return dl_[0]; }
     uint64_t stepH() const { return dh_[0]; }
-    uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint8_t* const rgb[3],
+    uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint32_t* rgb,
                         int64_t* const codes[3] = nullptr) const {
       if constexpr (kGroups)
         if (nh_ != nullptr) return nh_(simd_params_, sq, l, h, n, rgb, codes);

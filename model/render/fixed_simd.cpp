@@ -183,7 +183,7 @@ SHD_AVX512 inline void lobeGroup(const NhParams& p, const uint64_t* r64s, const 
 // kCodes: codes is not null (a compile-time case: the renderer's loop, without the test and the
 // code stores, runs some 20 % faster).
 template <bool kCodes>
-SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_t i, uint8_t* const rgb[3],
+SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_t i, uint32_t* rgb,
                                    int64_t* const codes[3]) {
   const __m512i nl = _mm512_loadu_si512(in.nl + i);
   const __m512i frac = _mm512_loadu_si512(in.frac + i), pair = _mm512_loadu_si512(in.pair + i);
@@ -197,6 +197,7 @@ SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_
                        _mm512_set1_epi64(1 << 15)),
       16);
 
+  __m512i packed = _mm512_setzero_si512();  // the lanes' packedRgb
   for (size_t k = 0; k < 3; ++k) {
     const __m512i diffuse = roundShift<32>(_mm512_mullo_epi64(_mm512_set1_epi64(p.diffuse[k]), nl));
     const __m512i specular = roundShift<24>(_mm512_mul_epu32(_mm512_set1_epi64(p.specular[k]), f));  // both below 2^32
@@ -205,9 +206,10 @@ SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_
                                                _mm512_add_epi64(diffuse, specular));
     const __m512i out = _mm512_srli_epi64(
         _mm512_add_epi64(_mm512_min_epi64(code, _mm512_set1_epi64(int64_t{255} << 12)), _mm512_set1_epi64(1 << 11)), 12);
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k] + i), _mm512_cvtepi64_epi8(out));
+    packed = _mm512_or_si512(packed, _mm512_slli_epi64(out, static_cast<unsigned>(8 * k)));
     if constexpr (kCodes) _mm512_storeu_si512(codes[k] + i, code);
   }
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgb + i), _mm512_cvtepi64_epi32(packed));
 }
 
 // AVX2 helpers, inlined into the AVX2 and the AVX-512 kernels (a subset of either's target).
@@ -331,7 +333,7 @@ template <class Scale, class Lobe, class Colour>
 }  // namespace
 
 SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                            uint8_t* const rgb[3], int64_t* const codes[3]) {
+                            uint32_t* rgb, int64_t* const codes[3]) {
   uint64_t r64[kMaxBatch];  // each group's written by scaleGroup before lobeGroup reads it
   LobeLanes lobe;           // each group's written by lobeGroup before colourGroup reads it
   return threePasses(
@@ -774,31 +776,31 @@ SHD_AVX2 inline void lobeGroupAvx2(const NhParams& p, const uint64_t* r64, const
   lobeLanes4(p, r64 + i + 4, l + i + 4, h + i + 4, validLanes4(n, 1), out, i + 4);
 }
 template <bool kCodes>
-SHD_AVX2 inline void colourGroupAvx2(const NhParams& p, const LobeLanes& in, size_t i, uint8_t* const rgb[3],
+SHD_AVX2 inline void colourGroupAvx2(const NhParams& p, const LobeLanes& in, size_t i, uint32_t* rgb,
                                      int64_t* const codes[3]) {
   __m256i a[3], b[3];
   codeLanes4(p, in, i, a);
   codeLanes4(p, in, i + 4, b);
-  // Lanes 0, 1 | 2, 3 of a to bytes 0, 1 | 2, 3 of their halves, b's to 4, 5 | 6, 7.
-  const __m256i pick_a = _mm256_setr_epi8(0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
-                                          -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1);
-  const __m256i pick_b = _mm256_setr_epi8(-1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1,  //
-                                          -1, -1, -1, -1, -1, -1, 0, 8, -1, -1, -1, -1, -1, -1, -1, -1);
+  // The lanes' packedRgb in 64-bit lanes, then their low words to 32-bit lanes 0-3 (a) and 4-7 (b).
+  __m256i pa = _mm256_setzero_si256(), pb = _mm256_setzero_si256();
   for (size_t k = 0; k < 3; ++k) {
-    const __m256i x = _mm256_or_si256(_mm256_shuffle_epi8(outputs4(a[k]), pick_a), _mm256_shuffle_epi8(outputs4(b[k]), pick_b));
-    _mm_storel_epi64(reinterpret_cast<__m128i*>(rgb[k] + i),
-                     _mm_or_si128(_mm256_castsi256_si128(x), _mm256_extracti128_si256(x, 1)));
+    pa = _mm256_or_si256(pa, _mm256_slli_epi64(outputs4(a[k]), static_cast<int>(8 * k)));
+    pb = _mm256_or_si256(pb, _mm256_slli_epi64(outputs4(b[k]), static_cast<int>(8 * k)));
     if constexpr (kCodes) {
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i), a[k]);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i + 4), b[k]);
     }
   }
+  const __m256i low_words = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgb + i),
+                      _mm256_blend_epi32(_mm256_permutevar8x32_epi32(pa, low_words),
+                                         _mm256_permutevar8x32_epi32(pb, low_words), 0xF0));
 }
 
 }  // namespace
 
 SHD_AVX2 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                              uint8_t* const rgb[3], int64_t* const codes[3]) {
+                              uint32_t* rgb, int64_t* const codes[3]) {
   uint64_t r64[kMaxBatch];  // as shadeNh's
   LobeLanes lobe;           // each group's written by lobeGroupAvx2 before colourGroupAvx2 reads it
   return threePasses(
@@ -961,7 +963,7 @@ bool cpuHasAvx512() { return false; }
 bool cpuHasAvx2() { return false; }
 bool available() { return false; }
 bool availableAvx2() { return false; }
-uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
+uint64_t shadeNh(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint32_t*,
                  int64_t* const[3]) {
   return allGroups(n);
 }
@@ -974,7 +976,7 @@ uint64_t colourRunsAvx512(const ColourRuns&, const Target&, uint8_t*, uint64_t&)
 uint64_t colourRunsAvx2(const ColourRuns&, const Target&, uint8_t*, uint64_t&) {
   throw std::logic_error("fixed_simd::colourRunsAvx2: built without the vector kernels");
 }
-uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint8_t* const[3],
+uint64_t shadeNhAvx2(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t n, uint32_t*,
                      int64_t* const[3]) {
   return allGroups(n);
 }

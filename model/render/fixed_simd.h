@@ -45,10 +45,15 @@ struct NhParams {
   std::array<int64_t, 3> ambient{}, diffuse{}, specular{};
 };
 
+// A pixel's colour bytes in one word: r | g << 8 | b << 16.
+constexpr uint32_t packedRgb(const std::array<uint8_t, 3>& c) {
+  return uint32_t{c[0]} | uint32_t{c[1]} << 8 | uint32_t{c[2]} << 16;
+}
+
 // Fragments i < n (n <= kMaxBatch) in groups of 8 (fragments 8g .. 8g + 7): squared norm sq[i]
 // (56 fraction bits) and the raw dot products N.L = l[i] and N.H = h[i] (58 fraction bits,
-// two's complement) give the output colour rgb[k][i] of channel k and, where codes is not
-// null, the 12-fraction-bit code before the output rounding (FixedShade::code) in codes[k][i].
+// two's complement) give the output colour rgb[i] (packedRgb) and, where codes is not null, the
+// 12-fraction-bit code of channel k before the output rounding (FixedShade::code) in codes[k][i].
 // Returns the groups it declines (bit g: a fragment of group g needs the scalar path); their
 // outputs are untouched. The inputs hold n rounded up to a multiple of 8 readable entries
 // (those past n are read and ignored), the outputs as many writable ones.
@@ -57,13 +62,13 @@ struct NhParams {
 // 32 x 32 products, shifts, compares and double subtraction).
 constexpr size_t kMaxBatch = 512;
 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                 uint8_t* const rgb[3], int64_t* const codes[3] = nullptr);
+                 uint32_t* rgb, int64_t* const codes[3] = nullptr);
 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
-                     uint8_t* const rgb[3], int64_t* const codes[3] = nullptr);
+                     uint32_t* rgb, int64_t* const codes[3] = nullptr);
 // The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else null (the
 // scalar datapath).
 using NhKernel = uint64_t (*)(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t,
-                              uint8_t* const[3], int64_t* const[3]);
+                              uint32_t*, int64_t* const[3]);
 NhKernel nhKernel();
 // Every group of n fragments: what shadeNh returns when it takes none.
 inline uint64_t allGroups(size_t n) { return n == 0 ? 0 : ~uint64_t{0} >> (64 - (n + 7) / 8); }
@@ -75,7 +80,7 @@ struct Batch {
   static_assert(kCap <= kMaxBatch && kCap % 8 == 0, "one shadeNh call shades a batch");
   std::array<uint64_t, kCap + 8> sq{}, l{}, h{};
   std::array<uint32_t, kCap + 8> pixel{};
-  std::array<std::array<uint8_t, kCap + 8>, 3> rgb{};
+  std::array<uint32_t, kCap + 8> rgb{};  // packedRgb
   size_t n = 0;
 };
 

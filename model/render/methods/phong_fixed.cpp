@@ -125,17 +125,18 @@ inline void fixedRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
 // Everything else that writes a colour at once flushes it first.
 template <class Kernel>
 void flushBatch(fixed_simd::Batch& b, uint8_t* const out, Kernel& kernel) {
-  uint8_t* const rgb[3] = {b.rgb[0].data(), b.rgb[1].data(), b.rgb[2].data()};
+  uint32_t* const rgb = b.rgb.data();
   const size_t n = b.n;  // a local: the pixels' byte stores may alias the batch
   const uint64_t declined = kernel.shadeBatch(b.sq.data(), b.l.data(), b.h.data(), n, rgb);
   for (uint64_t g = declined; g != 0; g &= g - 1)
-    for (size_t f = 8 * static_cast<size_t>(__builtin_ctzll(g)), e = std::min(f + 8, n); f < e; ++f) {
-      const std::array<uint8_t, 3> c = fixedColour(kernel.shadeRaw(b.sq[f], b.l[f], b.h[f]));
-      for (size_t k = 0; k < 3; ++k) rgb[k][f] = c[k];
-    }
+    for (size_t f = 8 * static_cast<size_t>(__builtin_ctzll(g)), e = std::min(f + 8, n); f < e; ++f)
+      rgb[f] = fixed_simd::packedRgb(fixedColour(kernel.shadeRaw(b.sq[f], b.l[f], b.h[f])));
   for (size_t f = 0; f < n; ++f) {
-    const size_t p = b.pixel[f];
-    for (size_t k = 0; k < 3; ++k) out[p * 3 + k] = rgb[k][f];
+    uint8_t* const px = out + 3 * size_t{b.pixel[f]};
+    const uint32_t c = rgb[f];
+    px[0] = static_cast<uint8_t>(c);
+    px[1] = static_cast<uint8_t>(c >> 8);
+    px[2] = static_cast<uint8_t>(c >> 16);
   }
   b.n = 0;
 }
