@@ -152,11 +152,9 @@ SHD_AVX512 inline bool scaleGroup(const uint64_t* sq, int n, uint64_t* r64_out) 
   return true;
 }
 
-// The lobe lookups and colours of a group, in two passes over the groups (as shadeNhAvx2's,
-// below): lobeGroup from the cosine scales (scaleGroup's) and dot products, the scaled N.L,
-// the lobe table's pair of entries at N.H and the step to the next, stored in a LobeLanes;
-// colourGroup from those, the colours. The table's gather ends the first pass's short chain,
-// and the groups behind it overlap its wait.
+// What lobeGroup leaves colourGroup (shadeNh's second and third passes, above; shadeNhAvx2's
+// too): per fragment the scaled N.L, the step from the lobe table's entry at N.H to the next
+// (frac) and the pair of entries.
 struct LobeLanes {
   uint64_t nl[kMaxBatch], frac[kMaxBatch], pair[kMaxBatch];
 };
