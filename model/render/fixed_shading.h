@@ -159,10 +159,13 @@ inline uint32_t cosCode(int64_t c32, int frac) {
 }
 // A lobe table (kFixedCosFrac-bit entries and the copy of the last) at a Q2.32 cosine clamped
 // to [0, 1]: the entry below and the linear step to the next with the cosine's next 16 bits,
-// rounded half up.
-inline uint32_t lobeAt(const uint32_t* t, int64_t c32) {
+// rounded half up. Below zero_below (LobeTable::zero_below) both entries are 0, and so is the
+// result: the table is not read there (most cosines of a high exponent, and a read of its
+// 256 KB that would miss the first-level cache).
+inline uint32_t lobeAt(const uint32_t* t, int64_t c32, uint32_t zero_below = 0) {
   const uint64_t c = static_cast<uint64_t>(std::clamp<int64_t>(c32, 0, int64_t{1} << 32));
   const uint64_t i = c >> (32 - kFixedCosFrac), frac = c & ((uint64_t{1} << (32 - kFixedCosFrac)) - 1);
+  if (i < zero_below) return 0;
   const int64_t step = int64_t{t[i + 1]} - int64_t{t[i]};
   return static_cast<uint32_t>(t[i] + roundShift(step * static_cast<int64_t>(frac), 32 - kFixedCosFrac));
 }
@@ -246,6 +249,7 @@ class FixedPointShader {
   struct Consts {
     std::array<int64_t, 3> ambient;
     const uint32_t* table;  // the lobe table (lobes of one cosine)
+    uint32_t zero_below;    // and its LobeTable::zero_below
     PerLight* lights;
     size_t count;
   };
@@ -263,6 +267,7 @@ class FixedPointShader {
       for (size_t i = 0; i < NL; ++i) lights_[i] = sh.lights_[i];
       ambient_ = sh.ambient_;
       table_ = sh.table_ ? sh.table_->code.data() : nullptr;
+      zero_below_ = sh.table_ ? sh.table_->zero_below : 0;
       if constexpr (kGroups) {
         nh_ = fixed_simd::nhKernel();
         simd_params_ = {table_, sh.table_->zero_below, ambient_, lights_[0].diffuse, lights_[0].specular};
@@ -325,7 +330,7 @@ class FixedPointShader {
     // The datapath from the raw dot products of the NL lights (and the current fragment's N.V).
     FixedShade shadeAt(uint64_t sqnorm, const uint64_t* l, const uint64_t* h) {
       return sh_.shadeDots<C>(
-          Consts{ambient_, table_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
+          Consts{ambient_, table_, zero_below_, lights_.data(), NL}, sqnorm, static_cast<int64_t>(v_),
           [&](size_t i, PerLight&) { return static_cast<int64_t>(l[i]); },
           [&](size_t i, const PerLight&) { return static_cast<int64_t>(h[i]); }, nullptr);
     }
@@ -333,6 +338,7 @@ class FixedPointShader {
     std::array<PerLight, NL> lights_;
     std::array<int64_t, 3> ambient_;
     const uint32_t* table_;
+    uint32_t zero_below_;
     uint64_t v_ = 0, dv_ = 0;
     std::array<uint64_t, NL> l_{}, dl_{}, h_{}, dh_{};
     std::array<int64_t, 3> dn_{};  // the steps' normal increment
@@ -392,7 +398,8 @@ inline FixedShade FixedPointShader::shadeAs(const int64_t* n28, uint64_t sqnorm,
   using fixed_detail::dot58;
   constexpr bool needs_nv = needsNv(C);
   return shadeDots<C>(
-      Consts{ambient_, table_ ? table_->code.data() : nullptr, lights_.data(), lights_.size()}, sqnorm,
+      Consts{ambient_, table_ ? table_->code.data() : nullptr, table_ ? table_->zero_below : 0, lights_.data(),
+             lights_.size()}, sqnorm,
       needs_nv ? dot58(n28, v_) : 0,
       [&](size_t, PerLight& pl) {
         if (pl.light->point) setDirections(pl, lightDirection(*pl.light, p_cam));
@@ -422,12 +429,12 @@ inline FixedShade FixedPointShader::shadeDots(const Consts& k, uint64_t sqnorm, 
     } else {
       uint32_t f = 0;
       if constexpr (C == Cosine::NH) {
-        f = lobeAt(k.table, nh);
+        f = lobeAt(k.table, nh, k.zero_below);
       } else if constexpr (C == Cosine::RV) {
         // R.V = 2 (N.L)(N.V) - L.V: the product of two Q2.32 is Q4.64, 2 x it back to Q2.32
         const __int128 p = static_cast<__int128>(nl) * nv;
         const int64_t rv = static_cast<int64_t>((p + (__int128{1} << 30)) >> 31) - pl.lv;
-        f = lobeAt(k.table, rv);
+        f = lobeAt(k.table, rv, k.zero_below);
       } else {
         f = cookTorranceCode(nl, nv, nh, pl);
       }

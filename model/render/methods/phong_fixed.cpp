@@ -241,7 +241,15 @@ class PhongFixedUnit final : public MethodUnit {
 
   void beginObject() override {
     const ObjectShading& o = f_.obj;
+    group_.reset();  // the previous object's: it refers to its shader
     fixed_.emplace(f_.ctx, *o.material, o.lobe, &o.coding, o.spec != nullptr ? o.spec->memo() : nullptr);
+    // The vector kernel's case: its run kernel built once for all of the object's triangles
+    // (built per triangle, its copies of the constants took 3 % of a frame).
+    if (f_.walker != nullptr && f_.opt.vector_kernel && fixed_->takesRuns())
+      fixed_->withRunKernel([&](auto& kernel) {
+        if constexpr (std::decay_t<decltype(kernel)>::kGroups)
+          if (kernel.vectorised()) group_.emplace(kernel);
+      });
   }
 
   void draw(const SpanTriangle& tri) override {
@@ -249,11 +257,8 @@ class PhongFixedUnit final : public MethodUnit {
     FixedTriangle t(f_, *fixed_, *batch_, req_, tri);
     // Runs where the shader takes them (directional lights; device lobes on the memo).
     if (f_.walker != nullptr && !t.batched && fixed_->takesRuns()) {
-      fixed_->withRunKernel([&](auto& kernel) {
-        if constexpr (std::decay_t<decltype(kernel)>::kGroups)
-          if (f_.opt.vector_kernel && kernel.vectorised()) return walkBatched(t, tri, kernel);
-        walkRuns(t, tri, kernel);
-      });
+      if (group_) walkBatched(t, tri, *group_);
+      else fixed_->withRunKernel([&](auto& kernel) { walkRuns(t, tri, kernel); });
     } else {
       auto fragment = [&t](int32_t x, int32_t y, const int64_t* attr) { fixedFragment(t, x, y, attr); };
       f_.walk(tri, fragment);
@@ -261,18 +266,16 @@ class PhongFixedUnit final : public MethodUnit {
     req_.finish(f_, t.write);
   }
 
-  // The object's fragments still in the batch (the vector kernel's case: its kernel).
+  // The object's fragments still in the batch (the vector kernel's case).
   void endObject() override {
-    if (batch_->n > 0)
-      fixed_->withRunKernel([&](auto& kernel) {
-        if constexpr (std::decay_t<decltype(kernel)>::kGroups) flushBatch(*batch_, f_.fb.rgb.data(), kernel);
-      });
+    if (batch_->n > 0 && group_) flushBatch(*batch_, f_.fb.rgb.data(), *group_);
     if (batch_->n > 0) throw std::logic_error("render: fragments left in the batch of another shader");
   }
 
  private:
   Frame& f_;
   std::optional<FixedPointShader> fixed_;  // the object's
+  std::optional<FixedPointShader::RunKernel<FixedCosine::NH, 1>> group_;  // its vector kernel's case
   std::unique_ptr<fixed_simd::Batch> batch_;
   PixelRequests req_;
 };
