@@ -190,12 +190,12 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
   EXPECT_THROW(FixedPointShader(ctx, s.materials.at(0), Lobe::Quadratic, nullptr, nullptr), std::logic_error);
 }
 
-// The vector kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2) against shade(), lane by lane:
+// The batch kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2, shadeNhScalar) against shade(), lane by lane:
 // runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms of every bit
 // length up to 64; codes up to 2^31), facing the light or away, for each lobe they take, with
 // factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
-// make a kernel decline the group. Each kernel where the CPU has its instructions; the test is
-// skipped, and says so, where it has neither.
+// make a kernel decline the group. Each vector kernel where the CPU has its instructions, and
+// the plain C++ one everywhere.
 static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
   SCOPED_TRACE(name);
   std::mt19937_64 rng(12);
@@ -277,22 +277,33 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
 }
 
 TEST(FixedSimd, LanesEqualTheScalarDatapath) {
-  if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
   if (fixed_simd::cpuHasAvx512()) checkNhKernel("avx512", fixed_simd::shadeNh);
   if (fixed_simd::cpuHasAvx2()) checkNhKernel("avx2", fixed_simd::shadeNhAvx2);
+  checkNhKernel("scalar", fixed_simd::shadeNhScalar);
 }
 
 // What a renderer's run kernel shades its batches with: the vector kernel where the CPU has one
-// (and SHD_SCALAR is not set), none (every group left to the scalar datapath) where it has not.
+// (and SHD_SCALAR is not set), the plain C++ one where it has not, and the buffer kernels that
+// go with each.
 TEST(FixedSimd, RunKernelTakesTheCpusKernel) {
   const Scene s = loadScene("builtin:sphere");
   const ShadeContext ctx = makeShadeContext(s);
   FixedPointShader fixed(ctx, s.materials.at(0), Lobe::Blinn, nullptr, nullptr);
   fixed.withRunKernel([&](auto kernel) {
     if constexpr (decltype(kernel)::kGroups) {
-      EXPECT_EQ(kernel.vectorised(), fixed_simd::nhKernel() != nullptr);
-      EXPECT_EQ(fixed_simd::nhKernel() != nullptr, fixed_simd::available() || fixed_simd::availableAvx2());
-      EXPECT_EQ(fixed_simd::bufferKernel() != nullptr, fixed_simd::nhKernel() != nullptr);
+      const bool avx512 = fixed_simd::available(), avx2 = fixed_simd::availableAvx2();
+      EXPECT_EQ(fixed_simd::nhKernel(),
+                avx512 ? fixed_simd::shadeNh : avx2 ? fixed_simd::shadeNhAvx2 : fixed_simd::shadeNhScalar);
+      EXPECT_EQ(fixed_simd::bufferKernel(),
+                avx512 ? fixed_simd::bufferRun : avx2 ? fixed_simd::bufferRunAvx2 : fixed_simd::bufferRunScalar);
+      EXPECT_EQ(fixed_simd::spansBufferKernel(), avx512 ? fixed_simd::bufferSpans
+                                                 : avx2 ? fixed_simd::bufferSpansAvx2
+                                                        : fixed_simd::bufferSpansScalar);
+      // The batch's shades equal the scalar datapath's (what shadeBatch gives, LanesEqualTheScalarDatapath).
+      uint64_t sq[8] = {uint64_t{1} << 56}, l[8] = {uint64_t{1} << 57}, h[8] = {uint64_t{1} << 57};
+      uint32_t rgb[8] = {};
+      EXPECT_EQ(kernel.shadeBatch(sq, l, h, 1, rgb), 0u);
+      EXPECT_EQ(rgb[0], fixed_simd::packedRgb(fixedColour(kernel.shadeRaw(sq[0], l[0], h[0]))));
     } else {
       FAIL() << "one directional light and blinn: the vector case";
     }
@@ -348,7 +359,8 @@ bool zTestWrite(const fixed_simd::RunPixels& px, size_t k, int32_t tag, std::vec
 
 }  // namespace
 
-// fixed_simd::bufferRun and bufferRunAvx2 (each where the CPU has its instructions) against the
+// fixed_simd::bufferRun and bufferRunAvx2 (each where the CPU has its instructions) and
+// bufferRunScalar against the
 // run loop they replace, fragment by fragment: runs of 1 to 40 pixels from every start offset,
 // over depth buffers holding codes above, below and equal to the run's (and 0, not covered),
 // with depth codes and steps that wrap mod 2^32, squared norms from SquaredNormRecurrence and
@@ -424,12 +436,12 @@ static void checkBufferKernel(const char* name, fixed_simd::BufferKernel buffer_
 }
 
 TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
-  if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
   if (fixed_simd::cpuHasAvx512()) checkBufferKernel("avx512", fixed_simd::bufferRun);
   if (fixed_simd::cpuHasAvx2()) checkBufferKernel("avx2", fixed_simd::bufferRunAvx2);
+  checkBufferKernel("scalar", fixed_simd::bufferRunScalar);
 }
 
-// fixed_simd::bufferSpans and bufferSpansAvx2 against what phong-fixed did before them with a
+// fixed_simd::bufferSpans, bufferSpansAvx2 and bufferSpansScalar against what phong-fixed did before them with a
 // triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made a Run as
 // batchRun makes it (dot58 of the codes at its first pixel, SquaredNormRecurrence::terms) and
 // buffered by the kernel's bufferRun, already held to the run loop above. Random rows' spans of
@@ -537,9 +549,9 @@ static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spa
 }
 
 TEST(FixedSimd, BufferSpansEqualsTheRowsRuns) {
-  if (!fixed_simd::cpuHasAvx512() && !fixed_simd::cpuHasAvx2()) GTEST_SKIP() << "no AVX-512 or AVX2 here";
   if (fixed_simd::cpuHasAvx512()) checkSpansKernel("avx512", fixed_simd::bufferSpans, fixed_simd::bufferRun);
   if (fixed_simd::cpuHasAvx2()) checkSpansKernel("avx2", fixed_simd::bufferSpansAvx2, fixed_simd::bufferRunAvx2);
+  checkSpansKernel("scalar", fixed_simd::bufferSpansScalar, fixed_simd::bufferRunScalar);
 }
 
 // The colour-run kernels (fixed_simd::colourRunsAvx512, colourRunsAvx2) against the flat/Gouraud

@@ -777,13 +777,12 @@ TEST(Render, NormalBisectionBetweenPhongAndLinearNormals) {
 }
 
 // The vector run paths (fixed_simd.h: flat and Gouraud runs, and phong-fixed's batches, which
-// collect the runs of several triangles of an object, in AVX-512 or AVX2) against the scalar
-// paths, on whole frames: the same colours, depths, triangle ids and statistics, on scenes
+// collect the runs of several triangles of an object, in AVX-512, AVX2 or, where neither runs,
+// plain C++) against the scalar paths (RenderOptions::vector_kernel false: phong-fixed's run
+// loop), on whole frames: the same colours, depths, triangle ids and statistics, on scenes
 // where triangles overlap (the teapots, the torus) and objects change shaders (materials), in
-// lane modes with runs and without. Skipped on a CPU without either kernel.
+// lane modes with runs and without. ctest runs it again with SHD_NO_AVX512 and with SHD_SCALAR.
 TEST(Render, VectorPathsEqualTheScalarPaths) {
-  if (!fixed_simd::available() && !fixed_simd::availableAvx2())
-    GTEST_SKIP() << "no AVX-512 or AVX2 here (or SHD_SCALAR set): only the scalar paths run";
   const std::string teapots = "/usr/share/assimp/models/Collada/teapots.DAE";
   ASSERT_TRUE(fs::exists(teapots)) << teapots << " missing: scripts/install_deps.sh installs assimp-testmodels";
   struct Case {

@@ -255,9 +255,10 @@ class Frame {
   const ShadeContext ctx;
   SpanEngine& span;
   const SpanParams* const walker;  // span.walker(): fragments shaded as the model's walk produces them
-  // phong-fixed's runs of a row to the vector kernels (fixed_simd.h): left to right, with depth
-  // codes that fit int32_t (AttrBits <= 32), z-tested into the batch by this kernel
-  // (fixed_simd::bufferKernel, AVX-512 or AVX2); null: the scalar run loop.
+  // phong-fixed's runs of a row to its batch (fixed_simd.h): left to right, with depth codes
+  // that fit int32_t (AttrBits <= 32), z-tested into the batch by this kernel
+  // (fixed_simd::bufferKernel: AVX-512, AVX2 or plain C++); null (RenderOptions::vector_kernel
+  // false): the run loop.
   const fixed_simd::BufferKernel buffer_run;
   // The same kernel's pass over a triangle's rows' spans (fixed_simd::spansBufferKernel), null
   // where buffer_run is.

@@ -273,16 +273,15 @@ class FixedPointShader {
         simd_params_ = {table_, sh.table_->zero_below, ambient_, lights_[0].diffuse, lights_[0].specular};
       }
     }
-    // The vector kernel's case (fixed_simd.h): one light and a lobe of N.H. Its fragments are
-    // shaded away from their runs, from their squared norms and raw dot products N.L and N.H
-    // (dotL, dotH at the current fragment; stepL, stepH per fragment), kept in buffers:
-    //   shadeBatch  up to fixed_simd::kMaxBatch of them, 8 at a time (fixed_simd::shadeNh):
-    //               the groups of 8 it does not take, all of them without the vector kernel;
+    // The batch's case (fixed_simd.h): one light and a lobe of N.H. Its fragments are shaded
+    // away from their runs, from their squared norms and raw dot products N.L and N.H (dotL,
+    // dotH at the current fragment; stepL, stepH per fragment), kept in buffers:
+    //   shadeBatch  up to fixed_simd::kMaxBatch of them, 8 at a time (fixed_simd::nhKernel():
+    //               AVX-512, AVX2 or plain C++), declining the groups of 8 it does not take;
     //   shadeRaw    one of them in the scalar datapath.
     // Both give what shade() gives.
     static constexpr bool kGroups = C == Cosine::NH && NL == 1;
     static constexpr bool kNeedsNv = needsNv(C);
-    bool vectorised() const { return nh_ != nullptr; }
     const fixed_simd::NhParams& nhParams() const { return simd_params_; }
     const std::array<int32_t, 3>& lightL() const { return lights_[0].l; }  // the one light's (kGroups)
     const std::array<int32_t, 3>& lightH() const { return lights_[0].h; }
@@ -292,8 +291,7 @@ class FixedPointShader {
     uint64_t stepH() const { return dh_[0]; }
     uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint32_t* rgb,
                         int64_t* const codes[3] = nullptr) const {
-      if constexpr (kGroups)
-        if (nh_ != nullptr) return nh_(simd_params_, sq, l, h, n, rgb, codes);
+      if constexpr (kGroups) return nh_(simd_params_, sq, l, h, n, rgb, codes);
       return fixed_simd::allGroups(n);
     }
     FixedShade shadeRaw(uint64_t sqnorm, uint64_t l, uint64_t h) {

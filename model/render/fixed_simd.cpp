@@ -19,6 +19,84 @@ namespace {
 bool oneColour(const RowSpans& s) {
   return (s.didx[0] | s.didx[1] | s.didx[2] | s.didy[0] | s.didy[1] | s.didy[2]) == 0;
 }
+
+// shadeNh's loop: the groups of 8 of n fragments, group(i, count) shading fragments i .. i +
+// count - 1 (false: it declines them); returns the groups declined. Inlined into each kernel
+// with the kernel's group, a lambda with the kernel's target.
+template <class Group>
+[[gnu::always_inline]] inline uint64_t eachGroup(size_t n, Group group) {
+  uint64_t declined = 0;
+  for (size_t g = 0; g * 8 < n; ++g)
+    if (!group(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)))) declined |= uint64_t{1} << g;
+  return declined;
+}
+
+// A later pass of shadeNh's: shade(i, count, codes) for each group not declined, codes a
+// std::bool_constant (kCodes: the kernel stores the codes).
+template <bool kCodes, class Shade>
+[[gnu::always_inline]] inline void shadePass(size_t n, uint64_t declined, Shade& shade) {
+  for (size_t g = 0; g * 8 < n; ++g)
+    if (((declined >> g) & 1) == 0)
+      shade(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)), std::bool_constant<kCodes>{});
+}
+// shadeNh's three passes: scale(i, count) for every group (eachGroup's group), then, each for
+// every group not declined (shadePass), lobe(i, count, std::false_type) and colour(i, count,
+// codes) (codes: with codes, the caller wants them). Returns the groups declined. n is at most
+// kMaxBatch (the kernels' arrays).
+template <class Scale, class Lobe, class Colour>
+[[gnu::always_inline]] inline uint64_t threePasses(size_t n, bool codes, Scale scale, Lobe lobe, Colour colour) {
+  if (n > kMaxBatch) throw std::logic_error("fixed_simd: a batch of more than kMaxBatch fragments");
+  const uint64_t declined = eachGroup(n, scale);
+  shadePass<false>(n, declined, lobe);
+  if (codes)
+    shadePass<true>(n, declined, colour);
+  else
+    shadePass<false>(n, declined, colour);
+  return declined;
+}
+
+// A triangle's rows' spans as its runs (NhSpans): the dot products and the squared-norm terms of
+// row i's first pixel from the triangle's, the runs buffered by buffer(run, first fragment) from
+// `at` on. Where a row's run stops (the batch full), `at` is left at its next fragment.
+// The dot products are linear mod 2^64 (dot58 is a sum of products mod 2^64), so at the row's
+// first pixel, RowSpans::at(k, lo, i) = a0 + u didx + i didy with u = lo - x0, N.L is
+// a0.L + u (didx.L) + i (didy.L), each mod 2^64: the values batchRun takes from dot58 of the
+// codes there.
+template <class Buffer>
+[[gnu::always_inline]] inline bool eachSpanRun(const NhSpans& r, SpanCursor& at, Buffer buffer) {
+  const RowSpans& s = *r.s;
+  auto dot = [](const std::array<int64_t, 4>& n, const std::array<int32_t, 3>& u) {
+    return static_cast<uint64_t>(fixed_detail::dot58(n.data(), u));
+  };
+  const uint64_t l0 = dot(s.a0, r.l), lx = dot(s.didx, r.l), ly = dot(s.didy, r.l);
+  const uint64_t h0 = dot(s.a0, r.h), hx = dot(s.didx, r.h), hy = dot(s.didy, r.h);
+  const std::array<int64_t, 3> dn{s.didx[0], s.didx[1], s.didx[2]};
+  Run run;
+  run.dl = lx;
+  run.dh = hx;
+  run.px.dz = static_cast<uint32_t>(s.didx[3]);
+  for (; at.row < s.rows; ++at.row, at.k = 0) {
+    const int32_t i = at.row;
+    const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
+    if (lo > hi || ((r.rows >> i) & 1) == 0) continue;
+    const uint64_t u = static_cast<uint64_t>(lo - s.x0), iu = static_cast<uint64_t>(i);
+    const SquaredNormRecurrence::Terms sq =
+        SquaredNormRecurrence::terms({s.at(0, lo, i), s.at(1, lo, i), s.at(2, lo, i)}, dn);
+    run.a = sq.a;
+    run.two_b = sq.two_b;
+    run.c = sq.c;
+    run.l = l0 + u * lx + iu * ly;
+    run.h = h0 + u * hx + iu * hy;
+    run.px.p = static_cast<size_t>(s.y0 + i) * r.W + static_cast<size_t>(lo);
+    run.px.count = static_cast<size_t>(hi - lo + 1);
+    run.px.z = static_cast<uint32_t>(s.at(3, lo, i));
+    run.room = r.W - static_cast<size_t>(lo);
+    at.k = buffer(run, at.k);
+    if (at.k < run.px.count) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 #ifdef SHD_X86_KERNELS
@@ -291,41 +369,6 @@ SHD_AVX512 inline __mmask8 zTest8(const Target& t, size_t p, size_t left, __m256
   _mm256_mask_storeu_epi32(depth, pass, z);
   if (t.tri != nullptr) _mm256_mask_storeu_epi32(t.tri + p, pass, _mm256_set1_epi32(t.tag));
   return pass;
-}
-
-// shadeNh's loop: the groups of 8 of n fragments, group(i, count) shading fragments i .. i +
-// count - 1 (false: it declines them); returns the groups declined. Inlined into each kernel
-// with the kernel's group, a lambda with the kernel's target.
-template <class Group>
-[[gnu::always_inline]] inline uint64_t eachGroup(size_t n, Group group) {
-  uint64_t declined = 0;
-  for (size_t g = 0; g * 8 < n; ++g)
-    if (!group(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)))) declined |= uint64_t{1} << g;
-  return declined;
-}
-
-// A later pass of shadeNh's: shade(i, count, codes) for each group not declined, codes a
-// std::bool_constant (kCodes: the kernel stores the codes).
-template <bool kCodes, class Shade>
-[[gnu::always_inline]] inline void shadePass(size_t n, uint64_t declined, Shade& shade) {
-  for (size_t g = 0; g * 8 < n; ++g)
-    if (((declined >> g) & 1) == 0)
-      shade(g * 8, static_cast<int>(std::min<size_t>(8, n - g * 8)), std::bool_constant<kCodes>{});
-}
-// shadeNh's three passes: scale(i, count) for every group (eachGroup's group), then, each for
-// every group not declined (shadePass), lobe(i, count, std::false_type) and colour(i, count,
-// codes) (codes: with codes, the caller wants them). Returns the groups declined. n is at most
-// kMaxBatch (the kernels' arrays).
-template <class Scale, class Lobe, class Colour>
-[[gnu::always_inline]] inline uint64_t threePasses(size_t n, bool codes, Scale scale, Lobe lobe, Colour colour) {
-  if (n > kMaxBatch) throw std::logic_error("fixed_simd: a batch of more than kMaxBatch fragments");
-  const uint64_t declined = eachGroup(n, scale);
-  shadePass<false>(n, declined, lobe);
-  if (codes)
-    shadePass<true>(n, declined, colour);
-  else
-    shadePass<false>(n, declined, colour);
-  return declined;
 }
 
 }  // namespace
@@ -897,48 +940,6 @@ SHD_AVX2 [[gnu::always_inline]] inline size_t bufferRunAvx2In(const Run& r, size
   return std::min(k, r.px.count);
 }
 
-// A triangle's rows' spans as its runs (NhSpans): the dot products and the squared-norm terms of
-// row i's first pixel from the triangle's, the runs buffered by buffer(run, first fragment) from
-// `at` on. Where a row's run stops (the batch full), `at` is left at its next fragment.
-// The dot products are linear mod 2^64 (dot58 is a sum of products mod 2^64), so at the row's
-// first pixel, RowSpans::at(k, lo, i) = a0 + u didx + i didy with u = lo - x0, N.L is
-// a0.L + u (didx.L) + i (didy.L), each mod 2^64: the values batchRun takes from dot58 of the
-// codes there.
-template <class Buffer>
-[[gnu::always_inline]] inline bool eachSpanRun(const NhSpans& r, SpanCursor& at, Buffer buffer) {
-  const RowSpans& s = *r.s;
-  auto dot = [](const std::array<int64_t, 4>& n, const std::array<int32_t, 3>& u) {
-    return static_cast<uint64_t>(fixed_detail::dot58(n.data(), u));
-  };
-  const uint64_t l0 = dot(s.a0, r.l), lx = dot(s.didx, r.l), ly = dot(s.didy, r.l);
-  const uint64_t h0 = dot(s.a0, r.h), hx = dot(s.didx, r.h), hy = dot(s.didy, r.h);
-  const std::array<int64_t, 3> dn{s.didx[0], s.didx[1], s.didx[2]};
-  Run run;
-  run.dl = lx;
-  run.dh = hx;
-  run.px.dz = static_cast<uint32_t>(s.didx[3]);
-  for (; at.row < s.rows; ++at.row, at.k = 0) {
-    const int32_t i = at.row;
-    const int64_t lo = s.span[static_cast<size_t>(i)][0], hi = s.span[static_cast<size_t>(i)][1];
-    if (lo > hi || ((r.rows >> i) & 1) == 0) continue;
-    const uint64_t u = static_cast<uint64_t>(lo - s.x0), iu = static_cast<uint64_t>(i);
-    const SquaredNormRecurrence::Terms sq =
-        SquaredNormRecurrence::terms({s.at(0, lo, i), s.at(1, lo, i), s.at(2, lo, i)}, dn);
-    run.a = sq.a;
-    run.two_b = sq.two_b;
-    run.c = sq.c;
-    run.l = l0 + u * lx + iu * ly;
-    run.h = h0 + u * hx + iu * hy;
-    run.px.p = static_cast<size_t>(s.y0 + i) * r.W + static_cast<size_t>(lo);
-    run.px.count = static_cast<size_t>(hi - lo + 1);
-    run.px.z = static_cast<uint32_t>(s.at(3, lo, i));
-    run.room = r.W - static_cast<size_t>(lo);
-    at.k = buffer(run, at.k);
-    if (at.k < run.px.count) return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
@@ -995,6 +996,94 @@ bool bufferSpansAvx2(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_
 }
 
 #endif
+
+// ---- phong-fixed's batch in plain C++ (no intrinsics) ----
+// shadeNh's three passes with the scalar datapath's own functions (cosineScale, scaleCosine,
+// lobeAt, unorm8FromCode), fragment by fragment: where no vector kernel runs, the batch still
+// keeps the runs' z-test and buffering apart from the datapath and lets the processor overlap
+// the independent fragments of a pass.
+uint64_t shadeNhScalar(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                       uint32_t* rgb, int64_t* const codes[3]) {
+  uint64_t r64[kMaxBatch];  // each group's written by the first pass before the second reads it
+  int64_t nl[kMaxBatch];    // the second pass's, for the third
+  uint32_t f[kMaxBatch];
+  return threePasses(
+      n, codes != nullptr,
+      [&](size_t i, int count) {
+        // A group with a squared norm below cosineScale's fast path (r64 == 0) is declined.
+        for (size_t e = i + static_cast<size_t>(count); i < e; ++i)
+          if ((r64[i] = static_cast<uint64_t>(cosineScale(sq[i]).r64)) == 0) return false;
+        return true;
+      },
+      [&](size_t i, int count, auto) {
+        for (size_t e = i + static_cast<size_t>(count); i < e; ++i) {
+          const CosineScale c{0, 1, static_cast<int64_t>(r64[i])};
+          nl[i] = scaleCosine(static_cast<int64_t>(l[i]), c);
+          f[i] = 0;  // N.H scaled only where the light reaches (as shadeDots)
+          if (nl[i] > 0) f[i] = fixed_detail::lobeAt(p.table, scaleCosine(static_cast<int64_t>(h[i]), c), p.zero_below);
+        }
+      },
+      [&](size_t i, int count, auto with_codes) {
+        using fixed_detail::roundShift;
+        for (size_t e = i + static_cast<size_t>(count); i < e; ++i) {
+          uint32_t packed = 0;
+          for (size_t k = 0; k < 3; ++k) {
+            int64_t code = p.ambient[k];
+            if (nl[i] > 0) code += roundShift(p.diffuse[k] * nl[i], 32) + roundShift(p.specular[k] * f[i], 24);
+            if constexpr (decltype(with_codes)::value) codes[k][i] = code;
+            packed |= uint32_t{unorm8FromCode(code, kFixedColourFrac)} << (8 * k);
+          }
+          rgb[i] = packed;
+        }
+      });
+}
+
+// bufferRun's z-test and buffering fragment by fragment, in its groups of 8 (the same stops when
+// the batch has room for fewer than 8 more); its values stepped by adds from the run's first
+// fragment taken: the squared norm by its difference two_b + c (2 k + 1), mod 2^64.
+namespace {
+[[gnu::always_inline]] inline size_t bufferRunScalarIn(const Run& r, size_t first, const Target& t, Batch& b,
+                                                       uint64_t& fresh) {
+  const uint64_t k0 = first;
+  uint64_t sq = r.a + k0 * r.two_b + k0 * k0 * r.c, dsq = r.two_b + r.c * (2 * k0 + 1);
+  uint64_t l = r.l + k0 * r.dl, h = r.h + k0 * r.dh;
+  uint32_t z = r.px.z + static_cast<uint32_t>(k0) * r.px.dz;
+  size_t n = b.n, k = first;
+  uint64_t covered = 0;
+  for (; k < r.px.count && n + 8 <= Batch::kCap;) {
+    for (const size_t e = std::min(k + 8, r.px.count); k < e; ++k) {
+      const size_t p = r.px.p + k;
+      const int32_t old = t.depth[p];
+      if (static_cast<int32_t>(z) > old) {
+        covered += old == 0 ? 1 : 0;
+        t.depth[p] = static_cast<int32_t>(z);
+        if (t.tri != nullptr) t.tri[p] = t.tag;
+        b.sq[n] = sq;
+        b.l[n] = l;
+        b.h[n] = h;
+        b.pixel[n] = static_cast<uint32_t>(p);
+        ++n;
+      }
+      sq += dsq;
+      dsq += 2 * r.c;
+      l += r.dl;
+      h += r.dh;
+      z += r.px.dz;
+    }
+  }
+  b.n = n;
+  fresh += covered;
+  return k;
+}
+
+}  // namespace
+
+size_t bufferRunScalar(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh) {
+  return bufferRunScalarIn(r, first, t, b, fresh);
+}
+bool bufferSpansScalar(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh) {
+  return eachSpanRun(r, at, [&](const Run& run, size_t first) { return bufferRunScalarIn(run, first, t, b, fresh); });
+}
 
 // colourSpansAvx2's rows pixel by pixel in plain C++ (no intrinsics): the same codes (RowSpans::at
 // mod 2^32, in 32-bit lanes), the same z-test of int32_t codes and the same colour bytes. The
@@ -1079,20 +1168,22 @@ uint64_t colourSpansScalar(const RowSpans& s, size_t W, int frac, const Target& 
 }
 
 // Each kernel's choice: the AVX-512 one where available(), else the AVX2 one where
-// availableAvx2(), else null (the scalar path; always without SHD_X86_KERNELS).
+// availableAvx2(), else the plain C++ one where there is one, else null (the run loop; always
+// without SHD_X86_KERNELS).
 namespace {
 template <class Kernel>
-Kernel byCpu(Kernel avx512, Kernel avx2) {
-  return available() ? avx512 : availableAvx2() ? avx2 : nullptr;
+Kernel byCpu(Kernel avx512, Kernel avx2, Kernel scalar = nullptr) {
+  return available() ? avx512 : availableAvx2() ? avx2 : scalar;
 }
 }  // namespace
 ColourKernel colourKernel() { return byCpu<ColourKernel>(colourRunsAvx512, colourRunsAvx2); }
 ColourSpansKernel colourSpansKernel() {
-  const ColourSpansKernel vector = byCpu<ColourSpansKernel>(colourSpansAvx512, colourSpansAvx2);
-  return vector != nullptr ? vector : colourSpansScalar;
+  return byCpu<ColourSpansKernel>(colourSpansAvx512, colourSpansAvx2, colourSpansScalar);
 }
-NhKernel nhKernel() { return byCpu<NhKernel>(shadeNh, shadeNhAvx2); }
-BufferKernel bufferKernel() { return byCpu<BufferKernel>(bufferRun, bufferRunAvx2); }
-SpansBufferKernel spansBufferKernel() { return byCpu<SpansBufferKernel>(bufferSpans, bufferSpansAvx2); }
+NhKernel nhKernel() { return byCpu<NhKernel>(shadeNh, shadeNhAvx2, shadeNhScalar); }
+BufferKernel bufferKernel() { return byCpu<BufferKernel>(bufferRun, bufferRunAvx2, bufferRunScalar); }
+SpansBufferKernel spansBufferKernel() {
+  return byCpu<SpansBufferKernel>(bufferSpans, bufferSpansAvx2, bufferSpansScalar);
+}
 
 }  // namespace shd::fixed_simd

@@ -2,7 +2,8 @@
 // CPU has it, else in AVX2 where it has that: the z-test and writes of the runs of a row (flat
 // and Gouraud colours; phong-fixed's inputs into a batch), and phong-fixed's datapath, the same
 // integer operations as FixedPointShader::shade() (fixed_shading.h, normalize.h), lane by lane,
-// so the same colours.
+// so the same colours. Where neither runs, phong-fixed's batch is kept in plain C++ kernels
+// (shadeNhScalar, bufferRunScalar, bufferSpansScalar).
 // The datapath covers the common case, one directional light and a lobe of N.H from a table
 // (blinn, pow, normalized-blinn, schlick); everything else, and lanes it cannot take (a squared
 // norm below 2^8, see CosineScale), stays scalar.
@@ -59,14 +60,17 @@ constexpr uint32_t packedRgb(const std::array<uint8_t, 3>& c) {
 // (those past n are read and ignored), the outputs as many writable ones.
 // Two kernels, each for a CPU with its instructions: AVX-512 (8 64-bit lanes) and AVX2 (4 lanes,
 // two per group; the 64-bit products, shifts and the bit length that AVX2 lacks made of its
-// 32 x 32 products, shifts, compares and double subtraction).
+// 32 x 32 products, shifts, compares and double subtraction); and one in plain C++ for any CPU
+// (shadeNhScalar: the scalar datapath's functions, fragment by fragment, in the same passes).
 constexpr size_t kMaxBatch = 512;
 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                  uint32_t* rgb, int64_t* const codes[3] = nullptr);
 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                      uint32_t* rgb, int64_t* const codes[3] = nullptr);
-// The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else null (the
-// scalar datapath).
+uint64_t shadeNhScalar(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
+                       uint32_t* rgb, int64_t* const codes[3] = nullptr);
+// The kernel to use: AVX-512 where available(), else AVX2 where availableAvx2(), else
+// shadeNhScalar.
 using NhKernel = uint64_t (*)(const NhParams&, const uint64_t*, const uint64_t*, const uint64_t*, size_t,
                               uint32_t*, int64_t* const[3]);
 NhKernel nhKernel();
@@ -162,12 +166,14 @@ ColourSpansKernel colourSpansKernel();
 // the z-test (the fragment's code above the buffer's), and where it passes the code and the
 // tag written to the buffers and the fragment appended to b. Adds to fresh the passing pixels
 // whose depth was 0 (not covered before). Returns the first fragment it did not take (r.count
-// when it took all); the caller shades the batch and calls again for the rest. With the
-// vector kernel only (available()).
+// when it took all); the caller shades the batch and calls again for the rest. AVX-512 (where
+// available()).
 size_t bufferRun(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
-// The same in AVX2 (the kernel of a CPU without AVX-512, with shadeNhAvx2).
+// The same in AVX2 (the kernel of a CPU without AVX-512, with shadeNhAvx2), and in plain C++ (with
+// shadeNhScalar).
 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
-// The one that goes with nhKernel() (null where that is).
+size_t bufferRunScalar(const Run& r, size_t first, const Target& t, Batch& b, uint64_t& fresh);
+// The one that goes with nhKernel().
 using BufferKernel = size_t (*)(const Run&, size_t, const Target&, Batch&, uint64_t&);
 BufferKernel bufferKernel();
 
@@ -191,9 +197,10 @@ struct SpanCursor {
 // 8 more: returns true when every run is in, else false with `at` at the first fragment not
 // taken (the caller shades the batch and calls again). Adds to fresh as bufferRun.
 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh);
-// The same with bufferRunAvx2.
+// The same with bufferRunAvx2, and with bufferRunScalar.
 bool bufferSpansAvx2(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh);
-// The one that goes with bufferKernel() (null where that is).
+bool bufferSpansScalar(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh);
+// The one that goes with bufferKernel().
 using SpansBufferKernel = bool (*)(const NhSpans&, SpanCursor&, const Target&, Batch&, uint64_t&);
 SpansBufferKernel spansBufferKernel();
 

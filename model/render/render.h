@@ -162,7 +162,8 @@ struct RenderOptions {
   double bisection_threshold = 0.02;  // normal-bisection: the listing's error bound per segment
   double adaptive_m = 0.9, adaptive_q = 0.004, adaptive_p = 0.008;  // the listing's opt_m, opt_q, opt_p
   // The AVX-512 and AVX2 paths (render/fixed_simd.h, the vertex transform of render/pipeline.h)
-  // where the CPU has them; false: the scalar paths alone (the same images: test
+  // where the CPU has them, and phong-fixed's batch (in plain C++ where neither runs); false:
+  // the scalar paths alone, phong-fixed's run loop without the batch (the same images: test
   // Render.VectorPathsEqualTheScalarPaths compares them).
   bool vector_kernel = true;
   // Small triangles set up straight to their rows' spans (raster/row_spans.h) where the method

@@ -9,12 +9,12 @@
 //              (requests batched per triangle), rows that are not runs, the RTL's span unit;
 //   runs       a whole run of a row by the shader's run kernel: the dot products stepped by
 //              constant increments (directional lights, device lobes on the unit's memo);
-//   batch      the vector kernels' case (one directional light, a lobe of N.H, AVX-512 or
-//              AVX2): the runs of an object's triangles z-tested and buffered
-//              (fixed_simd::bufferKernel; a triangle's rows' spans all with one call,
-//              fixed_simd::spansBufferKernel) and shaded 8 at a time (fixed_simd::nhKernel).
-//              The groups are independent, so the processor overlaps them, where one group
-//              per row of 5 or 6 pixels would wait out its own latency.
+//   batch      one directional light and a lobe of N.H, where the frame has a batch kernel
+//              (Frame::buffer_run: AVX-512, AVX2 or plain C++): the runs of an object's
+//              triangles z-tested and buffered (fixed_simd::bufferKernel; a triangle's rows'
+//              spans all with one call, fixed_simd::spansBufferKernel) and shaded 8 at a time
+//              (fixed_simd::nhKernel). The groups are independent, so the processor overlaps
+//              them, where one group per row of 5 or 6 pixels would wait out its own latency.
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -214,7 +214,7 @@ void batchSpans(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
   t.st.depth_rejected += fragments - passed;
 }
 
-// The walk with the vector kernel's batch, or the rows' spans without it.
+// The walk with the batch, or the rows' spans without it.
 template <class Kernel>
 void walkBatched(FixedTriangle& t, const SpanTriangle& tri, Kernel& kernel) {
   if (tri.rows != nullptr && tri.walked == nullptr && t.f.buffer_spans != nullptr) return batchSpans(t, tri, kernel);
@@ -243,12 +243,11 @@ class PhongFixedUnit final : public MethodUnit {
     const ObjectShading& o = f_.obj;
     group_.reset();  // the previous object's: it refers to its shader
     fixed_.emplace(f_.ctx, *o.material, o.lobe, &o.coding, o.spec != nullptr ? o.spec->memo() : nullptr);
-    // The vector kernel's case: its run kernel built once for all of the object's triangles
-    // (built per triangle, its copies of the constants took 3 % of a frame).
-    if (f_.walker != nullptr && f_.opt.vector_kernel && fixed_->takesRuns())
+    // The batch's case: its run kernel built once for all of the object's triangles (built per
+    // triangle, its copies of the constants took 3 % of a frame).
+    if (f_.buffer_run != nullptr && fixed_->takesRuns())
       fixed_->withRunKernel([&](auto& kernel) {
-        if constexpr (std::decay_t<decltype(kernel)>::kGroups)
-          if (kernel.vectorised()) group_.emplace(kernel);
+        if constexpr (std::decay_t<decltype(kernel)>::kGroups) group_.emplace(kernel);
       });
   }
 
@@ -266,7 +265,7 @@ class PhongFixedUnit final : public MethodUnit {
     req_.finish(f_, t.write);
   }
 
-  // The object's fragments still in the batch (the vector kernel's case).
+  // The object's fragments still in the batch (the batch's case).
   void endObject() override {
     if (batch_->n > 0 && group_) flushBatch(*batch_, f_.fb.rgb.data(), *group_);
     if (batch_->n > 0) throw std::logic_error("render: fragments left in the batch of another shader");
@@ -275,7 +274,7 @@ class PhongFixedUnit final : public MethodUnit {
  private:
   Frame& f_;
   std::optional<FixedPointShader> fixed_;  // the object's
-  std::optional<FixedPointShader::RunKernel<FixedCosine::NH, 1>> group_;  // its vector kernel's case
+  std::optional<FixedPointShader::RunKernel<FixedCosine::NH, 1>> group_;  // the batch's case
   std::unique_ptr<fixed_simd::Batch> batch_;
   PixelRequests req_;
 };
