@@ -256,8 +256,10 @@ class PhongFixedUnit final : public MethodUnit {
     FixedTriangle t(f_, *fixed_, *batch_, req_, tri);
     // Runs where the shader takes them (directional lights; device lobes on the memo).
     if (f_.walker != nullptr && !t.batched && fixed_->takesRuns()) {
-      if (group_) walkBatched(t, tri, *group_);
-      else fixed_->withRunKernel([&](auto& kernel) { walkRuns(t, tri, kernel); });
+      if (group_)
+        walkBatched(t, tri, *group_);
+      else
+        fixed_->withRunKernel([&](auto& kernel) { walkRuns(t, tri, kernel); });
     } else {
       auto fragment = [&t](int32_t x, int32_t y, const int64_t* attr) { fixedFragment(t, x, y, attr); };
       f_.walk(tri, fragment);
