@@ -270,7 +270,7 @@ class FixedPointShader {
       zero_below_ = sh.table_ ? sh.table_->zero_below : 0;
       if constexpr (kGroups) {
         nh_ = fixed_simd::nhKernel();
-        simd_params_ = {table_, sh.table_->zero_below, ambient_, lights_[0].diffuse, lights_[0].specular};
+        simd_params_ = {table_, zero_below_, ambient_, lights_[0].diffuse, lights_[0].specular};
       }
     }
     // The batch's case (fixed_simd.h): one light and a lobe of N.H. Its fragments are shaded
@@ -291,8 +291,8 @@ class FixedPointShader {
     uint64_t stepH() const { return dh_[0]; }
     uint64_t shadeBatch(const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n, uint32_t* rgb,
                         int64_t* const codes[3] = nullptr) const {
-      if constexpr (kGroups) return nh_(simd_params_, sq, l, h, n, rgb, codes);
-      return fixed_simd::allGroups(n);
+      static_assert(kGroups, "one light, and no N.V (a lobe of N.H)");
+      return nh_(simd_params_, sq, l, h, n, rgb, codes);
     }
     FixedShade shadeRaw(uint64_t sqnorm, uint64_t l, uint64_t h) {
       static_assert(kGroups, "one light, and no N.V (a lobe of N.H)");

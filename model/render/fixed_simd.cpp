@@ -1026,14 +1026,14 @@ uint64_t shadeNhScalar(const NhParams& p, const uint64_t* sq, const uint64_t* l,
       [&](size_t i, int count, auto with_codes) {
         using fixed_detail::roundShift;
         for (size_t e = i + static_cast<size_t>(count); i < e; ++i) {
-          uint32_t packed = 0;
+          std::array<uint8_t, 3> out;
           for (size_t k = 0; k < 3; ++k) {
             int64_t code = p.ambient[k];
             if (nl[i] > 0) code += roundShift(p.diffuse[k] * nl[i], 32) + roundShift(p.specular[k] * f[i], 24);
             if constexpr (decltype(with_codes)::value) codes[k][i] = code;
-            packed |= uint32_t{unorm8FromCode(code, kFixedColourFrac)} << (8 * k);
+            out[k] = unorm8FromCode(code, kFixedColourFrac);
           }
-          rgb[i] = packed;
+          rgb[i] = packedRgb(out);
         }
       });
 }

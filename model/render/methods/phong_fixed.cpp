@@ -155,11 +155,11 @@ uint64_t bufferAll(FixedTriangle& t, Kernel& kernel, Buffer buffer) {
 }
 
 // A run into the batch: z-tested, its depth codes written, its passing fragments' squared
-// norms and dot products buffered (Frame::buffer_run). Other runs (null buffer_run, right to left)
-// take fixedRun.
+// norms and dot products buffered (Frame::buffer_run, which the batch's case has). Runs right to
+// left take fixedRun.
 template <class Kernel>
 void batchRun(FixedTriangle& t, Kernel& kernel, const RowRun& r) {
-  if (t.f.buffer_run == nullptr || r.dx != 1) {
+  if (r.dx != 1) {
     if (t.batch.n > 0) flushBatch(t.batch, t.f.fb.rgb.data(), kernel);
     fixedRun(t, kernel, r);
     return;
