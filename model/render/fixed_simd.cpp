@@ -132,25 +132,27 @@ bool availableAvx2() {
 
 namespace {
 
-// The high 64 bits of the unsigned 128-bit products a b, lane by lane, from 32 x 32 products.
-SHD_AVX512 inline __m512i mulHiU64(__m512i a, __m512i b) {
+// (a b + 2^63) >> 64 for unsigned a and b, lane by lane, from 32 x 32 products: with a = ah 2^32 +
+// al, b = bh 2^32 + bl, t = al bl, u = ah bl + (t >> 32) and v = al bh + (u mod 2^32), a b is
+// (ah bh + (u >> 32)) 2^64 + v 2^32 + (t mod 2^32), so the low word's top bit, the carry of
+// the rounding, is bit 31 of v, and (v >> 32) plus that bit is (v + 2^31) >> 32 (v + 2^31 <
+// 2^64: v <= (2^32 - 1)^2 + 2^32 - 1 = 2^64 - 2^32).
+SHD_AVX512 inline __m512i mulHiRoundU64(__m512i a, __m512i b) {
   const __m512i low32 = _mm512_set1_epi64(0xFFFFFFFF);
   const __m512i ah = _mm512_srli_epi64(a, 32), bh = _mm512_srli_epi64(b, 32);
   const __m512i t = _mm512_mul_epu32(a, b);                                              // al bl
   const __m512i u = _mm512_add_epi64(_mm512_mul_epu32(ah, b), _mm512_srli_epi64(t, 32));  // ah bl + (al bl >> 32)
   const __m512i v = _mm512_add_epi64(_mm512_mul_epu32(a, bh), _mm512_and_si512(u, low32));  // al bh + low(u)
   return _mm512_add_epi64(_mm512_add_epi64(_mm512_mul_epu32(ah, bh), _mm512_srli_epi64(u, 32)),
-                          _mm512_srli_epi64(v, 32));
+                          _mm512_srli_epi64(_mm512_add_epi64(v, _mm512_set1_epi64(int64_t{1} << 31)), 32));
 }
 
-// scaleCosine's fast path: (d r64 + 2^63) >> 64 for signed d and 0 <= r64 < 2^63: the signed
-// high word (the unsigned one, less r64 where d < 0) plus the carry out of the low word.
+// scaleCosine's fast path: (d r64 + 2^63) >> 64 for signed d and 0 <= r64 < 2^63: the unsigned
+// product's, less r64 where d < 0 (the signed product is the unsigned one less r64 2^64 there).
 SHD_AVX512 inline __m512i scaleCosines(__m512i d, __m512i r64) {
   const __mmask8 neg = _mm512_cmplt_epi64_mask(d, _mm512_setzero_si512());
-  const __m512i hi_unsigned = mulHiU64(d, r64);
-  const __m512i hi = _mm512_mask_sub_epi64(hi_unsigned, neg, hi_unsigned, r64);
-  const __m512i lo = _mm512_mullo_epi64(d, r64);
-  return _mm512_add_epi64(hi, _mm512_srli_epi64(lo, 63));
+  const __m512i rounded = mulHiRoundU64(d, r64);
+  return _mm512_mask_sub_epi64(rounded, neg, rounded, r64);
 }
 
 // (x + 2^(s-1)) >> s, arithmetic: fixed_detail::roundShift.
@@ -669,17 +671,15 @@ SHD_AVX2 inline __m256i mulLo64(__m256i a, __m256i b) {
 SHD_AVX2 inline __m256i mulLo64By32(__m256i a, __m256i b) {
   return _mm256_add_epi64(_mm256_mul_epu32(a, b), _mm256_slli_epi64(_mm256_mul_epu32(a, _mm256_srli_epi64(b, 32)), 32));
 }
-// mulHiU64's operations, and the top bit of the low word of a b (bits 32 .. 63 of the low word
-// are v mod 2^32: the sum of al bh, ah bl and al bl's high half, mod 2^32) in lo_top.
-SHD_AVX2 inline __m256i mulHiU64x4(__m256i a, __m256i b, __m256i& lo_top) {
+// mulHiRoundU64's operations.
+SHD_AVX2 inline __m256i mulHiRoundU64x4(__m256i a, __m256i b) {
   const __m256i low32 = _mm256_set1_epi64x(0xFFFFFFFF);
   const __m256i ah = _mm256_srli_epi64(a, 32), bh = _mm256_srli_epi64(b, 32);
   const __m256i t = _mm256_mul_epu32(a, b);
   const __m256i u = _mm256_add_epi64(_mm256_mul_epu32(ah, b), _mm256_srli_epi64(t, 32));
   const __m256i v = _mm256_add_epi64(_mm256_mul_epu32(a, bh), _mm256_and_si256(u, low32));
-  lo_top = _mm256_srli_epi64(_mm256_slli_epi64(v, 32), 63);
   return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(ah, bh), _mm256_srli_epi64(u, 32)),
-                          _mm256_srli_epi64(v, 32));
+                          _mm256_srli_epi64(_mm256_add_epi64(v, _mm256_set1_epi64x(int64_t{1} << 31)), 32));
 }
 // x >> S, arithmetic (0 < S < 64): the logical shift with the sign's copies shifted in.
 template <int S>
@@ -692,9 +692,7 @@ SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(
 // scaleCosines' operations.
 SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
   const __m256i neg = _mm256_cmpgt_epi64(_mm256_setzero_si256(), d);
-  __m256i carry;
-  const __m256i hi = _mm256_sub_epi64(mulHiU64x4(d, r64, carry), _mm256_and_si256(neg, r64));
-  return _mm256_add_epi64(hi, carry);
+  return _mm256_sub_epi64(mulHiRoundU64x4(d, r64), _mm256_and_si256(neg, r64));
 }
 
 // The bit length of each lane's value v > 0 (64 less its count of leading zeros, which AVX2
