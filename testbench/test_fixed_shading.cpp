@@ -445,8 +445,8 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
 // triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made a Run as
 // batchRun makes it (dot58 of the codes at its first pixel, SquaredNormRecurrence::terms) and
 // buffered by the kernel's bufferRun, already held to the run loop above. Random rows' spans of
-// up to 64 rows, with rows without a pixel and rows of one, attribute codes over the whole
-// int32_t range (so the dot products and squared norms wrap mod 2^64), random subsets of the
+// up to 64 rows, with rows without a pixel and rows of one, attribute codes within int32_t and
+// past it (the dot products and squared norms wrap mod 2^64), random subsets of the
 // rows (RowShare), depth buffers around the codes, and batches filled to every level: the same
 // entries in the same order, depth and tag buffers and fresh pixels.
 static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spans, fixed_simd::BufferKernel runs) {
@@ -466,10 +466,23 @@ static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spa
       s.span[static_cast<size_t>(i)] = {static_cast<int16_t>(lo), static_cast<int16_t>(hi)};
     }
     s.x0 = std::max<int32_t>(0, s.span[0][0]);
-    for (size_t k = 0; k < 4; ++k) {  // at() within int32_t is not needed: the kernel's arithmetic wraps
+    // Odd triangles: codes within int32_t at every pixel, as RowSpans promises (|a0| <= 2^29,
+    // gradients below 2^23: |u didx| < 80 2^23 and |i didy| < 64 2^23, the sum below 2^31), the
+    // AVX-512 kernel's vector case. Even ones: codes over the whole int32_t range and past it, where the kernels'
+    // arithmetic wraps (the AVX-512 kernel's scalar rows).
+    const bool within = t % 2 == 1;
+    for (size_t k = 0; k < 4; ++k) {
+      if (within) {
+        s.a0[k] = static_cast<int64_t>(rng() % (uint64_t{1} << 30)) - (int64_t{1} << 29);
+        s.didx[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 23))) - (int64_t{1} << 21);
+        s.didy[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 23))) - (int64_t{1} << 21);
+        continue;
+      }
+      // (One in 4 of them with gradients past int32_t as well, up to 2^34.)
+      const uint64_t widest = t % 8 == 0 ? 34 : 31;
       s.a0[k] = static_cast<int64_t>(static_cast<int32_t>(rng()));
-      s.didx[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 31))) - (int64_t{1} << 20);
-      s.didy[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % 31))) - (int64_t{1} << 20);
+      s.didx[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % widest))) - (int64_t{1} << 20);
+      s.didy[k] = static_cast<int64_t>(rng() % (uint64_t{1} << (1 + rng() % widest))) - (int64_t{1} << 20);
     }
     fixed_simd::NhSpans r{&s, ~uint64_t{0}, {}, {}, W};
     for (size_t k = 0; k < 3; ++k) {

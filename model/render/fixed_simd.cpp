@@ -389,50 +389,66 @@ SHD_AVX512 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_
 
 namespace {
 
-// bufferRun's loop, inlined into bufferRun and bufferSpans.
-SHD_AVX512 [[gnu::always_inline]] inline size_t bufferRunIn(const Run& r, size_t first, const Target& t, Batch& b,
-                                                            uint64_t& fresh) {
-  const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
-  const __m512i a = _mm512_set1_epi64(static_cast<int64_t>(r.a)), two_b = _mm512_set1_epi64(static_cast<int64_t>(r.two_b));
-  const __m512i c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
-  const __m512i l0 = _mm512_set1_epi64(static_cast<int64_t>(r.l)), dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl));
-  const __m512i h0 = _mm512_set1_epi64(static_cast<int64_t>(r.h)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
-  size_t n = b.n, k = first;
+// A run's fragments k, k + 8, ... in 64-bit lanes (fragment k + i in lane i): the squared norm,
+// its step to the next group (dsq) and that step's (ddsq, constant), the dot products and
+// their steps, and in 32-bit lanes the depth code and its step, and the pixel.
+struct RunGroups {
+  __m512i sq, dsq, ddsq, l, dl8, h, dh8;
+  __m256i z, dz8, pixel;
+};
+
+// bufferRun's loop from its groups' values at fragment k (rg), inlined into bufferRun and
+// bufferSpans: each group z-tested, its passing fragments buffered, its values stepped by 8
+// fragments with adds (the same values mod 2^64 as the closed forms).
+SHD_AVX512 [[gnu::always_inline]] inline size_t bufferGroups(RunGroups g, const RunPixels& px, size_t k, const Target& t,
+                                                             Batch& b, uint64_t& fresh) {
+  size_t n = b.n;
   uint64_t covered = 0;
-  // Fragments k .. k + 7 in 64-bit lanes (k < 2^32): the quadratic, l and h there (mod 2^64), then
-  // stepped by 8 fragments a group with adds (the same values mod 2^64): sq by its difference
-  // dsq = sq(k + 8) - sq(k) = 16 b + c (16 k + 64), itself stepped by 128 c.
-  const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(k)), lane);
-  __m512i sq = _mm512_add_epi64(_mm512_add_epi64(a, _mm512_mullo_epi64(kv, two_b)),
-                                _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
-  __m512i dsq = _mm512_add_epi64(_mm512_slli_epi64(two_b, 3),
-                                 _mm512_mullo_epi64(c, _mm512_add_epi64(_mm512_slli_epi64(kv, 4), _mm512_set1_epi64(64))));
-  const __m512i ddsq = _mm512_slli_epi64(c, 7);
-  __m512i l = _mm512_add_epi64(l0, _mm512_mullo_epi64(kv, dl)), h = _mm512_add_epi64(h0, _mm512_mullo_epi64(kv, dh));
-  const __m512i dl8 = _mm512_slli_epi64(dl, 3), dh8 = _mm512_slli_epi64(dh, 3);
-  __m256i z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(k) * r.px.dz)),
-                               laneSteps(r.px.dz));
-  const __m256i dz8 = _mm256_set1_epi32(static_cast<int32_t>(8 * r.px.dz));
-  __m256i pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.p + k)), lanes8());
-  for (; k < r.px.count && n + 8 <= Batch::kCap; k += 8) {
-    const __mmask8 pass = zTest8(t, r.px.p + k, r.px.count - k, z, covered);
+  for (; k < px.count && n + 8 <= Batch::kCap; k += 8) {
+    const __mmask8 pass = zTest8(t, px.p + k, px.count - k, g.z, covered);
     // The passing lanes, packed (the register forms of compress: the memory forms are slow on
     // some CPUs), stored 8 entries wide.
-    _mm512_storeu_si512(b.sq.data() + n, _mm512_maskz_compress_epi64(pass, sq));
-    _mm512_storeu_si512(b.l.data() + n, _mm512_maskz_compress_epi64(pass, l));
-    _mm512_storeu_si512(b.h.data() + n, _mm512_maskz_compress_epi64(pass, h));
-    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b.pixel.data() + n), _mm256_maskz_compress_epi32(pass, pixel));
+    _mm512_storeu_si512(b.sq.data() + n, _mm512_maskz_compress_epi64(pass, g.sq));
+    _mm512_storeu_si512(b.l.data() + n, _mm512_maskz_compress_epi64(pass, g.l));
+    _mm512_storeu_si512(b.h.data() + n, _mm512_maskz_compress_epi64(pass, g.h));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(b.pixel.data() + n), _mm256_maskz_compress_epi32(pass, g.pixel));
     n += static_cast<size_t>(__builtin_popcount(pass));
-    sq = _mm512_add_epi64(sq, dsq);
-    dsq = _mm512_add_epi64(dsq, ddsq);
-    l = _mm512_add_epi64(l, dl8);
-    h = _mm512_add_epi64(h, dh8);
-    z = _mm256_add_epi32(z, dz8);
-    pixel = _mm256_add_epi32(pixel, _mm256_set1_epi32(8));
+    g.sq = _mm512_add_epi64(g.sq, g.dsq);
+    g.dsq = _mm512_add_epi64(g.dsq, g.ddsq);
+    g.l = _mm512_add_epi64(g.l, g.dl8);
+    g.h = _mm512_add_epi64(g.h, g.dh8);
+    g.z = _mm256_add_epi32(g.z, g.dz8);
+    g.pixel = _mm256_add_epi32(g.pixel, _mm256_set1_epi32(8));
   }
   b.n = n;
   fresh += covered;
-  return std::min(k, r.px.count);
+  return std::min(k, px.count);
+}
+
+// bufferRun's loop from fragment `first` (k < 2^32): the quadratic, l and h at fragments k .. k
+// + 7 (mod 2^64), the squared norm's step dsq = sq(k + 8) - sq(k) = 16 b + c (16 k + 64), itself
+// stepped by 128 c.
+SHD_AVX512 [[gnu::always_inline]] inline size_t bufferRunIn(const Run& r, size_t first, const Target& t, Batch& b,
+                                                            uint64_t& fresh) {
+  const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
+  const __m512i two_b = _mm512_set1_epi64(static_cast<int64_t>(r.two_b)), c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
+  const __m512i dl = _mm512_set1_epi64(static_cast<int64_t>(r.dl)), dh = _mm512_set1_epi64(static_cast<int64_t>(r.dh));
+  const __m512i kv = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(first)), lane);
+  RunGroups g;
+  g.sq = _mm512_add_epi64(_mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(r.a)), _mm512_mullo_epi64(kv, two_b)),
+                          _mm512_mullo_epi64(_mm512_mul_epu32(kv, kv), c));
+  g.dsq = _mm512_add_epi64(_mm512_slli_epi64(two_b, 3),
+                           _mm512_mullo_epi64(c, _mm512_add_epi64(_mm512_slli_epi64(kv, 4), _mm512_set1_epi64(64))));
+  g.ddsq = _mm512_slli_epi64(c, 7);
+  g.l = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(r.l)), _mm512_mullo_epi64(kv, dl));
+  g.h = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(r.h)), _mm512_mullo_epi64(kv, dh));
+  g.dl8 = _mm512_slli_epi64(dl, 3);
+  g.dh8 = _mm512_slli_epi64(dh, 3);
+  g.z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.z + static_cast<uint32_t>(first) * r.px.dz)),
+                         laneSteps(r.px.dz));
+  g.dz8 = _mm256_set1_epi32(static_cast<int32_t>(8 * r.px.dz));
+  g.pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(r.px.p + first)), lanes8());
+  return bufferGroups(g, r.px, first, t, b, fresh);
 }
 
 }  // namespace
@@ -944,8 +960,131 @@ SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch
   return bufferRunAvx2In(r, first, t, b, fresh);
 }
 
+namespace {
+// A triangle's rows' runs as bufferSpans takes them (rowRuns512): row i's first pixel p, its
+// count (not positive: no pixel), and at its first fragment the squared norm's terms a and
+// two_b, the dot products l and h, and the depth code z (mod 2^32).
+struct RowRuns {
+  static constexpr size_t kRows = RowSpans::kMaxRows;
+  alignas(64) std::array<uint64_t, kRows> a, two_b, l, h, p;
+  alignas(64) std::array<int64_t, kRows> count;
+  alignas(64) std::array<uint32_t, kRows> z;
+};
+
+// RowRuns of rows from..rows - 1 (and the rest of their groups of 8) of s, 8 rows a step in
+// 64-bit lanes, the products of two int32_t (vpmuldq, exact in 64 bits) and the sums mod 2^64,
+// as eachSpanRun takes them: the codes at(k, lo, i) = a0 + u didx + i didy with u = lo - x0;
+// the squared norm's terms from them (SquaredNormRecurrence::terms); the dot products as dot58
+// of them, which equals eachSpanRun's a0.L + u (didx.L) + i (didy.L) mod 2^64 (both are the
+// integer N.L mod 2^64). Rows without a pixel get values never read. False (with some rows
+// left undone) where that does not hold: a gradient, or a normal's code at the first pixel of
+// a row drawn, outside int32_t (RowSpans keeps them within; the tests' random planes do not).
+SHD_AVX512 [[gnu::always_inline]] inline bool rowRuns512(const NhSpans& r, int32_t from, RowRuns& out) {
+  const RowSpans& s = *r.s;
+  for (size_t k = 0; k < 4; ++k)
+    if (s.didx[k] != int32_t(s.didx[k]) || s.didy[k] != int32_t(s.didy[k])) return false;
+  const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+  __m512i didx[4], didy[4], a0[4];
+  for (size_t k = 0; k < 4; ++k) {
+    didx[k] = _mm512_set1_epi64(s.didx[k]);
+    didy[k] = _mm512_set1_epi64(s.didy[k]);
+    a0[k] = _mm512_set1_epi64(s.a0[k]);
+  }
+  const __m512i x0 = _mm512_set1_epi64(s.x0), y0 = _mm512_set1_epi64(s.y0);
+  const __m512i W = _mm512_set1_epi64(static_cast<int64_t>(r.W));
+  for (int32_t base = from & ~7; base < s.rows; base += 8) {
+    // Rows base .. base + 7: lo and hi (int16_t pairs) to 64-bit lanes.
+    const __m256i pairs = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.span.data() + base));
+    const __m512i lo = _mm512_cvtepi32_epi64(_mm256_srai_epi32(_mm256_slli_epi32(pairs, 16), 16));
+    const __m512i hi = _mm512_cvtepi32_epi64(_mm256_srai_epi32(pairs, 16));
+    const __m512i i = _mm512_add_epi64(_mm512_set1_epi64(base), iota);
+    const __m512i u = _mm512_sub_epi64(lo, x0);
+    __m512i code[4];
+    for (size_t k = 0; k < 4; ++k)
+      code[k] = _mm512_add_epi64(a0[k], _mm512_add_epi64(_mm512_mul_epi32(u, didx[k]), _mm512_mul_epi32(i, didy[k])));
+    // The rows drawn: with a pixel, in s from `from` on, and in r.rows.
+    const __mmask8 drawn = _mm512_cmpge_epi64_mask(hi, lo) & _mm512_cmplt_epi64_mask(i, _mm512_set1_epi64(s.rows)) &
+                           _mm512_cmpge_epi64_mask(i, _mm512_set1_epi64(from)) & static_cast<__mmask8>(r.rows >> base);
+    for (size_t k = 0; k < 3; ++k)
+      if (_mm512_mask_cmpneq_epi64_mask(drawn, code[k], _mm512_cvtepi32_epi64(_mm512_cvtepi64_epi32(code[k]))) != 0)
+        return false;
+    __m512i A = _mm512_setzero_si512(), B = A, l = A, h = A;
+    for (size_t k = 0; k < 3; ++k) {
+      A = _mm512_add_epi64(A, _mm512_mul_epi32(code[k], code[k]));
+      B = _mm512_add_epi64(B, _mm512_mul_epi32(code[k], didx[k]));
+      l = _mm512_add_epi64(l, _mm512_mul_epi32(code[k], _mm512_set1_epi64(r.l[k])));
+      h = _mm512_add_epi64(h, _mm512_mul_epi32(code[k], _mm512_set1_epi64(r.h[k])));
+    }
+    const size_t at = static_cast<size_t>(base);
+    _mm512_store_si512(out.a.data() + at, A);
+    _mm512_store_si512(out.two_b.data() + at, _mm512_add_epi64(B, B));
+    _mm512_store_si512(out.l.data() + at, l);
+    _mm512_store_si512(out.h.data() + at, h);
+    // (y0 + i) W + lo: y0 + i is the row on screen (not negative), W below 2^32.
+    _mm512_store_si512(out.p.data() + at, _mm512_add_epi64(_mm512_mul_epu32(_mm512_add_epi64(y0, i), W), lo));
+    _mm512_store_si512(out.count.data() + at, _mm512_add_epi64(_mm512_sub_epi64(hi, lo), _mm512_set1_epi64(1)));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(out.z.data() + at), _mm512_cvtepi64_epi32(code[3]));
+  }
+  return true;
+}
+}  // namespace
+
+// eachSpanRun's runs with their rows' values from rowRuns512, and each row's lanes from the
+// triangle's: at fragments 0 .. 7 the squared norm a + i two_b + i^2 c, its step 8 two_b + c
+// (16 i + 64), l + i dl and h + i dh, of which only i two_b is the row's. A row resumed
+// within (the batch full before its end) takes bufferRunIn from its fragment. Fewer than 4
+// rows left: eachSpanRun's scalar rows, cheaper than a step of 8 and the triangle's lanes.
 SHD_AVX512 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh) {
-  return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX512 { return bufferRunIn(run, first, t, b, fresh); });
+  const RowSpans& s = *r.s;
+  RowRuns rows;
+  if (s.rows - at.row < 4 || !rowRuns512(r, at.row, rows))
+    return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX512 { return bufferRunIn(run, first, t, b, fresh); });
+  const std::array<int64_t, 3> dn{s.didx[0], s.didx[1], s.didx[2]};
+  const uint64_t c = SquaredNormRecurrence::terms(dn, dn).a;  // |didx|^2
+  const uint64_t dl = static_cast<uint64_t>(fixed_detail::dot58(s.didx.data(), r.l));
+  const uint64_t dh = static_cast<uint64_t>(fixed_detail::dot58(s.didx.data(), r.h));
+  const __m512i lane = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m512i cv = _mm512_set1_epi64(static_cast<int64_t>(c));
+  const __m512i dlv = _mm512_set1_epi64(static_cast<int64_t>(dl)), dhv = _mm512_set1_epi64(static_cast<int64_t>(dh));
+  const __m512i lane_sq_c = _mm512_mullo_epi64(_mm512_mul_epu32(lane, lane), cv);
+  const __m512i lane_dsq_c = _mm512_mullo_epi64(cv, _mm512_add_epi64(_mm512_slli_epi64(lane, 4), _mm512_set1_epi64(64)));
+  const __m512i lane_dl = _mm512_mullo_epi64(lane, dlv), lane_dh = _mm512_mullo_epi64(lane, dhv);
+  RunGroups g;
+  g.ddsq = _mm512_slli_epi64(cv, 7);
+  g.dl8 = _mm512_slli_epi64(dlv, 3);
+  g.dh8 = _mm512_slli_epi64(dhv, 3);
+  const uint32_t dz = static_cast<uint32_t>(s.didx[3]);
+  const __m256i lane_dz = laneSteps(dz);
+  g.dz8 = _mm256_set1_epi32(static_cast<int32_t>(8 * dz));
+  for (; at.row < s.rows; ++at.row, at.k = 0) {
+    const size_t i = static_cast<size_t>(at.row);
+    if (rows.count[i] <= 0 || ((r.rows >> i) & 1) == 0) continue;
+    const RunPixels px{rows.p[i], static_cast<size_t>(rows.count[i]), rows.z[i], dz};
+    if (at.k == 0) {
+      const __m512i two_b = _mm512_set1_epi64(static_cast<int64_t>(rows.two_b[i]));
+      g.sq = _mm512_add_epi64(_mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(rows.a[i])), lane_sq_c),
+                              _mm512_mullo_epi64(lane, two_b));
+      g.dsq = _mm512_add_epi64(_mm512_slli_epi64(two_b, 3), lane_dsq_c);
+      g.l = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(rows.l[i])), lane_dl);
+      g.h = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(rows.h[i])), lane_dh);
+      g.z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(px.z)), lane_dz);
+      g.pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(px.p)), lanes8());
+      at.k = bufferGroups(g, px, 0, t, b, fresh);
+    } else {
+      Run run;
+      run.px = px;
+      run.a = rows.a[i];
+      run.two_b = rows.two_b[i];
+      run.c = c;
+      run.l = rows.l[i];
+      run.dl = dl;
+      run.h = rows.h[i];
+      run.dh = dh;
+      at.k = bufferRunIn(run, at.k, t, b, fresh);
+    }
+    if (at.k < px.count) return false;
+  }
+  return true;
 }
 SHD_AVX2 bool bufferSpansAvx2(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh) {
   return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX2 { return bufferRunAvx2In(run, first, t, b, fresh); });
