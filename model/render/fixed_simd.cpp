@@ -266,27 +266,37 @@ SHD_AVX512 inline void colourGroup(const NhParams& p, const LobeLanes& in, size_
   const __m512i nl = _mm512_loadu_si512(in.nl + i);
   const __m512i frac = _mm512_loadu_si512(in.frac + i), pair = _mm512_loadu_si512(in.pair + i);
   const __mmask8 lit = _mm512_cmpgt_epi64_mask(nl, _mm512_setzero_si512());
-  // f = t0 + ((t1 - t0) frac + 2^15) >> 16 as (t0 (2^16 - frac) + t1 frac + 2^15) >> 16 (see
-  // codeLanes4 below); _mm512_mul_epu32 reads the low word of pair: t0.
-  const __m512i t1 = _mm512_srli_epi64(pair, 32);
-  const __m512i f = _mm512_srli_epi64(
-      _mm512_add_epi64(_mm512_add_epi64(_mm512_mul_epu32(pair, _mm512_sub_epi64(_mm512_set1_epi64(1 << 16), frac)),
-                                        _mm512_mul_epu32(t1, frac)),
-                       _mm512_set1_epi64(1 << 15)),
-      16);
-
-  __m512i packed = _mm512_setzero_si512();  // the lanes' packedRgb
-  for (size_t k = 0; k < 3; ++k) {
-    const __m512i diffuse = roundShift<32>(_mm512_mullo_epi64(_mm512_set1_epi64(p.diffuse[k]), nl));
-    const __m512i specular = roundShift<24>(_mm512_mul_epu32(_mm512_set1_epi64(p.specular[k]), f));  // both below 2^32
-    // The sum of non-negative terms: unorm8FromCode's clamp at 0 never acts.
-    const __m512i code = _mm512_mask_add_epi64(_mm512_set1_epi64(p.ambient[k]), lit, _mm512_set1_epi64(p.ambient[k]),
-                                               _mm512_add_epi64(diffuse, specular));
-    const __m512i out = _mm512_srli_epi64(
-        _mm512_add_epi64(_mm512_min_epi64(code, _mm512_set1_epi64(int64_t{255} << 12)), _mm512_set1_epi64(1 << 11)), 12);
-    packed = _mm512_or_si512(packed, _mm512_slli_epi64(out, static_cast<unsigned>(8 * k)));
-    if constexpr (kCodes) _mm512_storeu_si512(codes[k] + i, code);
-  }
+  // The lanes' packedRgb, with the specular terms or without: where every lane's pair of
+  // entries is 0 (no lane read the table: most groups outside a highlight), f is 0 and so is
+  // each specular term, (0 + 2^23) >> 24.
+  auto colours = [&](auto with_specular) SHD_AVX512 {
+    __m512i f = _mm512_setzero_si512();
+    if constexpr (decltype(with_specular)::value) {
+      // f = t0 + ((t1 - t0) frac + 2^15) >> 16 as (t0 (2^16 - frac) + t1 frac + 2^15) >> 16 (see
+      // codeLanes4 below); _mm512_mul_epu32 reads the low word of pair: t0.
+      const __m512i t1 = _mm512_srli_epi64(pair, 32);
+      f = _mm512_srli_epi64(
+          _mm512_add_epi64(_mm512_add_epi64(_mm512_mul_epu32(pair, _mm512_sub_epi64(_mm512_set1_epi64(1 << 16), frac)),
+                                            _mm512_mul_epu32(t1, frac)),
+                           _mm512_set1_epi64(1 << 15)),
+          16);
+    }
+    __m512i packed = _mm512_setzero_si512();
+    for (size_t k = 0; k < 3; ++k) {
+      __m512i sum = roundShift<32>(_mm512_mullo_epi64(_mm512_set1_epi64(p.diffuse[k]), nl));  // diffuse
+      if constexpr (decltype(with_specular)::value)
+        sum = _mm512_add_epi64(sum, roundShift<24>(_mm512_mul_epu32(_mm512_set1_epi64(p.specular[k]), f)));  // both below 2^32
+      // The sum of non-negative terms: unorm8FromCode's clamp at 0 never acts.
+      const __m512i code = _mm512_mask_add_epi64(_mm512_set1_epi64(p.ambient[k]), lit, _mm512_set1_epi64(p.ambient[k]), sum);
+      const __m512i out = _mm512_srli_epi64(
+          _mm512_add_epi64(_mm512_min_epi64(code, _mm512_set1_epi64(int64_t{255} << 12)), _mm512_set1_epi64(1 << 11)), 12);
+      packed = _mm512_or_si512(packed, _mm512_slli_epi64(out, static_cast<unsigned>(8 * k)));
+      if constexpr (kCodes) _mm512_storeu_si512(codes[k] + i, code);
+    }
+    return packed;
+  };
+  const __m512i packed =
+      _mm512_test_epi64_mask(pair, pair) != 0 ? colours(std::true_type{}) : colours(std::false_type{});
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgb + i), _mm512_cvtepi64_epi32(packed));
 }
 
