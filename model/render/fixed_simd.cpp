@@ -971,84 +971,66 @@ SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch
 }
 
 namespace {
-// A triangle's rows' runs as bufferSpans takes them (rowRuns512): row i's first pixel p, its
-// count (not positive: no pixel), and at its first fragment the squared norm's terms a and
-// two_b, the dot products l and h, and the depth code z (mod 2^32).
-struct RowRuns {
-  static constexpr size_t kRows = RowSpans::kMaxRows;
-  alignas(64) std::array<uint64_t, kRows> a, two_b, l, h, p;
-  alignas(64) std::array<int64_t, kRows> count;
-  alignas(64) std::array<uint32_t, kRows> z;
+// The values of 8 rows of a triangle (RowSpans) at their first pixels, lane j row base + j: the
+// squared norm's terms a and two_b, the dot products l and h, and (in 32-bit lanes) the depth
+// code; in registers, each row's broadcast from them by a permutation (a store and loads of 8
+// bytes back would wait on store-to-load forwarding).
+struct RowLanes {
+  __m512i a, two_b, l, h;
+  __m256i z;
 };
 
-// RowRuns of rows from..rows - 1 (and the rest of their groups of 8) of s, 8 rows a step in
-// 64-bit lanes, the products of two int32_t (vpmuldq, exact in 64 bits) and the sums mod 2^64,
-// as eachSpanRun takes them: the codes at(k, lo, i) = a0 + u didx + i didy with u = lo - x0;
-// the squared norm's terms from them (SquaredNormRecurrence::terms); the dot products as dot58
-// of them, which equals eachSpanRun's a0.L + u (didx.L) + i (didy.L) mod 2^64 (both are the
-// integer N.L mod 2^64). Rows without a pixel get values never read. False (with some rows
-// left undone) where that does not hold: a gradient, or a normal's code at the first pixel of
-// a row drawn, outside int32_t (RowSpans keeps them within; the tests' random planes do not).
-SHD_AVX512 [[gnu::always_inline]] inline bool rowRuns512(const NhSpans& r, int32_t from, RowRuns& out) {
+// RowLanes of rows base .. base + 7 of r, the products of two int32_t (vpmuldq, exact in 64
+// bits) and the sums mod 2^64, as eachSpanRun takes them: the codes at(k, lo, i) = a0 + u didx
+// + i didy with u = lo - x0; the squared norm's terms from them (SquaredNormRecurrence::terms);
+// the dot products as dot58 of them, which equals eachSpanRun's a0.L + u (didx.L) + i (didy.L)
+// mod 2^64 (both are the integer N.L mod 2^64). Rows without a pixel get values never read.
+// False where that does not hold: a normal's code at the first pixel of a row drawn from row
+// `from` on (`drawn`) outside int32_t (RowSpans keeps the codes within, and the gradients,
+// which the caller checks; the tests' random planes do not).
+SHD_AVX512 [[gnu::always_inline]] inline bool rowLanes(const NhSpans& r, int32_t base, int32_t from, RowLanes& out) {
   const RowSpans& s = *r.s;
+  // Rows base .. base + 7 (of the 64 of span): lo and hi (int16_t pairs) to 64-bit lanes.
+  const __m256i pairs = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.span.data() + base));
+  const __m512i lo = _mm512_cvtepi32_epi64(_mm256_srai_epi32(_mm256_slli_epi32(pairs, 16), 16));
+  const __m512i hi = _mm512_cvtepi32_epi64(_mm256_srai_epi32(pairs, 16));
+  const __m512i i = _mm512_add_epi64(_mm512_set1_epi64(base), _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7));
+  const __m512i u = _mm512_sub_epi64(lo, _mm512_set1_epi64(s.x0));
+  __m512i code[4];
   for (size_t k = 0; k < 4; ++k)
-    if (s.didx[k] != int32_t(s.didx[k]) || s.didy[k] != int32_t(s.didy[k])) return false;
-  const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
-  __m512i didx[4], didy[4], a0[4];
-  for (size_t k = 0; k < 4; ++k) {
-    didx[k] = _mm512_set1_epi64(s.didx[k]);
-    didy[k] = _mm512_set1_epi64(s.didy[k]);
-    a0[k] = _mm512_set1_epi64(s.a0[k]);
+    code[k] = _mm512_add_epi64(_mm512_set1_epi64(s.a0[k]),
+                               _mm512_add_epi64(_mm512_mul_epi32(u, _mm512_set1_epi64(s.didx[k])),
+                                                _mm512_mul_epi32(i, _mm512_set1_epi64(s.didy[k]))));
+  const __mmask8 drawn = _mm512_cmpge_epi64_mask(hi, lo) & _mm512_cmplt_epi64_mask(i, _mm512_set1_epi64(s.rows)) &
+                         _mm512_cmpge_epi64_mask(i, _mm512_set1_epi64(from)) & static_cast<__mmask8>(r.rows >> base);
+  for (size_t k = 0; k < 3; ++k)
+    if (_mm512_mask_cmpneq_epi64_mask(drawn, code[k], _mm512_cvtepi32_epi64(_mm512_cvtepi64_epi32(code[k]))) != 0)
+      return false;
+  __m512i A = _mm512_setzero_si512(), B = A, l = A, h = A;
+  for (size_t k = 0; k < 3; ++k) {
+    A = _mm512_add_epi64(A, _mm512_mul_epi32(code[k], code[k]));
+    B = _mm512_add_epi64(B, _mm512_mul_epi32(code[k], _mm512_set1_epi64(s.didx[k])));
+    l = _mm512_add_epi64(l, _mm512_mul_epi32(code[k], _mm512_set1_epi64(r.l[k])));
+    h = _mm512_add_epi64(h, _mm512_mul_epi32(code[k], _mm512_set1_epi64(r.h[k])));
   }
-  const __m512i x0 = _mm512_set1_epi64(s.x0), y0 = _mm512_set1_epi64(s.y0);
-  const __m512i W = _mm512_set1_epi64(static_cast<int64_t>(r.W));
-  for (int32_t base = from & ~7; base < s.rows; base += 8) {
-    // Rows base .. base + 7: lo and hi (int16_t pairs) to 64-bit lanes.
-    const __m256i pairs = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.span.data() + base));
-    const __m512i lo = _mm512_cvtepi32_epi64(_mm256_srai_epi32(_mm256_slli_epi32(pairs, 16), 16));
-    const __m512i hi = _mm512_cvtepi32_epi64(_mm256_srai_epi32(pairs, 16));
-    const __m512i i = _mm512_add_epi64(_mm512_set1_epi64(base), iota);
-    const __m512i u = _mm512_sub_epi64(lo, x0);
-    __m512i code[4];
-    for (size_t k = 0; k < 4; ++k)
-      code[k] = _mm512_add_epi64(a0[k], _mm512_add_epi64(_mm512_mul_epi32(u, didx[k]), _mm512_mul_epi32(i, didy[k])));
-    // The rows drawn: with a pixel, in s from `from` on, and in r.rows.
-    const __mmask8 drawn = _mm512_cmpge_epi64_mask(hi, lo) & _mm512_cmplt_epi64_mask(i, _mm512_set1_epi64(s.rows)) &
-                           _mm512_cmpge_epi64_mask(i, _mm512_set1_epi64(from)) & static_cast<__mmask8>(r.rows >> base);
-    for (size_t k = 0; k < 3; ++k)
-      if (_mm512_mask_cmpneq_epi64_mask(drawn, code[k], _mm512_cvtepi32_epi64(_mm512_cvtepi64_epi32(code[k]))) != 0)
-        return false;
-    __m512i A = _mm512_setzero_si512(), B = A, l = A, h = A;
-    for (size_t k = 0; k < 3; ++k) {
-      A = _mm512_add_epi64(A, _mm512_mul_epi32(code[k], code[k]));
-      B = _mm512_add_epi64(B, _mm512_mul_epi32(code[k], didx[k]));
-      l = _mm512_add_epi64(l, _mm512_mul_epi32(code[k], _mm512_set1_epi64(r.l[k])));
-      h = _mm512_add_epi64(h, _mm512_mul_epi32(code[k], _mm512_set1_epi64(r.h[k])));
-    }
-    const size_t at = static_cast<size_t>(base);
-    _mm512_store_si512(out.a.data() + at, A);
-    _mm512_store_si512(out.two_b.data() + at, _mm512_add_epi64(B, B));
-    _mm512_store_si512(out.l.data() + at, l);
-    _mm512_store_si512(out.h.data() + at, h);
-    // (y0 + i) W + lo: y0 + i is the row on screen (not negative), W below 2^32.
-    _mm512_store_si512(out.p.data() + at, _mm512_add_epi64(_mm512_mul_epu32(_mm512_add_epi64(y0, i), W), lo));
-    _mm512_store_si512(out.count.data() + at, _mm512_add_epi64(_mm512_sub_epi64(hi, lo), _mm512_set1_epi64(1)));
-    _mm256_store_si256(reinterpret_cast<__m256i*>(out.z.data() + at), _mm512_cvtepi64_epi32(code[3]));
-  }
+  out = {A, _mm512_add_epi64(B, B), l, h, _mm512_cvtepi64_epi32(code[3])};
   return true;
 }
 }  // namespace
 
-// eachSpanRun's runs with their rows' values from rowRuns512, and each row's lanes from the
+// eachSpanRun's runs, 8 rows' values at a time from rowLanes, each row's lanes from the
 // triangle's: at fragments 0 .. 7 the squared norm a + i two_b + i^2 c, its step 8 two_b + c
-// (16 i + 64), l + i dl and h + i dh, of which only i two_b is the row's. A row resumed
-// within (the batch full before its end) takes bufferRunIn from its fragment. Fewer than 4
-// rows left: eachSpanRun's scalar rows, cheaper than a step of 8 and the triangle's lanes.
+// (16 i + 64), l + i dl and h + i dh, of which only i two_b is the row's. A row resumed within
+// (the batch full before its end) takes bufferRunIn from its fragment. Fewer than 4 rows left,
+// a gradient outside int32_t, or a code outside it from that row on: eachSpanRun's rows.
 SHD_AVX512 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, Batch& b, uint64_t& fresh) {
   const RowSpans& s = *r.s;
-  RowRuns rows;
-  if (s.rows - at.row < 4 || !rowRuns512(r, at.row, rows))
+  auto scalarRows = [&] {
     return eachSpanRun(r, at, [&](const Run& run, size_t first) SHD_AVX512 { return bufferRunIn(run, first, t, b, fresh); });
+  };
+  bool fits = s.rows - at.row >= 4;
+  for (size_t k = 0; k < 4; ++k) fits &= s.didx[k] == int32_t(s.didx[k]) && s.didy[k] == int32_t(s.didy[k]);
+  if (!fits) return scalarRows();
   const std::array<int64_t, 3> dn{s.didx[0], s.didx[1], s.didx[2]};
   const uint64_t c = SquaredNormRecurrence::terms(dn, dn).a;  // |didx|^2
   const uint64_t dl = static_cast<uint64_t>(fixed_detail::dot58(s.didx.data(), r.l));
@@ -1059,36 +1041,47 @@ SHD_AVX512 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, B
   const __m512i lane_sq_c = _mm512_mullo_epi64(_mm512_mul_epu32(lane, lane), cv);
   const __m512i lane_dsq_c = _mm512_mullo_epi64(cv, _mm512_add_epi64(_mm512_slli_epi64(lane, 4), _mm512_set1_epi64(64)));
   const __m512i lane_dl = _mm512_mullo_epi64(lane, dlv), lane_dh = _mm512_mullo_epi64(lane, dhv);
+  const uint32_t dz = static_cast<uint32_t>(s.didx[3]);
+  const __m256i lane_dz = laneSteps(dz);
   RunGroups g;
   g.ddsq = _mm512_slli_epi64(cv, 7);
   g.dl8 = _mm512_slli_epi64(dlv, 3);
   g.dh8 = _mm512_slli_epi64(dhv, 3);
-  const uint32_t dz = static_cast<uint32_t>(s.didx[3]);
-  const __m256i lane_dz = laneSteps(dz);
   g.dz8 = _mm256_set1_epi32(static_cast<int32_t>(8 * dz));
-  for (; at.row < s.rows; ++at.row, at.k = 0) {
+  RowLanes v;
+  for (int32_t base = -8; at.row < s.rows; ++at.row, at.k = 0) {
     const size_t i = static_cast<size_t>(at.row);
-    if (rows.count[i] <= 0 || ((r.rows >> i) & 1) == 0) continue;
-    const RunPixels px{rows.p[i], static_cast<size_t>(rows.count[i]), rows.z[i], dz};
+    if ((at.row & ~7) != base) {
+      base = at.row & ~7;
+      if (!rowLanes(r, base, at.row, v)) return scalarRows();
+    }
+    const int64_t lo = s.span[i][0], hi = s.span[i][1];
+    if (lo > hi || ((r.rows >> i) & 1) == 0) continue;
+    // Row i's values broadcast from its lane.
+    const __m512i j = _mm512_set1_epi64(at.row - base);
+    const __m512i two_b = _mm512_permutexvar_epi64(j, v.two_b), a = _mm512_permutexvar_epi64(j, v.a);
+    const __m512i l = _mm512_permutexvar_epi64(j, v.l), h = _mm512_permutexvar_epi64(j, v.h);
+    const __m256i z = _mm256_permutexvar_epi32(_mm256_set1_epi32(at.row - base), v.z);
+    const RunPixels px{static_cast<size_t>(s.y0 + at.row) * r.W + static_cast<size_t>(lo), static_cast<size_t>(hi - lo + 1),
+                       static_cast<uint32_t>(_mm256_cvtsi256_si32(z)), dz};
     if (at.k == 0) {
-      const __m512i two_b = _mm512_set1_epi64(static_cast<int64_t>(rows.two_b[i]));
-      g.sq = _mm512_add_epi64(_mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(rows.a[i])), lane_sq_c),
-                              _mm512_mullo_epi64(lane, two_b));
+      g.sq = _mm512_add_epi64(_mm512_add_epi64(a, lane_sq_c), _mm512_mullo_epi64(lane, two_b));
       g.dsq = _mm512_add_epi64(_mm512_slli_epi64(two_b, 3), lane_dsq_c);
-      g.l = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(rows.l[i])), lane_dl);
-      g.h = _mm512_add_epi64(_mm512_set1_epi64(static_cast<int64_t>(rows.h[i])), lane_dh);
-      g.z = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(px.z)), lane_dz);
+      g.l = _mm512_add_epi64(l, lane_dl);
+      g.h = _mm512_add_epi64(h, lane_dh);
+      g.z = _mm256_add_epi32(z, lane_dz);
       g.pixel = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int32_t>(px.p)), lanes8());
       at.k = bufferGroups(g, px, 0, t, b, fresh);
     } else {
+      auto low = [](__m512i x) SHD_AVX512 { return static_cast<uint64_t>(_mm_cvtsi128_si64(_mm512_castsi512_si128(x))); };
       Run run;
       run.px = px;
-      run.a = rows.a[i];
-      run.two_b = rows.two_b[i];
+      run.a = low(a);
+      run.two_b = low(two_b);
       run.c = c;
-      run.l = rows.l[i];
+      run.l = low(l);
       run.dl = dl;
-      run.h = rows.h[i];
+      run.h = low(h);
       run.dh = dh;
       at.k = bufferRunIn(run, at.k, t, b, fresh);
     }
