@@ -407,7 +407,7 @@ struct RunGroups {
   __m256i z, dz8, pixel;
 };
 
-// bufferRun's loop from its groups' values at fragment k (rg), inlined into bufferRun and
+// bufferRun's loop from its groups' values at fragment k (g), inlined into bufferRun and
 // bufferSpans: each group z-tested, its passing fragments buffered, its values stepped by 8
 // fragments with adds (the same values mod 2^64 as the closed forms).
 SHD_AVX512 [[gnu::always_inline]] inline size_t bufferGroups(RunGroups g, const RunPixels& px, size_t k, const Target& t,
@@ -973,8 +973,8 @@ SHD_AVX2 size_t bufferRunAvx2(const Run& r, size_t first, const Target& t, Batch
 namespace {
 // The values of 8 rows of a triangle (RowSpans) at their first pixels, lane j row base + j: the
 // squared norm's terms a and two_b, the dot products l and h, and (in 32-bit lanes) the depth
-// code; in registers, each row's broadcast from them by a permutation (a store and loads of 8
-// bytes back would wait on store-to-load forwarding).
+// code; kept in registers, each row's broadcast from them by a permutation, rather than stored
+// and read back 8 bytes at a time (docs/performance.md, "What makes a frame fast").
 struct RowLanes {
   __m512i a, two_b, l, h;
   __m256i z;
