@@ -190,10 +190,10 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
   EXPECT_THROW(FixedPointShader(ctx, s.materials.at(0), Lobe::Quadratic, nullptr, nullptr), std::logic_error);
 }
 
-// The batch kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2, shadeNhScalar) against shade(), lane by lane:
-// runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms of every bit
-// length up to 64; codes up to 2^31), facing the light or away, for each lobe they take, with
-// factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
+// The batch kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2, shadeNhScalar) against shade(),
+// lane by lane: runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms
+// of every bit length up to 64; codes up to 2^31), facing the light or away, for each lobe they
+// take, with factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
 // make a kernel decline the group. Each vector kernel where the CPU has its instructions, and
 // the plain C++ one everywhere.
 static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
@@ -360,8 +360,7 @@ bool zTestWrite(const fixed_simd::RunPixels& px, size_t k, int32_t tag, std::vec
 }  // namespace
 
 // fixed_simd::bufferRun and bufferRunAvx2 (each where the CPU has its instructions) and
-// bufferRunScalar against the
-// run loop they replace, fragment by fragment: runs of 1 to 40 pixels from every start offset,
+// bufferRunScalar against the run loop they replace, fragment by fragment: runs of 1 to 40 pixels from every start offset,
 // over depth buffers holding codes above, below and equal to the run's (and 0, not covered),
 // with depth codes and steps that wrap mod 2^32, squared norms from SquaredNormRecurrence and
 // dot products that wrap mod 2^64, into batches filled to every level (a batch with room for
@@ -441,8 +440,8 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
   checkBufferKernel("scalar", fixed_simd::bufferRunScalar);
 }
 
-// fixed_simd::bufferSpans, bufferSpansAvx2 and bufferSpansScalar against what phong-fixed did before them with a
-// triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made a Run as
+// fixed_simd::bufferSpans, bufferSpansAvx2 and bufferSpansScalar against what phong-fixed did
+// before them with a triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made a Run as
 // batchRun makes it (dot58 of the codes at its first pixel, SquaredNormRecurrence::terms) and
 // buffered by the kernel's bufferRun, already held to the run loop above. Random rows' spans of
 // up to 64 rows, with rows without a pixel and rows of one, attribute codes within int32_t and
@@ -468,8 +467,8 @@ static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spa
     s.x0 = std::max<int32_t>(0, s.span[0][0]);
     // Odd triangles: codes within int32_t at every pixel, as RowSpans promises (|a0| <= 2^29,
     // gradients below 2^23: |u didx| < 80 2^23 and |i didy| < 64 2^23, the sum below 2^31), the
-    // AVX-512 kernel's vector case. Even ones: codes over the whole int32_t range and past it, where the kernels'
-    // arithmetic wraps (the AVX-512 kernel's scalar rows).
+    // AVX-512 kernel's vector case. Even ones: codes over the whole int32_t range and past it,
+    // where the kernels' arithmetic wraps (the AVX-512 kernel's scalar rows).
     const bool within = t % 2 == 1;
     for (size_t k = 0; k < 4; ++k) {
       if (within) {

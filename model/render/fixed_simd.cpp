@@ -1062,8 +1062,8 @@ SHD_AVX512 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, B
     const __m512i two_b = _mm512_permutexvar_epi64(j, v.two_b), a = _mm512_permutexvar_epi64(j, v.a);
     const __m512i l = _mm512_permutexvar_epi64(j, v.l), h = _mm512_permutexvar_epi64(j, v.h);
     const __m256i z = _mm256_permutexvar_epi32(_mm256_set1_epi32(at.row - base), v.z);
-    const RunPixels px{static_cast<size_t>(s.y0 + at.row) * r.W + static_cast<size_t>(lo), static_cast<size_t>(hi - lo + 1),
-                       static_cast<uint32_t>(_mm256_cvtsi256_si32(z)), dz};
+    // (The depth code px.z is the resumed row's alone: bufferGroups steps g.z.)
+    RunPixels px{static_cast<size_t>(s.y0 + at.row) * r.W + static_cast<size_t>(lo), static_cast<size_t>(hi - lo + 1), 0, dz};
     if (at.k == 0) {
       g.sq = _mm512_add_epi64(_mm512_add_epi64(a, lane_sq_c), _mm512_mullo_epi64(lane, two_b));
       g.dsq = _mm512_add_epi64(_mm512_slli_epi64(two_b, 3), lane_dsq_c);
@@ -1074,6 +1074,7 @@ SHD_AVX512 bool bufferSpans(const NhSpans& r, SpanCursor& at, const Target& t, B
       at.k = bufferGroups(g, px, 0, t, b, fresh);
     } else {
       auto low = [](__m512i x) SHD_AVX512 { return static_cast<uint64_t>(_mm_cvtsi128_si64(_mm512_castsi512_si128(x))); };
+      px.z = static_cast<uint32_t>(_mm256_cvtsi256_si32(z));
       Run run;
       run.px = px;
       run.a = low(a);
