@@ -191,11 +191,11 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
 }
 
 // The batch kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2, shadeNhScalar) against shade(),
-// lane by lane: runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms
-// of every bit length up to 64; codes up to 2^31), facing the light or away, for each lobe they
-// take, with factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
-// make a kernel decline the group. Each vector kernel where the CPU has its instructions, and
-// the plain C++ one everywhere.
+// lane by lane: runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms of
+// every bit length up to 64; codes up to 2^31), facing the light or away, for each lobe they take,
+// with factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
+// make a kernel decline the group. Each vector kernel where the CPU has its instructions, and the
+// plain C++ one everywhere.
 static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
   SCOPED_TRACE(name);
   std::mt19937_64 rng(12);
@@ -360,11 +360,11 @@ bool zTestWrite(const fixed_simd::RunPixels& px, size_t k, int32_t tag, std::vec
 }  // namespace
 
 // fixed_simd::bufferRun and bufferRunAvx2 (each where the CPU has its instructions) and
-// bufferRunScalar against the run loop they replace, fragment by fragment: runs of 1 to 40 pixels from every start offset,
-// over depth buffers holding codes above, below and equal to the run's (and 0, not covered),
-// with depth codes and steps that wrap mod 2^32, squared norms from SquaredNormRecurrence and
-// dot products that wrap mod 2^64, into batches filled to every level (a batch with room for
-// fewer than 8 stops the run; the rest follows after the batch is emptied).
+// bufferRunScalar against the run loop they replace, fragment by fragment: runs of 1 to 40 pixels
+// from every start offset, over depth buffers holding codes above, below and equal to the run's
+// (and 0, not covered), with depth codes and steps that wrap mod 2^32, squared norms from
+// SquaredNormRecurrence and dot products that wrap mod 2^64, into batches filled to every level (a
+// batch with room for fewer than 8 stops the run; the rest follows after the batch is emptied).
 static void checkBufferKernel(const char* name, fixed_simd::BufferKernel buffer_run) {
   SCOPED_TRACE(name);
   std::mt19937_64 rng(21);
@@ -441,13 +441,13 @@ TEST(FixedSimd, BufferRunEqualsTheRunLoop) {
 }
 
 // fixed_simd::bufferSpans, bufferSpansAvx2 and bufferSpansScalar against what phong-fixed did
-// before them with a triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made a Run as
-// batchRun makes it (dot58 of the codes at its first pixel, SquaredNormRecurrence::terms) and
-// buffered by the kernel's bufferRun, already held to the run loop above. Random rows' spans of
-// up to 64 rows, with rows without a pixel and rows of one, attribute codes within int32_t and
-// past it (the dot products and squared norms wrap mod 2^64), random subsets of the
-// rows (RowShare), depth buffers around the codes, and batches filled to every level: the same
-// entries in the same order, depth and tag buffers and fresh pixels.
+// before them with a triangle's rows' spans: the walk's runs of the rows (emitRowSpans), each made
+// a Run as batchRun makes it (dot58 of the codes at its first pixel, SquaredNormRecurrence::terms)
+// and buffered by the kernel's bufferRun, already held to the run loop above. Random rows' spans of
+// up to 64 rows, with rows without a pixel and rows of one, attribute codes within int32_t and past
+// it (the dot products and squared norms wrap mod 2^64), random subsets of the rows (RowShare),
+// depth buffers around the codes, and batches filled to every level: the same entries in the same
+// order, depth and tag buffers and fresh pixels.
 static void checkSpansKernel(const char* name, fixed_simd::SpansBufferKernel spans, fixed_simd::BufferKernel runs) {
   SCOPED_TRACE(name);
   std::mt19937_64 rng(23);
