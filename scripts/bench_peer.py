@@ -3,7 +3,7 @@
 
   scripts/bench_peer.py --pair METHOD 'PEER COMMAND' [--pair ...] [--rounds R] [--frames N]
                         [--threads 1,2] [--scene SCENE | --segments 32,64,...] [--shadesim BIN]
-                        [--peer-pattern REGEX] [--cpu N] [--json-out FILE]
+                        [--peer-pattern REGEX] [--cpu N] [--no-bound] [--json-out FILE]
 
 Each --pair names a shadesim method (`shadesim render --method`) and a shell command that prints
 the peer's time per frame in milliseconds. Every round runs, for every pair, shadesim
@@ -26,6 +26,14 @@ its output; the last match counts (default: a number followed by "ms").
 peer's threads); two-thread runs keep every CPU. On a VM whose CPUs do not run at the same
 speed (one of this project's 2-core VMs had one 1.4-1.5 times slower than the other at times),
 an unpinned run lands on either, and the ratio of two runs then mixes the CPUs' speeds.
+
+Two-thread pairs (--threads 2) also time, in each round right after the two-thread frame, a
+one-thread frame pinned to each of the two CPUs it runs on (the first two of this process's),
+and print the bound those speeds set: 1 / (1 / t0 + 1 / t1), the frame shared between both CPUs
+at their speeds with nothing spent on sharing it. On a VM whose two CPUs run at different
+speeds, that bound over the peer's time is the lowest two-thread ratio the machine allows
+then; bound / two-thread time is how much of it the frame reached. --no-bound: without these
+runs.
 
 Prints, per pair, every round's two times and their ratio, then the median of the rounds'
 ratios (shadesim / peer: below 1, shadesim is faster) with its range, and the ratio of the two
@@ -89,6 +97,17 @@ def sphere_scene(work, seg):
     return path
 
 
+def bound_ms(a, scene, method, work):
+    """One-thread frames pinned to each of the two CPUs a two-thread frame runs on (the first two
+    of this process's), and the time of a frame shared between both at those speeds with no
+    cost of its own: 1 / (1 / t0 + 1 / t1)."""
+    per_cpu = {}
+    for c in sorted(os.sched_getaffinity(0))[:2]:
+        pinned = argparse.Namespace(**{**vars(a), "cpu": c})
+        per_cpu[c] = shadesim_ms(pinned, scene, method, 1, work)
+    return per_cpu, 1.0 / sum(1.0 / ms for ms in per_cpu.values())
+
+
 def measure(a):
     sizes = a.segments or [None]
     results = [{"method": m, "threads": n, "segments": g, "peer": c if g is None else c.replace("{seg}", str(g)),
@@ -99,15 +118,25 @@ def measure(a):
             for res in results:
                 order = ("shadesim", "peer") if r % 2 == 0 else ("peer", "shadesim")
                 t = {}
+                per_cpu = None
                 for who in order:
-                    t[who] = (shadesim_ms(a, scenes[res["segments"]], res["method"], res["threads"], work)
-                              if who == "shadesim"
-                              else peer_ms(a, res["peer"], res["threads"]))
+                    if who == "peer":
+                        t["peer"] = peer_ms(a, res["peer"], res["threads"])
+                        continue
+                    t["shadesim"] = shadesim_ms(a, scenes[res["segments"]], res["method"], res["threads"], work)
+                    if res["threads"] == 2 and a.bound:
+                        per_cpu, t["bound"] = bound_ms(a, scenes[res["segments"]], res["method"], work)
                 t["ratio"] = t["shadesim"] / t["peer"]
+                bound = ""
+                if per_cpu is not None:
+                    t["cpu_ms"] = {str(c): ms for c, ms in per_cpu.items()}
+                    t["bound_ratio"] = t["bound"] / t["peer"]
+                    bound = ("; one thread: " + ", ".join(f"CPU {c} {ms:.3f} ms" for c, ms in per_cpu.items()) +
+                             f", bound {t['bound']:.3f} ms")
                 res["rounds"].append(t)
                 print(f"bench_peer: round {r + 1}/{a.rounds} {label(res)}: "
                       f"shadesim {t['shadesim']:.3f} ms, "
-                      f"peer {t['peer']:.3f} ms, ratio {t['ratio']:.3f}", file=sys.stderr, flush=True)
+                      f"peer {t['peer']:.3f} ms, ratio {t['ratio']:.3f}{bound}", file=sys.stderr, flush=True)
     for res in results:
         ratios = [t["ratio"] for t in res["rounds"]]
         res["ratio_median"] = statistics.median(ratios)
@@ -115,6 +144,9 @@ def measure(a):
         res["shadesim_fastest"] = min(t["shadesim"] for t in res["rounds"])
         res["peer_fastest"] = min(t["peer"] for t in res["rounds"])
         res["ratio_fastest"] = res["shadesim_fastest"] / res["peer_fastest"]
+        if all("bound" in t for t in res["rounds"]):
+            res["bound_ratio_median"] = statistics.median(t["bound_ratio"] for t in res["rounds"])
+            res["efficiency_median"] = statistics.median(t["bound"] / t["shadesim"] for t in res["rounds"])
     return results
 
 
@@ -132,12 +164,20 @@ def report(a, results):
           "ratio = shadesim / peer")
     for res in results:
         print(f"\n{label(res)}, against: {res['peer']}")
-        print(f"{'round':>5} {'shadesim ms':>12} {'peer ms':>10} {'ratio':>7}")
+        bounded = "bound_ratio_median" in res
+        cpus = list(res["rounds"][0]["cpu_ms"]) if bounded else []
+        extra = "".join(f" {'CPU ' + c + ' ms':>9}" for c in cpus) + (f" {'bound ms':>9} {'bound/peer':>10}" if bounded else "")
+        print(f"{'round':>5} {'shadesim ms':>12} {'peer ms':>10} {'ratio':>7}{extra}")
         for i, t in enumerate(res["rounds"]):
-            print(f"{i + 1:>5} {t['shadesim']:>12.3f} {t['peer']:>10.3f} {t['ratio']:>7.3f}")
+            extra = "".join(f" {t['cpu_ms'][c]:>9.3f}" for c in cpus) + (
+                f" {t['bound']:>9.3f} {t['bound_ratio']:>10.3f}" if bounded else "")
+            print(f"{i + 1:>5} {t['shadesim']:>12.3f} {t['peer']:>10.3f} {t['ratio']:>7.3f}{extra}")
         print(f"median ratio {res['ratio_median']:.3f} (rounds {res['ratio_min']:.3f} to {res['ratio_max']:.3f})")
         print(f"fastest rounds: shadesim {res['shadesim_fastest']:.3f} ms, peer {res['peer_fastest']:.3f} ms, "
               f"ratio {res['ratio_fastest']:.3f}")
+        if bounded:
+            print(f"the CPUs' bound against the peer, median {res['bound_ratio_median']:.3f}; "
+                  f"two threads reached {res['efficiency_median']:.2f} of the bound (median)")
 
 
 def main(argv):
@@ -151,6 +191,7 @@ def main(argv):
     p.add_argument("--shadesim", default=os.path.join(ROOT, "build", "sim", "shadesim"))
     p.add_argument("--peer-pattern", default=DEFAULT_PATTERN)
     p.add_argument("--cpu", type=int)
+    p.add_argument("--no-bound", dest="bound", action="store_false")
     p.add_argument("--json-out")
     a = p.parse_args(argv)
     try:

@@ -2,8 +2,9 @@
 # bench_peer_test.sh SHADESIM WORK: scripts/bench_peer.py against a stand-in peer that prints a
 # given time (no figure is checked, only the plumbing): the ratios are shadesim's times over the
 # peer's, "{seg}" reaches the peer command with each sphere size of --segments, --cpu pins the
-# one-thread runs, the JSON holds every round, and bad input or a peer without a time exits 2
-# naming the cause.
+# one-thread runs, the JSON holds every round (a two-thread round also its one-thread frames on
+# each of the first two CPUs and the bound they set, none with --no-bound), and bad input or a
+# peer without a time exits 2 naming the cause.
 set -euo pipefail
 shadesim=$(realpath "$1")
 work=$2
@@ -16,7 +17,7 @@ bench=("$root/scripts/bench_peer.py" --shadesim "$shadesim" --frames 2 --rounds 
 "${bench[@]}" --segments 6,9 --threads 1,2 --pair gouraud 'echo "frame {seg}.0 ms"' --json-out r.json > out.txt
 cat out.txt
 python3 - <<'PY'
-import json
+import json, os
 r = json.load(open("r.json"))
 assert r["segments"] == [6, 9], r["segments"]
 pairs = r["pairs"]
@@ -30,11 +31,25 @@ for p in pairs:
     fastest = min(t["shadesim"] for t in p["rounds"])
     assert p["shadesim_fastest"] == fastest and p["peer_fastest"] == p["segments"], p
     assert abs(p["ratio_fastest"] - fastest / p["segments"]) < 1e-12, p
+    # Two threads: a one-thread frame pinned to each of the first two CPUs, and their bound.
+    cpus = [str(c) for c in sorted(os.sched_getaffinity(0))[:2]]
+    for t in p["rounds"]:
+        if p["threads"] == 1:
+            assert "bound" not in t and "cpu_ms" not in t, t
+            continue
+        assert sorted(t["cpu_ms"]) == sorted(cpus) and all(ms > 0 for ms in t["cpu_ms"].values()), t
+        assert abs(t["bound"] - 1 / sum(1 / ms for ms in t["cpu_ms"].values())) < 1e-12, t
+        assert abs(t["bound_ratio"] - t["bound"] / t["peer"]) < 1e-12, t
+    assert ("bound_ratio_median" in p) == (p["threads"] == 2), p
 print("bench_peer json: ok")
 PY
 grep -q "^gouraud (1 thread(s), 9 segments), against: echo \"frame 9.0 ms\"" out.txt
 grep -q "^median ratio " out.txt
 grep -q "^fastest rounds: shadesim [0-9.]* ms, peer 9.000 ms, ratio " out.txt
+grep -q "^the CPUs' bound against the peer, median [0-9.]*; two threads reached [0-9.]* of the bound" out.txt
+"${bench[@]}" --threads 2 --no-bound --pair gouraud 'echo "frame 1.0 ms"' --json-out nobound.json > /dev/null
+python3 -c 'import json; r = json.load(open("nobound.json")); assert all("bound" not in t for p in r["pairs"] for t in p["rounds"])'
+
 # --cpu: the one-thread rounds' peer runs on that CPU alone, the two-thread rounds' on all (the
 # peer's time here: the count of CPUs it may run on).
 first=$(python3 -c 'import os; print(min(os.sched_getaffinity(0)))')
