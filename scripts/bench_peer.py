@@ -68,11 +68,12 @@ def run(cmd, shell=False, cpu=None):
     return p.stdout
 
 
-def shadesim_ms(a, scene, method, threads, work):
+def shadesim_ms(a, scene, method, threads, work, cpu=None):
+    """The median frame time; on one thread pinned to cpu, else to --cpu (if given)."""
     js = os.path.join(work, "render.json")
     run([a.shadesim, "render", "--scene", scene, "--method", method, "--bench", str(a.frames), "--quiet",
          "--threads", str(threads), "-o", os.path.join(work, "render.png"), "--json", js],
-        cpu=a.cpu if threads == 1 else None)
+        cpu=(a.cpu if cpu is None else cpu) if threads == 1 else None)
     with open(js, encoding="utf-8") as f:
         return float(json.load(f)["ms"])
 
@@ -101,10 +102,7 @@ def bound_ms(a, scene, method, work):
     """One-thread frames pinned to each of the two CPUs a two-thread frame runs on (the first two
     of this process's), and the time of a frame shared between both at those speeds with no
     cost of its own: 1 / (1 / t0 + 1 / t1)."""
-    per_cpu = {}
-    for c in sorted(os.sched_getaffinity(0))[:2]:
-        pinned = argparse.Namespace(**{**vars(a), "cpu": c})
-        per_cpu[c] = shadesim_ms(pinned, scene, method, 1, work)
+    per_cpu = {c: shadesim_ms(a, scene, method, 1, work, cpu=c) for c in sorted(os.sched_getaffinity(0))[:2]}
     return per_cpu, 1.0 / sum(1.0 / ms for ms in per_cpu.values())
 
 
