@@ -237,21 +237,37 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
   const double lim[4] = {scalar.lim / scalar.scale[0], scalar.lim / scalar.scale[1], scalar.lim / scalar.scale[2],
                          scalar.lim / scalar.scale[3]};
   std::map<RowSpansSetup, long> outcome;
+  long exact_planes = 0;
   for (int n = 0; n < 300000; ++n) {
     // Where: small, wide (out to the guard band on both sides) or tall (from far above into
-    // the first rows); the attributes: over their whole range, small integers, the renderer's.
-    const int where = static_cast<int>(rng() % 3), what = static_cast<int>(rng() % 3);
+    // the first rows); the attributes: over their whole range, small integers, the renderer's,
+    // or codes a x + b y + c of the pixel (x, y) with integers a, b, c and the vertices at whole
+    // pixels, whose gradients are the exact quotients a and b.
+    const int where = static_cast<int>(rng() % 3), what = static_cast<int>(rng() % 4);
     const double r = 1 + u(rng) * 30, cx = 20 + u(rng) * 470, cy = 20 + u(rng) * 470;
+    std::array<int64_t, 4> pa{}, pb{}, pc{};  // the codes pa x + pb y + pc
+    for (size_t k = 0; k < 4; ++k) {
+      const int bits = static_cast<int>(rng() % 18);  // |a|, |b| <= 2^bits (codes past setup's bound: General)
+      pa[k] = static_cast<int64_t>(rng() % ((uint64_t{2} << bits) + 1)) - (int64_t{1} << bits);
+      pb[k] = static_cast<int64_t>(rng() % ((uint64_t{2} << bits) + 1)) - (int64_t{1} << bits);
+      pc[k] = static_cast<int64_t>(rng() % (uint64_t{1} << 28)) - (int64_t{1} << 27);
+    }
     std::array<RowSpans::Vertex, 3> v;
     for (size_t i = 0; i < 3; ++i) {
       RowSpans::Vertex& x = v[i];
       x.x = cx + (u(rng) * 2 - 1) * (where == 0 ? r : 8000);
       x.y = where == 1 ? cy + (u(rng) * 2 - 1) * 30 : (where == 2 ? u(rng) * 40 : cy + (u(rng) * 2 - 1) * r);
       if (where == 2 && i == 0) x.y = -8000 * u(rng);
+      if (what == 3) {
+        x.x = std::round(x.x);
+        x.y = std::round(x.y);
+      }
       for (size_t k = 0; k < 4; ++k) {
         if (what == 0) x.attr[k] = (u(rng) * 2 - 1) * lim[k];
         else if (what == 1) x.attr[k] = static_cast<double>(rng() % 7) / scalar.scale[k];
-        else x.attr[k] = (k < 3 ? u(rng) * 255 : u(rng));
+        else if (what == 2) x.attr[k] = (k < 3 ? u(rng) * 255 : u(rng));
+        else x.attr[k] = static_cast<double>(pa[k] * static_cast<int64_t>(x.x) + pb[k] * static_cast<int64_t>(x.y) + pc[k]) /
+                         scalar.scale[k];
       }
     }
     RowSpans a;
@@ -268,11 +284,17 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
       ASSERT_EQ(a.a0, b.a0) << "triangle " << n;
       ASSERT_EQ(a.didx, b.didx) << "triangle " << n;
       ASSERT_EQ(a.didy, b.didy) << "triangle " << n;
+      if (what == 3 && c == &vector) {  // the exact quotients
+        ASSERT_EQ(b.didx, pa) << "triangle " << n;
+        ASSERT_EQ(b.didy, pb) << "triangle " << n;
+        ++exact_planes;
+      }
       for (int32_t i = 0; i < a.rows; ++i) ASSERT_EQ(a.span[static_cast<size_t>(i)], b.span[static_cast<size_t>(i)]);
     }
   }
   EXPECT_GT(outcome[RowSpansSetup::Drawn], 100000);
   EXPECT_GT(outcome[RowSpansSetup::General], 1000);  // the whole range: planes beyond 32 bits
+  EXPECT_GT(exact_planes, 20000) << "drawn with exact integer gradients";
 }
 
 // The colour kernels straight from the rows' spans (fixed_simd::colourSpansAvx2 and

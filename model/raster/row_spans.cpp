@@ -120,15 +120,17 @@ bool planeScalar(const Codes& a, const PlaneGeom& g, RowSpans& o) {
 namespace planeavx2 {
 
 // round-half-even(base + n / d) per lane, d > 0, from doubles that hold integers exactly: |n|
-// and d at most 2^51, |base| below 2^51. The correctly rounded quotient's floor is the exact
-// quotient's, m: it lies in [m, m + 1] (rounding is monotone and m, m + 1 are doubles), and it
-// reaches m + 1 only if m + 1 - n / d >= 1 / d is below half a unit in the last place of m + 1,
-// which needs (|m| + 1) d > 2^53, where here (|m| + 1) d <= |n| + d <= 2^52. So the remainder
-// n - m d is exact (|m d| <= 2^52) and in [0, d). Then roundHalfEvenFrom's rule: up when it is
-// above half of d, or half with the floor (base + m) odd.
-SHD_AVX2 inline __m256d roundDivPlus(__m256d base, __m256d n, __m256d d) {
+// and d at most 2^51, |base| below 2^51; inv = 1 / d, correctly rounded (or a power of two
+// times it: 1 / (2 d) = inv / 2 exactly). No division: t = n inv, two roundings, lies within
+// |n / d| 2^-52 (1 + 2^-52) < 1 / d of n / d (|n| < 2^52). A quotient that is not an integer
+// lies at least 1 / d from the integers, so m = floor(t) is its floor and the remainder
+// n - m d is in (0, d); an integer quotient j gives m = j (remainder 0) or m = j - 1
+// (remainder d). The remainder is exact (|m d| <= |n| + d <= 2^52). Then roundHalfEvenFrom's
+// rule: up when the remainder is above half of d (j - 1 with remainder d: up to j), or half
+// with the floor (base + m) odd.
+SHD_AVX2 inline __m256d roundDivPlus(__m256d base, __m256d n, __m256d d, __m256d inv) {
   const __m256d zero = _mm256_setzero_pd(), one = _mm256_set1_pd(1.0), half = _mm256_set1_pd(0.5);
-  const __m256d m = _mm256_floor_pd(_mm256_div_pd(n, d));
+  const __m256d m = _mm256_floor_pd(_mm256_mul_pd(n, inv));
   const __m256d r = _mm256_sub_pd(n, _mm256_mul_pd(m, d));
   const __m256d q = _mm256_add_pd(m, base);
   const __m256d rest = _mm256_sub_pd(d, r);
@@ -192,8 +194,9 @@ SHD_AVX2 bool plane(const CodesF& a, const PlaneGeom& g, RowSpans& o) {
     return false;
   const __m256d num = _mm256_add_pd(_mm256_mul_pd(nx, cv(g.dcx)), _mm256_mul_pd(ny, cv(g.dcy)));
   const __m256d zero = _mm256_setzero_pd(), d = cv(g.det);
-  const __m256d didx = roundDivPlus(zero, sx, d), didy = roundDivPlus(zero, sy, d);
-  const __m256d iref = roundDivPlus(a0, num, _mm256_add_pd(d, d));
+  const __m256d inv = _mm256_set1_pd(1.0 / static_cast<double>(g.det));
+  const __m256d didx = roundDivPlus(zero, sx, d, inv), didy = roundDivPlus(zero, sy, d, inv);
+  const __m256d iref = roundDivPlus(a0, num, _mm256_add_pd(d, d), _mm256_mul_pd(inv, _mm256_set1_pd(0.5)));
   const __m256d lo32 = _mm256_set1_pd(-2147483648.0), hi32 = _mm256_set1_pd(2147483647.0);
   if (!within(didx, lo32, hi32) || !within(didy, lo32, hi32)) return false;
   const __m256d corner = _mm256_add_pd(_mm256_add_pd(iref, _mm256_mul_pd(didx, cv(g.bx))), _mm256_mul_pd(didy, cv(g.by)));
@@ -347,28 +350,33 @@ SHD_AVX2 bool walk(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTal
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 // walk in AVX-512 (RowSpansConfig::avx512), its pass 1 in closed form, 8 rows at once in 64-bit
 // lanes and an edge a vector: the DDA's bound after i steps is q0 + i k + ceil((i m - r0) / D)
-// (q_i = ceil(N_i / D) with N_i = q0 D - r0 + i (k D + m)). Its quotient in doubles: i m - r0
-// and D are integers below 2^47 (i < 64, 0 <= m, r0 < D, and D = |A| < 2^40 by
-// RowSpansConfig::applies), exact, and the correctly rounded quotient has the exact one's
-// ceiling: where the exact one is not an integer j, it lies at least 1 / D > 2^-40 from j and
-// from j - 1, more than half a unit in the last place of a double of magnitude up to 64
-// (2^-47), so rounding reaches neither. Each side's bound is the greatest of its edges' (a side
-// without an edge: none, as the scalar loop's), clamped as walk's. Takes every triangle.
+// (q_i = ceil(N_i / D) with N_i = q0 D - r0 + i (k D + m)). Its quotient in doubles, without a
+// division per group: x = i m - r0 and D are integers below 2^47 (i < 64, 0 <= m, r0 < D, and
+// D = |A| < 2^40 by RowSpansConfig::applies), exact, and |x / D| < 64. The product t = x (1 / D),
+// two roundings, lies within 2^-46 of x / D, so c = ceil(t) is the exact ceiling, or one above
+// it where x / D is an integer j and t rounded above j. (It is never below: a quotient that is
+// not an integer lies at least 1 / D > 2^-40 from the integers, farther than t moves.) Then
+// e = c D - x is exact (integers below 2^53), and e >= D where c is one too many. i k is one signed
+// 32 x 32 product (|k| < 2^30: CoordBits <= 31). Each side's bound is the greatest of its
+// edges' (a side without an edge: none, as the scalar loop's), clamped as walk's. Takes every
+// triangle.
 SHD_AVX512 void walk512(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTally& t) {
   const __m512i iota = _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7);
   const __m512d iota_d = _mm512_cvtepi64_pd(iota);
   __m512i base[3], step[3];    // q0 + i k for the group's rows, and 8 k
   __m512d num[3], num_step[3];  // i m - r0, and 8 m
-  __m512d den[3];
+  __m512d den[3], rcp[3];       // D and 1 / D
   for (size_t s = 0; s < 3; ++s) {
     const RowEdge& g = e[s];
-    base[s] = _mm512_add_epi64(_mm512_set1_epi64(g.q), _mm512_mullo_epi64(iota, _mm512_set1_epi64(g.k)));
+    base[s] = _mm512_add_epi64(_mm512_set1_epi64(g.q), _mm512_mul_epi32(iota, _mm512_set1_epi64(g.k)));
     step[s] = _mm512_set1_epi64(8 * g.k);
     const __m512d m = _mm512_set1_pd(static_cast<double>(g.m));
     num[s] = _mm512_fmsub_pd(iota_d, m, _mm512_set1_pd(static_cast<double>(g.r)));
     num_step[s] = _mm512_mul_pd(m, _mm512_set1_pd(8.0));
     den[s] = _mm512_set1_pd(static_cast<double>(g.D));
+    rcp[s] = _mm512_set1_pd(1.0 / static_cast<double>(g.D));
   }
+  const __m512d one_d = _mm512_set1_pd(1.0);
   const __m512i none = _mm512_set1_epi64(INT64_MIN);
   const __m512i lo_min = _mm512_setzero_si512(), lo_max = _mm512_set1_epi64(W);
   const __m512i nhi_min = _mm512_set1_epi64(1 - W), nhi_max = _mm512_set1_epi64(1);
@@ -376,8 +384,10 @@ SHD_AVX512 void walk512(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, R
   for (int64_t g = 0; g < n; g += 8) {
     __m512i lo = none, nhi = none;  // the greatest bound of each side: x >= lo, x <= -nhi
     for (size_t s = 0; s < 3; ++s) {
-      const __m512i q = _mm512_add_epi64(
-          base[s], _mm512_cvt_roundpd_epi64(_mm512_div_pd(num[s], den[s]), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC));
+      __m512d c = _mm512_roundscale_pd(_mm512_mul_pd(num[s], rcp[s]), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
+      const __m512d err = _mm512_fmsub_pd(c, den[s], num[s]);  // c D - x, exact
+      c = _mm512_mask_sub_pd(c, _mm512_cmp_pd_mask(err, den[s], _CMP_GE_OQ), c, one_d);
+      const __m512i q = _mm512_add_epi64(base[s], _mm512_cvtpd_epi64(c));
       if (e[s].right) nhi = _mm512_max_epi64(nhi, q);
       else lo = _mm512_max_epi64(lo, q);
       base[s] = _mm512_add_epi64(base[s], step[s]);
