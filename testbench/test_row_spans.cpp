@@ -238,6 +238,9 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
                          scalar.lim / scalar.scale[3]};
   std::map<RowSpansSetup, long> outcome;
   long exact_planes = 0;
+  std::vector<std::array<RowSpans::Vertex, 3>> block_in;
+  std::vector<RowSpans> block_ref;
+  std::vector<RowSpansSetup> block_got;
   for (int n = 0; n < 300000; ++n) {
     // Where: small, wide (out to the guard band on both sides) or tall (from far above into
     // the first rows); the attributes: over their whole range, small integers, the renderer's,
@@ -290,6 +293,27 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
         ++exact_planes;
       }
       for (int32_t i = 0; i < a.rows; ++i) ASSERT_EQ(a.span[static_cast<size_t>(i)], b.span[static_cast<size_t>(i)]);
+    }
+    // The same triangles through setupRowSpansBlock, 13 at a time (a block of 8 and one of 5).
+    block_in.push_back(v);
+    block_ref.push_back(a);
+    block_got.push_back(ga);
+    if (block_in.size() == 13) {
+      std::array<RowSpans, 13> out;
+      std::array<RowSpansSetup, 13> got;
+      setupRowSpansBlock(block_in.data(), block_in.size(), wide, out.data(), got.data());
+      for (size_t t = 0; t < block_in.size(); ++t) {
+        ASSERT_EQ(got[t], block_got[t]) << "block triangle " << n - 12 + static_cast<int>(t);
+        if (got[t] != RowSpansSetup::Drawn) continue;
+        const RowSpans &x = block_ref[t], &y = out[t];
+        ASSERT_TRUE(x.y0 == y.y0 && x.rows == y.rows && x.x0 == y.x0 && x.fragments == y.fragments &&
+                    x.groups == y.groups && x.a0 == y.a0 && x.didx == y.didx && x.didy == y.didy)
+            << "block triangle " << n - 12 + static_cast<int>(t);
+        for (int32_t i = 0; i < x.rows; ++i) ASSERT_EQ(x.span[static_cast<size_t>(i)], y.span[static_cast<size_t>(i)]);
+      }
+      block_in.clear();
+      block_ref.clear();
+      block_got.clear();
     }
   }
   EXPECT_GT(outcome[RowSpansSetup::Drawn], 100000);
@@ -419,4 +443,41 @@ TEST(RowSpans, DeclineWhatSetupRefusesOrTheyCannotHold) {
   three.unit.NumAttr = 3;
   three.attr_frac_bits = {12, 12, 12};
   EXPECT_FALSE(RowSpansConfig(three).applies);
+  // setupRowSpansBlock decides these as setupRowSpans does, and a DDA step at the register
+  // bound |k| < k_lim: an edge of 2 subpixels' height across 2 k_lim + e subpixels, whose step
+  // is the floor of +-(k_lim + e / 2) columns a row: held only for k_lim - 1 (e = -1, +).
+  std::vector<std::array<RowSpans::Vertex, 3>> tris = {
+      {vtx(10, 10), vtx(20, 12), vtx(12, 18)},           {vtx(10.5, 10), vtx(60, 10), vtx(10.5, 73.9)},
+      {vtx(10.5, 10), vtx(60, 10), vtx(10.5, 74.9)},     {vtx(10.5, 10), vtx(60, 11), vtx(10.7, 74.9)},
+      {vtx(nan, 10), vtx(20, 12), vtx(12, 18)},
+      {vtx(10, 10), vtx(20, inf), vtx(12, 18)},          {vtx(10, 10), vtx(20, 12), vtx(9000, 18)},
+      {vtx(10, 10), vtx(20, 12, {10, nan, 30, 0.5}), vtx(12, 18)},
+      {vtx(10, 10), vtx(20, 12, {1e9, 0, 0, 0.5}), vtx(12, 18)},
+      {vtx(10, 10), vtx(20, 12), vtx(30, 14)},           {vtx(-30, 10), vtx(-20, 12), vtx(-25, 18)},
+      {vtx(10.5, 10, {0, 0, 0, 0}), vtx(10.5625, 10, {0, 0, 0, 1}), vtx(10.5, 14, {0, 0, 0, 0})}};
+  for (const int e : {-1, 1})
+    for (const double sign : {-1.0, 1.0}) {
+      const double across = static_cast<double>(2 * rc.k_lim + e) / 16;
+      tris.push_back({vtx(4000, 10), vtx(4000 + sign * across, 10.125), vtx(4000, 40)});
+      tris.push_back({vtx(4000, 40), vtx(4000 + sign * across, 10.125), vtx(4000, 10)});
+    }
+  RowSpansConfig block = rc;
+  block.vector = fixed_simd::availableAvx2();
+  block.avx512 = block.vector && fixed_simd::available();
+  std::vector<RowSpans> out(tris.size());
+  std::vector<RowSpansSetup> got(tris.size());
+  setupRowSpansBlock(tris.data(), tris.size(), block, out.data(), got.data());
+  std::map<RowSpansSetup, int> outcomes;
+  for (size_t t = 0; t < tris.size(); ++t) {
+    RowSpans ref;
+    const RowSpansSetup want = setupRowSpans(tris[t], rc, ref);
+    ++outcomes[want];
+    EXPECT_EQ(got[t], want) << "triangle " << t;
+    if (want == RowSpansSetup::Drawn && got[t] == want) {
+      EXPECT_TRUE(ref.y0 == out[t].y0 && ref.rows == out[t].rows && ref.x0 == out[t].x0 && ref.a0 == out[t].a0 &&
+                  ref.didx == out[t].didx && ref.didy == out[t].didy)
+          << "triangle " << t;
+    }
+  }
+  EXPECT_EQ(outcomes[RowSpansSetup::Drawn], 4);  // the first two, and the two of step k_lim - 1
 }

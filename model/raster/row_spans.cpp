@@ -406,6 +406,76 @@ SHD_AVX512 void walk512(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, R
 
 }  // namespace
 
+// setupRowSpans from its edges on (`Front`, its vertices snapped and ordered counter-clockwise
+// and its edges' DDAs from row r0): the rows' spans and the plane. a or af: the attribute codes,
+// in the vertices' order (af where c.vector).
+namespace {
+struct Front {
+  std::array<int64_t, 3> X, Y;
+  int64_t det, r0, r1;
+  std::array<RowEdge, 3> e;
+};
+RowSpansSetup spansAndPlane(const Front& f, const RowSpansConfig& c, Codes& a, const CodesF& af, RowSpans& o) {
+  const std::array<int64_t, 3>& X = f.X;
+  const std::array<int64_t, 3>& Y = f.Y;
+  const int S = c.S;
+  const int64_t r0 = f.r0, r1 = f.r1, det = f.det;
+  const std::array<RowEdge, 3>& e = f.e;
+#ifdef SHD_X86_KERNELS
+  const bool vector = c.vector;
+#else
+  const bool vector = false;
+  (void)af;
+#endif
+  // The rows' spans, with what the unit's cycles and the plane's check below need.
+  RowTally t(c, o);
+  const int64_t n = r1 - r0 + 1;
+#ifdef SHD_X86_KERNELS
+  if (vector && c.avx512) rowsx86::walk512(e, n, c.W, t);
+  else if (!vector || !rowsx86::walk(e, n, c.W, t))
+#endif
+  {
+    std::array<RowEdge, 3> d = e;
+    for (int64_t i = 0; i < n; ++i) {
+      int64_t lo = 0, hi = c.W - 1;
+      for (RowEdge& g : d) {
+        lo = g.right ? lo : std::max(lo, g.q);
+        hi = g.right ? std::min(hi, -g.q) : hi;
+        const int64_t r = g.r - g.m;
+        const int64_t borrow = r < 0 ? 1 : 0;  // without a branch, as the walker's stepEdge
+        g.r = r + (g.D & -borrow);
+        g.q += g.k + borrow;
+      }
+      t.add(i, lo, hi);
+    }
+  }
+  const int64_t first = t.first, last = t.last, xmin = t.xmin, xmax = t.xmax;
+  if (first < 0) return RowSpansSetup::Dropped;  // no pixel centre inside it in the viewport
+  if (first > 0) std::copy(o.span.begin() + first, o.span.begin() + last + 1, o.span.begin());
+  o.y0 = static_cast<int32_t>(r0 + first);
+  o.rows = static_cast<int32_t>(last - first + 1);
+  o.x0 = o.span[0][0];
+  o.fragments = static_cast<uint32_t>(t.fragments);
+  o.groups = static_cast<uint32_t>(t.groups);
+  // The plane, from the reference pixel (setup's setPlane).
+  const int64_t xref = std::clamp<int64_t>(std::min({X[0], X[1], X[2]}) >> S, 0, c.W - 1);
+  const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
+  const PlaneGeom g{X[1] - X[0], Y[1] - Y[0], X[2] - X[0], Y[2] - Y[0], ((2 * xref + 1) << S) - 2 * X[0],
+                    ((2 * yref + 1) << S) - 2 * Y[0], S, det, xmin - xref, o.y0 - yref, xmax - xmin, o.rows - 1,
+                    o.x0 - xmin};
+#ifdef SHD_X86_KERNELS
+  if (vector) {
+    if (planeavx2::plane(af, g, o)) return RowSpansSetup::Drawn;
+    for (size_t i = 0; i < 3; ++i)
+      for (size_t k = 0; k < 4; ++k) a[i][k] = static_cast<int64_t>(af[i][k]);  // exact: below 2^31
+  }
+#endif
+  if (!planeScalar(a, g, o)) return RowSpansSetup::General;
+  return RowSpansSetup::Drawn;
+}
+
+}  // namespace
+
 RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, RowSpans& o) {
   const int S = c.S;
   // Snapped as setup snaps them (snapVertices); what it refuses, setupTriangle refuses, naming it.
@@ -489,48 +559,182 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     if (k >= c.k_lim || k < -c.k_lim) return RowSpansSetup::General;
     e[s] = {q, q * D - N, D, k, -B[s] - k * D, A[s] < 0};
   }
-  // The rows' spans, with what the unit's cycles and the plane's check below need.
-  RowTally t(c, o);
-  const int64_t n = r1 - r0 + 1;
+  Front f{X, Y, det, r0, r1, e};
+  return spansAndPlane(f, c, a, af, o);
+}
+
+
+// ---- setupRowSpans of 8 triangles at once (AVX-512): each lane a triangle up to its edges ----
 #ifdef SHD_X86_KERNELS
-  if (vector && c.avx512) rowsx86::walk512(e, n, c.W, t);
-  else if (!vector || !rowsx86::walk(e, n, c.W, t))
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+namespace {
+// setupRowSpans's steps before its rows, for triangle lane t of v (t < n; the lanes past n take
+// triangle n - 1), in 64-bit lanes: the same integers, from the same operations. Snapping as
+// snapSmall: x 2^S + 1.5 2^52 rounds x 2^S to an integer (the power of two is exact), which the
+// subtraction leaves exact; within the guard band |x 2^S| < 2^29. The products of coordinates
+// (below 2^31) are 64-bit lane products. The DDA's quotients q = ceil(N / D) and k = floor(-B / D)
+// are those of the correctly rounded quotients of doubles: N, B and D are integers below 2^51,
+// exact, and a quotient that is not an integer lies at least 1 / D from the integers, farther
+// than rounding moves a double of magnitude below 2^51 / D (half a unit in its last place, at
+// most |N / D| 2^-53 < 1 / D); an integer quotient is exact. Lanes that setupRowSpans would
+// settle with a 128-bit division (a horizontal edge) or an N beyond 2^51 go to it whole.
+struct Front8 {
+  alignas(64) int64_t X[3][8], Y[3][8], det[8], r0[8], r1[8];
+  alignas(64) int64_t q[3][8], r[3][8], D[3][8], k[3][8], m[3][8];
+  __mmask8 general = 0, dropped = 0, whole = 0, swapped = 0, right[3] = {0, 0, 0};
+};
+SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, Front8& f) {
+  static_assert(sizeof(RowSpans::Vertex) == 6 * sizeof(double), "a vertex: x, y and 4 attributes");
+  const int S = c.S;
+  const __m512i lane = _mm512_min_epi64(_mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7), _mm512_set1_epi64(static_cast<int64_t>(n) - 1));
+  const __m512i base = _mm512_mul_epu32(lane, _mm512_set1_epi64(18));  // 3 vertices of 6 doubles
+  const double* p = &v[0][0].x;
+  const __m512d scale = _mm512_set1_pd(static_cast<double>(int64_t{1} << S)), guard = _mm512_set1_pd(c.guard);
+  const __m512d magic = _mm512_set1_pd(6755399441055744.0);  // 1.5 2^52
+  __m512i X[3], Y[3];
+  __mmask8 ok = 0xFF;
+  for (int i = 0; i < 3; ++i) {
+    const __m512d x = _mm512_i64gather_pd(_mm512_add_epi64(base, _mm512_set1_epi64(6 * i)), p, 8);
+    const __m512d y = _mm512_i64gather_pd(_mm512_add_epi64(base, _mm512_set1_epi64(6 * i + 1)), p, 8);
+    ok &= _mm512_cmp_pd_mask(_mm512_abs_pd(x), guard, _CMP_LE_OQ) & _mm512_cmp_pd_mask(_mm512_abs_pd(y), guard, _CMP_LE_OQ);
+    const __m512d xs = _mm512_mask_blend_pd(ok, _mm512_setzero_pd(), _mm512_mul_pd(x, scale));
+    const __m512d ys = _mm512_mask_blend_pd(ok, _mm512_setzero_pd(), _mm512_mul_pd(y, scale));
+    X[i] = _mm512_cvtpd_epi64(_mm512_sub_pd(_mm512_add_pd(xs, magic), magic));
+    Y[i] = _mm512_cvtpd_epi64(_mm512_sub_pd(_mm512_add_pd(ys, magic), magic));
+  }
+  const __m512i zero = _mm512_setzero_si512();
+  __m512i det = _mm512_sub_epi64(_mm512_mullo_epi64(_mm512_sub_epi64(X[1], X[0]), _mm512_sub_epi64(Y[2], Y[0])),
+                                 _mm512_mullo_epi64(_mm512_sub_epi64(X[2], X[0]), _mm512_sub_epi64(Y[1], Y[0])));
+  const __mmask8 flat = _mm512_cmpeq_epi64_mask(det, zero), neg = _mm512_cmplt_epi64_mask(det, zero);
+  {
+    const __m512i x1 = X[1], y1 = Y[1];
+    X[1] = _mm512_mask_blend_epi64(neg, X[1], X[2]);
+    Y[1] = _mm512_mask_blend_epi64(neg, Y[1], Y[2]);
+    X[2] = _mm512_mask_blend_epi64(neg, X[2], x1);
+    Y[2] = _mm512_mask_blend_epi64(neg, Y[2], y1);
+  }
+  det = _mm512_abs_epi64(det);
+  __m512i xu[3], yu[3];
+  for (int i = 0; i < 3; ++i) {
+    xu[i] = _mm512_slli_epi64(X[i], 1);
+    yu[i] = _mm512_slli_epi64(Y[i], 1);
+  }
+  const __m512i half = _mm512_set1_epi64(int64_t{1} << S);
+  __m512i A[3], B[3], C[3];
+  __mmask8 horizontal = 0;
+  for (int s = 0; s < 3; ++s) {
+    const int q = (s + 1) % 3;
+    const __m512i dx = _mm512_sub_epi64(xu[q], xu[s]), dy = _mm512_sub_epi64(yu[q], yu[s]);
+    A[s] = _mm512_sub_epi64(zero, _mm512_slli_epi64(dy, static_cast<unsigned>(S + 1)));
+    B[s] = _mm512_slli_epi64(dx, static_cast<unsigned>(S + 1));
+    C[s] = _mm512_sub_epi64(_mm512_mullo_epi64(dx, _mm512_sub_epi64(half, yu[s])),
+                            _mm512_mullo_epi64(dy, _mm512_sub_epi64(half, xu[s])));
+    const __mmask8 a0 = _mm512_cmpeq_epi64_mask(A[s], zero);
+    const __mmask8 top_left = _mm512_cmpgt_epi64_mask(A[s], zero) | (a0 & _mm512_cmpgt_epi64_mask(B[s], zero));
+    C[s] = _mm512_mask_sub_epi64(C[s], static_cast<__mmask8>(~top_left), C[s], _mm512_set1_epi64(1));
+    horizontal |= a0;
+  }
+  // centreRows: -((half - lo) >> (S + 1)) and (hi - half) >> (S + 1), arithmetic shifts.
+  auto rowsLo = [&](__m512i lo) SHD_AVX512 {
+    return _mm512_sub_epi64(zero, _mm512_srai_epi64(_mm512_sub_epi64(half, lo), static_cast<unsigned>(S + 1)));
+  };
+  auto rowsHi = [&](__m512i hi) SHD_AVX512 { return _mm512_srai_epi64(_mm512_sub_epi64(hi, half), static_cast<unsigned>(S + 1)); };
+  const __m512i r0 = _mm512_max_epi64(rowsLo(_mm512_min_epi64(_mm512_min_epi64(yu[0], yu[1]), yu[2])), zero);
+  const __m512i r1 = _mm512_min_epi64(rowsHi(_mm512_max_epi64(_mm512_max_epi64(yu[0], yu[1]), yu[2])), _mm512_set1_epi64(c.H - 1));
+  const __m512i c0 = rowsLo(_mm512_min_epi64(_mm512_min_epi64(xu[0], xu[1]), xu[2]));
+  const __m512i c1 = rowsHi(_mm512_max_epi64(_mm512_max_epi64(xu[0], xu[1]), xu[2]));
+  const __mmask8 box_out = _mm512_cmpgt_epi64_mask(r0, r1) | _mm512_cmplt_epi64_mask(c1, zero) |
+                           _mm512_cmpgt_epi64_mask(c0, _mm512_set1_epi64(c.W - 1));
+  const __mmask8 tall = _mm512_cmpge_epi64_mask(_mm512_sub_epi64(r1, r0), _mm512_set1_epi64(RowSpans::kMaxRows));
+  __mmask8 wide = 0, steep = 0;
+  const __m512i lim = _mm512_set1_epi64(int64_t{1} << 51), k_lim = _mm512_set1_epi64(c.k_lim);
+  for (int s = 0; s < 3; ++s) {
+    const __m512i D = _mm512_abs_epi64(A[s]);
+    const __m512i N = _mm512_sub_epi64(zero, _mm512_add_epi64(_mm512_mullo_epi64(B[s], r0), C[s]));
+    wide |= _mm512_cmpge_epi64_mask(_mm512_abs_epi64(N), lim);
+    const __m512d Dd = _mm512_cvtepi64_pd(D);
+    const __m512i q = _mm512_cvt_roundpd_epi64(_mm512_div_pd(_mm512_cvtepi64_pd(N), Dd), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
+    const __m512i negB = _mm512_sub_epi64(zero, B[s]);
+    const __m512i k = _mm512_cvt_roundpd_epi64(_mm512_div_pd(_mm512_cvtepi64_pd(negB), Dd), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    steep |= _mm512_cmpge_epi64_mask(k, k_lim) | _mm512_cmplt_epi64_mask(k, _mm512_sub_epi64(zero, k_lim));
+    _mm512_store_si512(f.q[s], q);
+    _mm512_store_si512(f.r[s], _mm512_sub_epi64(_mm512_mullo_epi64(q, D), N));
+    _mm512_store_si512(f.D[s], D);
+    _mm512_store_si512(f.k[s], k);
+    _mm512_store_si512(f.m[s], _mm512_sub_epi64(negB, _mm512_mullo_epi64(k, D)));
+    f.right[s] = _mm512_cmplt_epi64_mask(A[s], zero);
+  }
+  for (int i = 0; i < 3; ++i) {
+    _mm512_store_si512(f.X[i], X[i]);
+    _mm512_store_si512(f.Y[i], Y[i]);
+  }
+  _mm512_store_si512(f.det, det);
+  _mm512_store_si512(f.r0, r0);
+  _mm512_store_si512(f.r1, r1);
+  // setupRowSpans's order of outcomes: General outside the guard band, Dropped at zero area, a
+  // horizontal edge its own, Dropped outside the viewport, General for too many rows, an N
+  // beyond 2^51 its own, General for a DDA step beyond the register bound.
+  __mmask8 open = ok;
+  f.general = static_cast<__mmask8>(~ok);
+  f.dropped = open & flat;
+  open &= static_cast<__mmask8>(~flat);
+  f.whole = open & horizontal;
+  open &= static_cast<__mmask8>(~horizontal);
+  f.dropped |= open & box_out;
+  open &= static_cast<__mmask8>(~box_out);
+  f.general |= open & tall;
+  open &= static_cast<__mmask8>(~tall);
+  f.whole |= open & wide;
+  open &= static_cast<__mmask8>(~wide);
+  f.general |= open & steep;
+  f.swapped = neg;
+}
+}  // namespace
+#pragma GCC diagnostic pop
 #endif
-    for (int64_t i = 0; i < n; ++i) {
-      int64_t lo = 0, hi = c.W - 1;
-      for (RowEdge& g : e) {
-        lo = g.right ? lo : std::max(lo, g.q);
-        hi = g.right ? std::min(hi, -g.q) : hi;
-        const int64_t r = g.r - g.m;
-        const int64_t borrow = r < 0 ? 1 : 0;  // without a branch, as the walker's stepEdge
-        g.r = r + (g.D & -borrow);
-        g.q += g.k + borrow;
-      }
-      t.add(i, lo, hi);
-    }
-  const int64_t first = t.first, last = t.last, xmin = t.xmin, xmax = t.xmax;
-  if (first < 0) return RowSpansSetup::Dropped;  // no pixel centre inside it in the viewport
-  if (first > 0) std::copy(o.span.begin() + first, o.span.begin() + last + 1, o.span.begin());
-  o.y0 = static_cast<int32_t>(r0 + first);
-  o.rows = static_cast<int32_t>(last - first + 1);
-  o.x0 = o.span[0][0];
-  o.fragments = static_cast<uint32_t>(t.fragments);
-  o.groups = static_cast<uint32_t>(t.groups);
-  // The plane, from the reference pixel (setup's setPlane).
-  const int64_t xref = std::clamp<int64_t>(std::min({X[0], X[1], X[2]}) >> S, 0, c.W - 1);
-  const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
-  const PlaneGeom g{X[1] - X[0], Y[1] - Y[0], X[2] - X[0], Y[2] - Y[0], ((2 * xref + 1) << S) - xu[0],
-                    ((2 * yref + 1) << S) - yu[0], S, det, xmin - xref, o.y0 - yref, xmax - xmin, o.rows - 1,
-                    o.x0 - xmin};
+
+void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, RowSpans* out,
+                        RowSpansSetup* got) {
 #ifdef SHD_X86_KERNELS
-  if (vector) {
-    if (planeavx2::plane(af, g, o)) return RowSpansSetup::Drawn;
-    for (size_t i = 0; i < 3; ++i)
-      for (size_t k = 0; k < 4; ++k) a[i][k] = static_cast<int64_t>(af[i][k]);  // exact: below 2^31
+  if (c.vector && c.avx512) {
+    for (; n > 0; v += 8, out += 8, got += 8, n -= std::min<size_t>(n, 8)) {
+      Front8 f;
+      front8(v, std::min<size_t>(n, 8), c, f);
+      for (size_t t = 0; t < std::min<size_t>(n, 8); ++t) {
+        const auto bit = [t](__mmask8 m) { return ((m >> t) & 1) != 0; };
+        CodesF af;
+        if (!planeavx2::snapCodes(v[t], c, af) || bit(f.general)) {
+          got[t] = RowSpansSetup::General;
+          continue;
+        }
+        if (bit(f.dropped)) {
+          got[t] = RowSpansSetup::Dropped;
+          continue;
+        }
+        if (bit(f.whole)) {
+          got[t] = setupRowSpans(v[t], c, out[t]);
+          continue;
+        }
+        Front fr;
+        for (size_t i = 0; i < 3; ++i) {
+          fr.X[i] = f.X[i][t];
+          fr.Y[i] = f.Y[i][t];
+          fr.e[i] = {f.q[i][t], f.r[i][t], f.D[i][t], f.k[i][t], f.m[i][t], bit(f.right[i])};
+        }
+        fr.det = f.det[t];
+        fr.r0 = f.r0[t];
+        fr.r1 = f.r1[t];
+        if (bit(f.swapped)) std::swap(af[1], af[2]);
+        Codes a;
+        got[t] = spansAndPlane(fr, c, a, af, out[t]);
+      }
+    }
+    return;
   }
 #endif
-  if (!planeScalar(a, g, o)) return RowSpansSetup::General;
-  return RowSpansSetup::Drawn;
+  for (size_t t = 0; t < n; ++t) got[t] = setupRowSpans(v[t], c, out[t]);
 }
 
 SpanWalk countRowSpans(const SpanParams& p, const RowSpans& s, SpanStream* stream) {

@@ -83,6 +83,11 @@ enum class RowSpansSetup {
   General,  // not settled here: set it up with setupTriangle
 };
 RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, RowSpans& out);
+// setupRowSpans of the n triangles v[0 .. n - 1] into out[i] and got[i]: the same outcomes and
+// rows' spans. Where the row loop runs in AVX-512 (RowSpansConfig::avx512), 8 triangles at a time
+// up to their edges' DDAs, one in each 64-bit lane.
+void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, RowSpans* out,
+                        RowSpansSetup* got);
 
 // The cycles and fragments walkSpanUnit counts for the descriptor setup makes of the same
 // triangle (p: the unit, NumTri 1), the full-rate unit's on `stream` (as walkSpanUnit's).

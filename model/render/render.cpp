@@ -205,13 +205,22 @@ struct TriangleSetup {
   // inside). tag: the triangle's id, in setup's descriptor and its errors.
   bool run(const SetupInput& v, Method m, bool colour_attrs, uint32_t tag, RowSpans& rows, SetupResult& setup,
            bool& spans) const {
-    const std::optional<RowSpansConfig>& rs = colour_attrs ? rs_colour : rs_unit;
+    const RowSpansConfig* rs = rowSpans(m, colour_attrs);
     spans = false;
-    if (rs && traits(m).row_spans) {
+    if (rs != nullptr) {
       const RowSpansSetup got = setupRowSpans(v, *rs, rows);
       if (got == RowSpansSetup::Dropped) return false;
       if (got == RowSpansSetup::Drawn) return spans = true;
     }
+    return general(v, colour_attrs, tag, setup);
+  }
+  // The configuration a triangle of method m is set up to its rows' spans with, or null.
+  const RowSpansConfig* rowSpans(Method m, bool colour_attrs) const {
+    const std::optional<RowSpansConfig>& rs = colour_attrs ? rs_colour : rs_unit;
+    return rs && traits(m).row_spans ? &*rs : nullptr;
+  }
+  // By the span unit's setup (false: dropped).
+  bool general(const SetupInput& v, bool colour_attrs, uint32_t tag, SetupResult& setup) const {
     std::array<SetupVertex, 3> sv;
     for (size_t i = 0; i < 3; ++i) {
       sv[i].x = v[i].x;
@@ -393,6 +402,8 @@ class SceneDrawer {
   void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
   void keepTaken(const std::vector<std::array<uint32_t, 3>>& tris);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
+  bool setUpLater(uint32_t ti);
+  void drawSetUp();
   void drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner);
   bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
   bool drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner);
@@ -423,6 +434,21 @@ class SceneDrawer {
   SplitSide* const side_;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
   RowSpans rows_;                     // the same as rows' spans
+  // One thread, where the rows' spans' row loop runs in AVX-512: mesh triangles drawn as
+  // themselves (one part, the mesh's own vertices), set up to their rows' spans 8 at a time
+  // (setupRowSpansBlock) and then drawn in order, before anything else is drawn (drawSetUp).
+  struct Waiting {
+    Part part;
+    uint32_t ti;
+  };
+  bool blocks_ = false;
+  size_t waiting_ = 0;
+  const RowSpansConfig* waiting_rs_ = nullptr;
+  bool waiting_colour_ = false;
+  std::array<Waiting, 8> wait_;
+  std::array<SetupInput, 8> wait_in_;
+  std::array<RowSpans, 8> wait_rows_;
+  std::array<RowSpansSetup, 8> wait_got_;
 };
 
 // The pixels a recorded screen triangle may draw, in the framebuffer's drawn rectangle.
@@ -547,13 +573,18 @@ void SceneDrawer::drawObject(size_t oi) {
     triangleNormals(obj, basis_, kept, scratch_.verts.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
   if (faces_lit_) lightFaces(f_, scratch_.verts, obj.mesh.triangles, kept, scratch_.faces);
   scratch_.lit.assign(scratch_.verts.size(), 0);
+  // (Not where a specular unit counts the requests: a waiting triangle's vertices are lit
+  // before the triangles ahead of it are drawn.)
+  blocks_ = queue_ == nullptr && side_ == nullptr && f_.obj.spec == nullptr;
   uint32_t ti = 0;
   try {
     for (size_t j = 0; j < kept.size(); ++j) {
       ti = kept[j];
       if (side_ != nullptr) drawSplitTriangle(obj.mesh.triangles[ti], ti, scratch_.owner[j] != 0);
       else drawMeshTriangle(obj.mesh.triangles[ti], ti);
+      if (waiting_ == wait_.size()) drawSetUp();
     }
+    drawSetUp();
   } catch (const std::range_error& e) {
     throw std::range_error(fmt::format("{}: object '{}' triangle {}: {}", scene_.name, obj.name, ti, e.what()));
   }
@@ -622,6 +653,8 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
   unit_.parts(fan_, parts_);
+  if (blocks_ && fan_[0] == tv.v0 && setUpLater(ti)) return;
+  drawSetUp();  // the triangles waiting first
   // Every part handed to the back end before setup (it then counts the mesh triangle if setup
   // drops them all), while fewer than hand_off_below jobs wait for it.
   const bool hand_off = back_records_ && !parts_.empty() && queue_->backlog() < f_.opt.hand_off_below;
@@ -631,6 +664,47 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
     drawn |= drawPart(parts_[k], ti, hand_off ? first | last : 0);
   }
   if (!drawn && !hand_off) ++st.culled_no_pixel;  // every part dropped by setup: nothing on screen
+}
+
+// The triangle drawn as itself (parts_) into the triangles waiting for setupRowSpansBlock, where
+// its one part has the mesh's vertices and is set up to its rows' spans in AVX-512 with the
+// configuration of those waiting (else they are drawn first): false where it is not.
+bool SceneDrawer::setUpLater(uint32_t ti) {
+  if (parts_.size() != 1) return false;
+  const Part& part = parts_[0];
+  const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
+  const RowSpansConfig* rs = setup_config_.rowSpans(part.method, colour_attrs);
+  if (rs == nullptr || !rs->avx512) return false;
+  const PVertex* const verts = scratch_.verts.data();
+  for (const PVertex* v : part.v)
+    if (v < verts || v >= verts + scratch_.verts.size()) return false;
+  if (waiting_ > 0 && rs != waiting_rs_) drawSetUp();
+  waiting_rs_ = rs;
+  waiting_colour_ = colour_attrs;
+  wait_[waiting_] = {part, ti};
+  wait_in_[waiting_] = setupInput(part, colour_attrs);
+  ++waiting_;
+  return true;
+}
+
+// The triangles waiting, set up and drawn in order, as drawPart draws each (one thread).
+void SceneDrawer::drawSetUp() {
+  if (waiting_ == 0) return;
+  const size_t n = waiting_;
+  waiting_ = 0;
+  setupRowSpansBlock(wait_in_.data(), n, *waiting_rs_, wait_rows_.data(), wait_got_.data());
+  const RasterConfig& rc = setup_config_.raster(waiting_colour_);
+  for (size_t t = 0; t < n; ++t) {
+    const Part& part = wait_[t].part;
+    const uint32_t tag = static_cast<uint32_t>(triangles_.size());
+    const bool spans = wait_got_[t] == RowSpansSetup::Drawn;
+    if (!spans && (wait_got_[t] == RowSpansSetup::Dropped || !setup_config_.general(wait_in_[t], waiting_colour_, tag, setup_))) {
+      ++f_.st.culled_no_pixel;  // no pixel centre inside
+      continue;
+    }
+    recordTriangle(f_.obj.index, wait_[t].ti, partXY(part), spans, triangles_, f_.st, f_.fb);
+    part.unit->draw(SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, spans ? &wait_rows_[t] : nullptr, rc, tag});
+  }
 }
 
 // A part's vertices as its unit sets them up: colour (the part's own, flat's, or the vertex's,
