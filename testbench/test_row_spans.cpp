@@ -269,8 +269,10 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
         if (what == 0) x.attr[k] = (u(rng) * 2 - 1) * lim[k];
         else if (what == 1) x.attr[k] = static_cast<double>(rng() % 7) / scalar.scale[k];
         else if (what == 2) x.attr[k] = (k < 3 ? u(rng) * 255 : u(rng));
-        else x.attr[k] = static_cast<double>(pa[k] * static_cast<int64_t>(x.x) + pb[k] * static_cast<int64_t>(x.y) + pc[k]) /
-                         scalar.scale[k];
+        else
+          x.attr[k] = static_cast<double>(pa[k] * static_cast<int64_t>(x.x) + pb[k] * static_cast<int64_t>(x.y) +
+                                          pc[k]) /
+                      scalar.scale[k];
       }
     }
     RowSpans a;

@@ -588,7 +588,8 @@ struct Front8 {
 SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, Front8& f) {
   static_assert(sizeof(RowSpans::Vertex) == 6 * sizeof(double), "a vertex: x, y and 4 attributes");
   const int S = c.S;
-  const __m512i lane = _mm512_min_epi64(_mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7), _mm512_set1_epi64(static_cast<int64_t>(n) - 1));
+  const __m512i lane =
+      _mm512_min_epi64(_mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7), _mm512_set1_epi64(static_cast<int64_t>(n) - 1));
   const __m512i base = _mm512_mul_epu32(lane, _mm512_set1_epi64(18));  // 3 vertices of 6 doubles
   const double* p = &v[0][0].x;
   const __m512d scale = _mm512_set1_pd(static_cast<double>(int64_t{1} << S)), guard = _mm512_set1_pd(c.guard);
@@ -598,7 +599,8 @@ SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const
   for (int i = 0; i < 3; ++i) {
     const __m512d x = _mm512_i64gather_pd(_mm512_add_epi64(base, _mm512_set1_epi64(6 * i)), p, 8);
     const __m512d y = _mm512_i64gather_pd(_mm512_add_epi64(base, _mm512_set1_epi64(6 * i + 1)), p, 8);
-    ok &= _mm512_cmp_pd_mask(_mm512_abs_pd(x), guard, _CMP_LE_OQ) & _mm512_cmp_pd_mask(_mm512_abs_pd(y), guard, _CMP_LE_OQ);
+    ok &= _mm512_cmp_pd_mask(_mm512_abs_pd(x), guard, _CMP_LE_OQ) &
+          _mm512_cmp_pd_mask(_mm512_abs_pd(y), guard, _CMP_LE_OQ);
     const __m512d xs = _mm512_mask_blend_pd(ok, _mm512_setzero_pd(), _mm512_mul_pd(x, scale));
     const __m512d ys = _mm512_mask_blend_pd(ok, _mm512_setzero_pd(), _mm512_mul_pd(y, scale));
     X[i] = _mm512_cvtpd_epi64(_mm512_sub_pd(_mm512_add_pd(xs, magic), magic));
@@ -640,9 +642,12 @@ SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const
   auto rowsLo = [&](__m512i lo) SHD_AVX512 {
     return _mm512_sub_epi64(zero, _mm512_srai_epi64(_mm512_sub_epi64(half, lo), static_cast<unsigned>(S + 1)));
   };
-  auto rowsHi = [&](__m512i hi) SHD_AVX512 { return _mm512_srai_epi64(_mm512_sub_epi64(hi, half), static_cast<unsigned>(S + 1)); };
+  auto rowsHi = [&](__m512i hi) SHD_AVX512 {
+    return _mm512_srai_epi64(_mm512_sub_epi64(hi, half), static_cast<unsigned>(S + 1));
+  };
   const __m512i r0 = _mm512_max_epi64(rowsLo(_mm512_min_epi64(_mm512_min_epi64(yu[0], yu[1]), yu[2])), zero);
-  const __m512i r1 = _mm512_min_epi64(rowsHi(_mm512_max_epi64(_mm512_max_epi64(yu[0], yu[1]), yu[2])), _mm512_set1_epi64(c.H - 1));
+  const __m512i r1 =
+      _mm512_min_epi64(rowsHi(_mm512_max_epi64(_mm512_max_epi64(yu[0], yu[1]), yu[2])), _mm512_set1_epi64(c.H - 1));
   const __m512i c0 = rowsLo(_mm512_min_epi64(_mm512_min_epi64(xu[0], xu[1]), xu[2]));
   const __m512i c1 = rowsHi(_mm512_max_epi64(_mm512_max_epi64(xu[0], xu[1]), xu[2]));
   const __mmask8 box_out = _mm512_cmpgt_epi64_mask(r0, r1) | _mm512_cmplt_epi64_mask(c1, zero) |
@@ -655,9 +660,11 @@ SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const
     const __m512i N = _mm512_sub_epi64(zero, _mm512_add_epi64(_mm512_mullo_epi64(B[s], r0), C[s]));
     wide |= _mm512_cmpge_epi64_mask(_mm512_abs_epi64(N), lim);
     const __m512d Dd = _mm512_cvtepi64_pd(D);
-    const __m512i q = _mm512_cvt_roundpd_epi64(_mm512_div_pd(_mm512_cvtepi64_pd(N), Dd), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
+    const __m512i q =
+        _mm512_cvt_roundpd_epi64(_mm512_div_pd(_mm512_cvtepi64_pd(N), Dd), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC);
     const __m512i negB = _mm512_sub_epi64(zero, B[s]);
-    const __m512i k = _mm512_cvt_roundpd_epi64(_mm512_div_pd(_mm512_cvtepi64_pd(negB), Dd), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+    const __m512d k_quotient = _mm512_div_pd(_mm512_cvtepi64_pd(negB), Dd);
+    const __m512i k = _mm512_cvt_roundpd_epi64(k_quotient, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
     steep |= _mm512_cmpge_epi64_mask(k, k_lim) | _mm512_cmplt_epi64_mask(k, _mm512_sub_epi64(zero, k_lim));
     _mm512_store_si512(f.q[s], q);
     _mm512_store_si512(f.r[s], _mm512_sub_epi64(_mm512_mullo_epi64(q, D), N));

@@ -698,12 +698,15 @@ void SceneDrawer::drawSetUp() {
     const Part& part = wait_[t].part;
     const uint32_t tag = static_cast<uint32_t>(triangles_.size());
     const bool spans = wait_got_[t] == RowSpansSetup::Drawn;
-    if (!spans && (wait_got_[t] == RowSpansSetup::Dropped || !setup_config_.general(wait_in_[t], waiting_colour_, tag, setup_))) {
+    const bool set_up = spans || (wait_got_[t] == RowSpansSetup::General &&
+                                  setup_config_.general(wait_in_[t], waiting_colour_, tag, setup_));
+    if (!set_up) {
       ++f_.st.culled_no_pixel;  // no pixel centre inside
       continue;
     }
     recordTriangle(f_.obj.index, wait_[t].ti, partXY(part), spans, triangles_, f_.st, f_.fb);
-    part.unit->draw(SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, spans ? &wait_rows_[t] : nullptr, rc, tag});
+    part.unit->draw(
+        SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, spans ? &wait_rows_[t] : nullptr, rc, tag});
   }
 }
 
