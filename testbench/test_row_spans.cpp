@@ -225,6 +225,20 @@ TEST(RowSpans, EqualSetupAndTheWalkOnSliversAndViewportEdges) {
 // far above into the first rows: few rows, large coordinate differences), with attributes over
 // their whole range (the plane's magnitudes beyond where the vector path declines), small
 // integers (remainders of exactly half a step: the ties of round-half-even) or the renderer's.
+namespace {
+// Two triangles' rows' spans the same: their rows, first pixel, fragments and lane groups, plane,
+// and every row's span.
+testing::AssertionResult sameRowSpans(const RowSpans& a, const RowSpans& b) {
+  if (!(a.y0 == b.y0 && a.rows == b.rows && a.x0 == b.x0 && a.fragments == b.fragments && a.groups == b.groups))
+    return testing::AssertionFailure() << "rows, first pixel or counts differ";
+  if (a.a0 != b.a0 || a.didx != b.didx || a.didy != b.didy) return testing::AssertionFailure() << "planes differ";
+  for (int32_t i = 0; i < a.rows; ++i)
+    if (a.span[static_cast<size_t>(i)] != b.span[static_cast<size_t>(i)])
+      return testing::AssertionFailure() << "row " << i << " differs";
+  return testing::AssertionSuccess();
+}
+}  // namespace
+
 TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
   if (!fixed_simd::availableAvx2()) GTEST_SKIP() << "no AVX2 (or SHD_SCALAR set)";
   const RasterConfig cfg = rendererConfig("serial");
@@ -283,18 +297,12 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
       const RowSpansSetup gb = setupRowSpans(v, *c, b);
       ASSERT_EQ(ga, gb) << "triangle " << n << (c->avx512 ? " (AVX-512 rows)" : "");
       if (ga != RowSpansSetup::Drawn) continue;
-      ASSERT_TRUE(a.y0 == b.y0 && a.rows == b.rows && a.x0 == b.x0 && a.fragments == b.fragments &&
-                  a.groups == b.groups)
-          << "triangle " << n << (c->avx512 ? " (AVX-512 rows)" : "");
-      ASSERT_EQ(a.a0, b.a0) << "triangle " << n;
-      ASSERT_EQ(a.didx, b.didx) << "triangle " << n;
-      ASSERT_EQ(a.didy, b.didy) << "triangle " << n;
+      ASSERT_TRUE(sameRowSpans(a, b)) << "triangle " << n << (c->avx512 ? " (AVX-512 rows)" : "");
       if (what == 3 && c == &vector) {  // the exact quotients
         ASSERT_EQ(b.didx, pa) << "triangle " << n;
         ASSERT_EQ(b.didy, pb) << "triangle " << n;
         ++exact_planes;
       }
-      for (int32_t i = 0; i < a.rows; ++i) ASSERT_EQ(a.span[static_cast<size_t>(i)], b.span[static_cast<size_t>(i)]);
     }
     // The same triangles through setupRowSpansBlock, 13 at a time (a block of 8 and one of 5).
     block_in.push_back(v);
@@ -307,11 +315,7 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
       for (size_t t = 0; t < block_in.size(); ++t) {
         ASSERT_EQ(got[t], block_got[t]) << "block triangle " << n - 12 + static_cast<int>(t);
         if (got[t] != RowSpansSetup::Drawn) continue;
-        const RowSpans &x = block_ref[t], &y = out[t];
-        ASSERT_TRUE(x.y0 == y.y0 && x.rows == y.rows && x.x0 == y.x0 && x.fragments == y.fragments &&
-                    x.groups == y.groups && x.a0 == y.a0 && x.didx == y.didx && x.didy == y.didy)
-            << "block triangle " << n - 12 + static_cast<int>(t);
-        for (int32_t i = 0; i < x.rows; ++i) ASSERT_EQ(x.span[static_cast<size_t>(i)], y.span[static_cast<size_t>(i)]);
+        ASSERT_TRUE(sameRowSpans(block_ref[t], out[t])) << "block triangle " << n - 12 + static_cast<int>(t);
       }
       block_in.clear();
       block_ref.clear();

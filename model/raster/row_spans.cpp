@@ -404,12 +404,9 @@ SHD_AVX512 void walk512(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, R
 }  // namespace rowsx86
 #endif
 
-}  // namespace
-
 // setupRowSpans from its edges on (`Front`, its vertices snapped and ordered counter-clockwise
 // and its edges' DDAs from row r0): the rows' spans and the plane. a or af: the attribute codes,
 // in the vertices' order (af where c.vector).
-namespace {
 struct Front {
   std::array<int64_t, 3> X, Y;
   int64_t det, r0, r1;
@@ -706,10 +703,11 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
                         RowSpansSetup* got) {
 #ifdef SHD_X86_KERNELS
   if (c.vector && c.avx512) {
-    for (; n > 0; v += 8, out += 8, got += 8, n -= std::min<size_t>(n, 8)) {
+    for (size_t count; n > 0; v += count, out += count, got += count, n -= count) {
+      count = std::min<size_t>(n, 8);
       Front8 f;
-      front8(v, std::min<size_t>(n, 8), c, f);
-      for (size_t t = 0; t < std::min<size_t>(n, 8); ++t) {
+      front8(v, count, c, f);
+      for (size_t t = 0; t < count; ++t) {
         const auto bit = [t](__mmask8 m) { return ((m >> t) & 1) != 0; };
         CodesF af;
         if (!planeavx2::snapCodes(v[t], c, af) || bit(f.general)) {

@@ -443,8 +443,7 @@ class SceneDrawer {
   };
   bool blocks_ = false;
   size_t waiting_ = 0;
-  const RowSpansConfig* waiting_rs_ = nullptr;
-  bool waiting_colour_ = false;
+  bool waiting_colour_ = false;  // their attributes (TriangleSetup::rowSpans's configuration)
   std::array<Waiting, 8> wait_;
   std::array<SetupInput, 8> wait_in_;
   std::array<RowSpans, 8> wait_rows_;
@@ -678,8 +677,7 @@ bool SceneDrawer::setUpLater(uint32_t ti) {
   const PVertex* const verts = scratch_.verts.data();
   for (const PVertex* v : part.v)
     if (v < verts || v >= verts + scratch_.verts.size()) return false;
-  if (waiting_ > 0 && rs != waiting_rs_) drawSetUp();
-  waiting_rs_ = rs;
+  if (waiting_ > 0 && colour_attrs != waiting_colour_) drawSetUp();
   waiting_colour_ = colour_attrs;
   wait_[waiting_] = {part, ti};
   wait_in_[waiting_] = setupInput(part, colour_attrs);
@@ -692,7 +690,8 @@ void SceneDrawer::drawSetUp() {
   if (waiting_ == 0) return;
   const size_t n = waiting_;
   waiting_ = 0;
-  setupRowSpansBlock(wait_in_.data(), n, *waiting_rs_, wait_rows_.data(), wait_got_.data());
+  const RowSpansConfig& rs = *(waiting_colour_ ? setup_config_.rs_colour : setup_config_.rs_unit);
+  setupRowSpansBlock(wait_in_.data(), n, rs, wait_rows_.data(), wait_got_.data());
   const RasterConfig& rc = setup_config_.raster(waiting_colour_);
   for (size_t t = 0; t < n; ++t) {
     const Part& part = wait_[t].part;
