@@ -402,11 +402,14 @@ class SceneDrawer {
   void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
   void keepTaken(const std::vector<std::array<uint32_t, 3>>& tris);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
-  bool setUpLater(uint32_t ti);
+  bool setUpLater(uint32_t ti, bool owner);
   void drawSetUp();
   void drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner);
   bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
   bool drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner);
+  uint32_t splitTag(bool owner) const;
+  void drawSplitSetUp(const Part& part, uint32_t ti, uint32_t k, bool owner, bool meets, const RowSpans* rows,
+                      uint32_t tag);
   bool queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off);
   SetupInput setupInput(const Part& part, bool colour_attrs) const;
 
@@ -434,12 +437,14 @@ class SceneDrawer {
   SplitSide* const side_;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
   RowSpans rows_;                     // the same as rows' spans
-  // One thread, where the rows' spans' row loop runs in AVX-512: mesh triangles drawn as
-  // themselves (one part, the mesh's own vertices), set up to their rows' spans 8 at a time
-  // (setupRowSpansBlock) and then drawn in order, before anything else is drawn (drawSetUp).
+  // One thread or a side of a frame split by rows, where the rows' spans' row loop runs in
+  // AVX-512: mesh triangles drawn as themselves (one part, the mesh's own vertices), set up to
+  // their rows' spans 8 at a time (setupRowSpansBlock) and then drawn in order, before anything
+  // else is drawn (drawSetUp). On a side: whether it owns each and whether it may reach its rows.
   struct Waiting {
     Part part;
     uint32_t ti;
+    bool owner, meets;
   };
   bool blocks_ = false;
   size_t waiting_ = 0;
@@ -574,7 +579,7 @@ void SceneDrawer::drawObject(size_t oi) {
   scratch_.lit.assign(scratch_.verts.size(), 0);
   // (Not where a specular unit counts the requests: a waiting triangle's vertices are lit
   // before the triangles ahead of it are drawn.)
-  blocks_ = queue_ == nullptr && side_ == nullptr && f_.obj.spec == nullptr;
+  blocks_ = queue_ == nullptr && f_.obj.spec == nullptr;
   uint32_t ti = 0;
   try {
     for (size_t j = 0; j < kept.size(); ++j) {
@@ -635,6 +640,8 @@ void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t
   parts_.clear();
   f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &scratch_.faces[ti] : nullptr;
   unit_.parts(fan_, parts_);
+  if (blocks_ && fan_[0] == tv.v0 && setUpLater(ti, owner)) return;
+  drawSetUp();  // the triangles waiting first
   bool drawn = false;
   for (size_t k = 0; k < parts_.size(); ++k) drawn |= drawSplitPart(parts_[k], ti, static_cast<uint32_t>(k), owner);
   if (!drawn) ++st.culled_no_pixel;
@@ -652,7 +659,7 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
   unit_.parts(fan_, parts_);
-  if (blocks_ && fan_[0] == tv.v0 && setUpLater(ti)) return;
+  if (blocks_ && fan_[0] == tv.v0 && setUpLater(ti, true)) return;
   drawSetUp();  // the triangles waiting first
   // Every part handed to the back end before setup (it then counts the mesh triangle if setup
   // drops them all), while fewer than hand_off_below jobs wait for it.
@@ -667,8 +674,9 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
 
 // The triangle drawn as itself (parts_) into the triangles waiting for setupRowSpansBlock, where
 // its one part has the mesh's vertices and is set up to its rows' spans in AVX-512 with the
-// configuration of those waiting (else they are drawn first): false where it is not.
-bool SceneDrawer::setUpLater(uint32_t ti) {
+// configuration of those waiting (else they are drawn first), and on a side of a frame split by
+// rows, where the side sets it up (drawSplitPart): false where it is not. owner: the side's.
+bool SceneDrawer::setUpLater(uint32_t ti, bool owner) {
   if (parts_.size() != 1) return false;
   const Part& part = parts_[0];
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
@@ -677,15 +685,22 @@ bool SceneDrawer::setUpLater(uint32_t ti) {
   const PVertex* const verts = scratch_.verts.data();
   for (const PVertex* v : part.v)
     if (v < verts || v >= verts + scratch_.verts.size()) return false;
+  bool meets = true;
+  if (side_ != nullptr) {
+    const auto [lo, hi] = side_->rowsOf(*part.v[0], *part.v[1], *part.v[2]);
+    meets = side_->rows.anyIn(lo, hi);
+    if (!owner && !meets) return false;
+  }
   if (waiting_ > 0 && colour_attrs != waiting_colour_) drawSetUp();
   waiting_colour_ = colour_attrs;
-  wait_[waiting_] = {part, ti};
+  wait_[waiting_] = {part, ti, owner, meets};
   wait_in_[waiting_] = setupInput(part, colour_attrs);
   ++waiting_;
   return true;
 }
 
-// The triangles waiting, set up and drawn in order, as drawPart draws each (one thread).
+// The triangles waiting, set up and drawn in order, as drawPart (one thread) or drawSplitPart
+// (a side of a frame split by rows) draws each.
 void SceneDrawer::drawSetUp() {
   if (waiting_ == 0) return;
   const size_t n = waiting_;
@@ -694,16 +709,21 @@ void SceneDrawer::drawSetUp() {
   setupRowSpansBlock(wait_in_.data(), n, rs, wait_rows_.data(), wait_got_.data());
   const RasterConfig& rc = setup_config_.raster(waiting_colour_);
   for (size_t t = 0; t < n; ++t) {
-    const Part& part = wait_[t].part;
-    const uint32_t tag = static_cast<uint32_t>(triangles_.size());
+    const Waiting& w = wait_[t];
+    const Part& part = w.part;
+    const uint32_t tag = side_ != nullptr ? splitTag(w.owner) : static_cast<uint32_t>(triangles_.size());
     const bool spans = wait_got_[t] == RowSpansSetup::Drawn;
     const bool set_up = spans || (wait_got_[t] == RowSpansSetup::General &&
                                   setup_config_.general(wait_in_[t], waiting_colour_, tag, setup_));
     if (!set_up) {
-      ++f_.st.culled_no_pixel;  // no pixel centre inside
+      ++(w.owner ? f_.st : side_->others).culled_no_pixel;  // no pixel centre inside
       continue;
     }
-    recordTriangle(f_.obj.index, wait_[t].ti, partXY(part), spans, triangles_, f_.st, f_.fb);
+    if (side_ != nullptr) {
+      drawSplitSetUp(part, w.ti, 0, w.owner, w.meets, spans ? &wait_rows_[t] : nullptr, tag);
+      continue;
+    }
+    recordTriangle(f_.obj.index, w.ti, partXY(part), spans, triangles_, f_.st, f_.fb);
     part.unit->draw(
         SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, spans ? &wait_rows_[t] : nullptr, rc, tag});
   }
@@ -778,34 +798,49 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
 }
 
 // A part on a side of a frame split by rows (SplitSide): set up (false: dropped, or not this
-// side's), recorded and counted by its owner, its rows of this side drawn. tag: the side's own.
+// side's), recorded and counted by its owner, its rows of this side drawn (drawSplitSetUp).
 bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner) {
-  SplitSide& side = *side_;
-  const auto [lo, hi] = side.rowsOf(*part.v[0], *part.v[1], *part.v[2]);
-  const bool meets = side.rows.anyIn(lo, hi);
+  const auto [lo, hi] = side_->rowsOf(*part.v[0], *part.v[1], *part.v[2]);
+  const bool meets = side_->rows.anyIn(lo, hi);
   if (!owner && !meets) return false;
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
-  const uint32_t tag = owner ? static_cast<uint32_t>(side.keys.size())
-                             : SplitSide::kForeignTag + static_cast<uint32_t>(side.foreign.size());
+  const uint32_t tag = splitTag(owner);
   bool spans = false;
   if (!setup_config_.run(setupInput(part, colour_attrs), part.method, colour_attrs, tag, rows_, setup_, spans))
     return false;  // no pixel centre inside
+  drawSplitSetUp(part, ti, k, owner, meets, spans ? &rows_ : nullptr, tag);
+  return true;
+}
+
+// On a side of a frame split by rows: the tag of the next part it sets up, its own index of
+// those it owns, or kForeignTag plus the index of those it draws for the other side.
+uint32_t SceneDrawer::splitTag(bool owner) const {
+  return owner ? static_cast<uint32_t>(side_->keys.size())
+               : SplitSide::kForeignTag + static_cast<uint32_t>(side_->foreign.size());
+}
+
+// Part k of mesh triangle ti, set up on a side of a frame split by rows (as rows, else setup_)
+// with its tag (splitTag): recorded and counted if the side owns it, its rows of the side drawn
+// if it meets them.
+void SceneDrawer::drawSplitSetUp(const Part& part, uint32_t ti, uint32_t k, bool owner, bool meets,
+                                 const RowSpans* rows, uint32_t tag) {
+  SplitSide& side = *side_;
+  const bool spans = rows != nullptr;
   const PartKey key{static_cast<uint32_t>(f_.obj.index), ti, k};
   if (owner) {
     side.keys.push_back(key);
     ScreenTriangleInfo& info = side.owned.emplace_back();
     describeTriangle(f_.obj.index, ti, partXY(part), spans, info, f_.st);  // placed among the frame's later
     markDrawn(side.drawn, info);
-    if (spans) f_.countRows(rows_);
+    if (spans) f_.countRows(*rows);
   } else {
     side.foreign.push_back(key);
   }
   if (!spans) walkAhead(*setup_.desc, side.walk, owner);
-  if (!meets) return true;
-  part.unit->draw(SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, spans ? &rows_ : nullptr,
-                               setup_config_.raster(colour_attrs), tag, spans ? nullptr : &side.walk, spans,
-                               side.rows});
-  return true;
+  if (!meets) return;
+  const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
+  part.unit->draw(SpanTriangle{part.v, part.method, spans ? nullptr : &setup_, rows, setup_config_.raster(colour_attrs),
+                               tag, spans ? nullptr : &side.walk, spans, side.rows});
 }
 
 // A part of a TwoThreads::AfterSetup method queued for the back end, which records it: set up
