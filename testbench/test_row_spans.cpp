@@ -327,6 +327,64 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
   EXPECT_GT(exact_planes, 20000) << "drawn with exact integer gradients";
 }
 
+// The plane's bound on the coordinate differences (below 2^20 subpixels), which the renderer's
+// configuration (CoordBits 16: a guard band of 2^13 px) never reaches: with CoordBits 27 (2^24 px)
+// slivers across the viewport from a million pixels away, whose attribute codes are planes a x +
+// b y + c steep enough in x that the numerators' products pass 2^53 (inexact in doubles) while
+// the numerators cancel to below the plane's other bounds. The vector plane (AVX2, and the AVX-512
+// block) must give up on them and leave them to the scalar one, as its bound says.
+TEST(RowSpans, VectorPlaneLeavesWideCoordinatesToTheScalarOne) {
+  if (!fixed_simd::availableAvx2()) GTEST_SKIP() << "no AVX2 (or SHD_SCALAR set)";
+  RasterConfig cfg = rendererConfig("serial");
+  cfg.unit.CoordBits = 27;  // CoordBits + S = 31, setupRowSpans's limit
+  RowSpansConfig scalar(cfg), vector(cfg), wide(cfg);
+  ASSERT_TRUE(scalar.applies);
+  vector.vector = true;
+  wide.vector = true;
+  wide.avx512 = fixed_simd::available();
+  std::mt19937_64 rng(41);
+  std::uniform_real_distribution<double> u(0, 1);
+  long wide_drawn = 0;
+  std::array<std::array<RowSpans::Vertex, 3>, 8> block;
+  std::array<RowSpans, 8> ref;
+  std::array<RowSpansSetup, 8> ref_got;
+  for (int n = 0; n < 40000; ++n) {
+    const size_t t = static_cast<size_t>(n % 8);
+    std::array<RowSpans::Vertex, 3>& v = block[t];
+    const double reach = std::ldexp(1.0, 16 + static_cast<int>(rng() % 8));  // 2^16 .. 2^23 px
+    const double y = 10 + u(rng) * 490;
+    v[0].x = 10 + u(rng) * 490;
+    v[0].y = y;
+    v[1].x = -reach * u(rng);
+    v[1].y = y + (u(rng) * 2 - 1) * 3;
+    v[2].x = reach * u(rng);
+    v[2].y = y + (u(rng) * 2 - 1) * 3;
+    for (size_t k = 0; k < 4; ++k) {
+      const double a = std::round((u(rng) * 2 - 1) * 0x1p31 / reach), b = std::round((u(rng) * 2 - 1) * 4096);
+      for (RowSpans::Vertex& x : v) x.attr[k] = std::round(a * x.x + b * x.y) / scalar.scale[k];
+    }
+    ref_got[t] = setupRowSpans(v, scalar, ref[t]);
+    const bool far = std::max({std::fabs(v[1].x), std::fabs(v[2].x)}) * 16 >= 0x1p20;
+    wide_drawn += far && ref_got[t] == RowSpansSetup::Drawn;
+    RowSpans b;
+    ASSERT_EQ(setupRowSpans(v, vector, b), ref_got[t]) << "triangle " << n;
+    if (ref_got[t] == RowSpansSetup::Drawn) {
+      ASSERT_TRUE(sameRowSpans(ref[t], b)) << "triangle " << n;
+    }
+    if (t + 1 < block.size()) continue;
+    std::array<RowSpans, 8> out;
+    std::array<RowSpansSetup, 8> got;
+    setupRowSpansBlock(block.data(), block.size(), wide, out.data(), got.data());
+    for (size_t i = 0; i < block.size(); ++i) {
+      ASSERT_EQ(got[i], ref_got[i]) << "block triangle " << n - 7 + static_cast<int>(i);
+      if (got[i] == RowSpansSetup::Drawn) {
+        ASSERT_TRUE(sameRowSpans(ref[i], out[i])) << "block triangle " << n - 7 + static_cast<int>(i);
+      }
+    }
+  }
+  EXPECT_GT(wide_drawn, 1000) << "drawn with coordinate differences of 2^20 subpixels and more";
+}
+
 // The colour kernels straight from the rows' spans (fixed_simd::colourSpansAvx2 and
 // colourSpansAvx512, flat and Gouraud's where the CPU has AVX2 or AVX-512, and colourSpansScalar,
 // the scalar paths') against what they replace, the rows' runs (emitRowSpans, as the walk hands

@@ -412,7 +412,9 @@ struct Front {
   int64_t det, r0, r1;
   std::array<RowEdge, 3> e;
 };
-RowSpansSetup spansAndPlane(const Front& f, const RowSpansConfig& c, Codes& a, const CodesF& af, RowSpans& o) {
+// The rows' spans into o, and the plane's geometry g: Dropped (no pixel centre inside it in the
+// viewport) or Drawn (the plane to follow: planeOf).
+RowSpansSetup spans(const Front& f, const RowSpansConfig& c, RowSpans& o, PlaneGeom& g) {
   const std::array<int64_t, 3>& X = f.X;
   const std::array<int64_t, 3>& Y = f.Y;
   const int S = c.S;
@@ -422,7 +424,6 @@ RowSpansSetup spansAndPlane(const Front& f, const RowSpansConfig& c, Codes& a, c
   const bool vector = c.vector;
 #else
   const bool vector = false;
-  (void)af;
 #endif
   // The rows' spans, with what the unit's cycles and the plane's check below need.
   RowTally t(c, o);
@@ -457,18 +458,32 @@ RowSpansSetup spansAndPlane(const Front& f, const RowSpansConfig& c, Codes& a, c
   // The plane, from the reference pixel (setup's setPlane).
   const int64_t xref = std::clamp<int64_t>(std::min({X[0], X[1], X[2]}) >> S, 0, c.W - 1);
   const int64_t yref = std::clamp<int64_t>(std::min({Y[0], Y[1], Y[2]}) >> S, 0, c.H - 1);
-  const PlaneGeom g{X[1] - X[0], Y[1] - Y[0], X[2] - X[0], Y[2] - Y[0], ((2 * xref + 1) << S) - 2 * X[0],
-                    ((2 * yref + 1) << S) - 2 * Y[0], S, det, xmin - xref, o.y0 - yref, xmax - xmin, o.rows - 1,
-                    o.x0 - xmin};
+  g = {X[1] - X[0], Y[1] - Y[0], X[2] - X[0], Y[2] - Y[0], ((2 * xref + 1) << S) - 2 * X[0],
+       ((2 * yref + 1) << S) - 2 * Y[0], S, det, xmin - xref, o.y0 - yref, xmax - xmin, o.rows - 1,
+       o.x0 - xmin};
+  return RowSpansSetup::Drawn;
+}
+
+// The plane of g into o (Drawn), or General where it does not fit. a or af: the attribute
+// codes, in the vertices' order (af where c.vector).
+RowSpansSetup planeOf(const RowSpansConfig& c, Codes& a, const CodesF& af, const PlaneGeom& g, RowSpans& o) {
 #ifdef SHD_X86_KERNELS
-  if (vector) {
+  if (c.vector) {
     if (planeavx2::plane(af, g, o)) return RowSpansSetup::Drawn;
     for (size_t i = 0; i < 3; ++i)
       for (size_t k = 0; k < 4; ++k) a[i][k] = static_cast<int64_t>(af[i][k]);  // exact: below 2^31
   }
+#else
+  (void)af;
 #endif
   if (!planeScalar(a, g, o)) return RowSpansSetup::General;
   return RowSpansSetup::Drawn;
+}
+
+RowSpansSetup spansAndPlane(const Front& f, const RowSpansConfig& c, Codes& a, const CodesF& af, RowSpans& o) {
+  PlaneGeom g;
+  const RowSpansSetup got = spans(f, c, o, g);
+  return got == RowSpansSetup::Dropped ? got : planeOf(c, a, af, g, o);
 }
 
 }  // namespace
@@ -695,6 +710,90 @@ SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const
   f.general |= open & steep;
   f.swapped = neg;
 }
+
+// planeavx2::plane of 8 triangles at once, a triangle per lane and an attribute at a time: the
+// same operations on the same doubles, so a lane that passes every check of plane gets plane's
+// (and planeScalar's) integers. The lanes of `lanes` whose triangles have their codes in a and
+// their geometry in the other arrays; returns those done (o's a0, didx and didy written), the
+// others for planeOf. The other lanes are not read (zero: their results are not stored).
+struct Plane8 {
+  alignas(64) double a[3][4][8];  // vertex, attribute, lane
+  alignas(64) int64_t dx1[8], dy1[8], dx2[8], dy2[8], dcx[8], dcy[8], det[8], bx[8], by[8], across[8], down[8],
+      dx0[8];
+  // Lane t: triangle t's codes af and geometry g.
+  void set(size_t t, const CodesF& af, const PlaneGeom& g) {
+    for (size_t i = 0; i < 3; ++i)
+      for (size_t k = 0; k < 4; ++k) a[i][k][t] = af[i][k];
+    dx1[t] = g.dx1, dy1[t] = g.dy1, dx2[t] = g.dx2, dy2[t] = g.dy2, dcx[t] = g.dcx, dcy[t] = g.dcy, det[t] = g.det;
+    bx[t] = g.bx, by[t] = g.by, across[t] = g.across, down[t] = g.down, dx0[t] = g.dx0;
+  }
+};
+// roundDivPlus of planeavx2 in 8 lanes.
+SHD_AVX512 inline __m512d roundDivPlus8(__m512d base, __m512d n, __m512d d, __m512d inv) {
+  const __m512d one = _mm512_set1_pd(1.0), half = _mm512_set1_pd(0.5);
+  const __m512d m = _mm512_roundscale_pd(_mm512_mul_pd(n, inv), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+  const __m512d r = _mm512_sub_pd(n, _mm512_mul_pd(m, d));
+  const __m512d q = _mm512_add_pd(m, base);
+  const __m512d rest = _mm512_sub_pd(d, r);
+  const __m512d h = _mm512_roundscale_pd(_mm512_mul_pd(q, half), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
+  const __mmask8 odd = _mm512_cmp_pd_mask(_mm512_sub_pd(q, _mm512_add_pd(h, h)), _mm512_setzero_pd(), _CMP_NEQ_OQ);
+  const __mmask8 up = _mm512_cmp_pd_mask(r, rest, _CMP_GT_OQ) | (_mm512_cmp_pd_mask(r, rest, _CMP_EQ_OQ) & odd);
+  return _mm512_mask_add_pd(q, up, q, one);
+}
+SHD_AVX512 __mmask8 plane8(const Plane8& p, __mmask8 lanes, int S, RowSpans* o) {
+  auto load = [lanes](const int64_t* v) SHD_AVX512 { return _mm512_cvtepi64_pd(_mm512_maskz_loadu_epi64(lanes, v)); };
+  auto within = [](__m512d v, double lo, double hi) SHD_AVX512 {
+    return static_cast<__mmask8>(_mm512_cmp_pd_mask(v, _mm512_set1_pd(lo), _CMP_GE_OQ) &
+                                 _mm512_cmp_pd_mask(v, _mm512_set1_pd(hi), _CMP_LE_OQ));
+  };
+  constexpr double kCoord = 1048576.0, k50 = 1125899906842624.0, lo32 = -2147483648.0, hi32 = 2147483647.0;
+  const __m512d dx1 = load(p.dx1), dy1 = load(p.dy1), dx2 = load(p.dx2), dy2 = load(p.dy2);
+  const __m512d dcx = load(p.dcx), dcy = load(p.dcy), d = load(p.det);
+  // plane's first checks: the coordinate differences below 2^20, det below 2^50.
+  __mmask8 ok = lanes & _mm512_cmp_pd_mask(_mm512_max_pd(_mm512_max_pd(_mm512_abs_pd(dx1), _mm512_abs_pd(dy1)),
+                                                         _mm512_max_pd(_mm512_abs_pd(dx2), _mm512_abs_pd(dy2))),
+                                           _mm512_set1_pd(kCoord), _CMP_LT_OQ) &
+                _mm512_cmp_pd_mask(d, _mm512_set1_pd(k50), _CMP_LT_OQ);
+  const __m512d bx = load(p.bx), by = load(p.by), across = load(p.across), down = load(p.down), dx0 = load(p.dx0);
+  const __m512d scale = _mm512_set1_pd(static_cast<double>(int64_t{1} << S));
+  const __m512d inv = _mm512_div_pd(_mm512_set1_pd(1.0), d), d2 = _mm512_add_pd(d, d);
+  const __m512d inv2 = _mm512_mul_pd(inv, _mm512_set1_pd(0.5));
+  const __m512d adcx = _mm512_abs_pd(dcx), adcy = _mm512_abs_pd(dcy);
+  alignas(64) int64_t first[4][8], gx[4][8], gy[4][8];
+  for (size_t k = 0; k < 4; ++k) {
+    const __m512d a0 = _mm512_maskz_load_pd(lanes, p.a[0][k]);
+    const __m512d da1 = _mm512_sub_pd(_mm512_maskz_load_pd(lanes, p.a[1][k]), a0);
+    const __m512d da2 = _mm512_sub_pd(_mm512_maskz_load_pd(lanes, p.a[2][k]), a0);
+    const __m512d nx = _mm512_sub_pd(_mm512_mul_pd(da1, dy2), _mm512_mul_pd(da2, dy1));
+    const __m512d ny = _mm512_sub_pd(_mm512_mul_pd(dx1, da2), _mm512_mul_pd(dx2, da1));
+    const __m512d px = _mm512_mul_pd(_mm512_abs_pd(nx), adcx), py = _mm512_mul_pd(_mm512_abs_pd(ny), adcy);
+    const __m512d sx = _mm512_mul_pd(nx, scale), sy = _mm512_mul_pd(ny, scale);
+    ok &= within(px, -k50, k50) & within(py, -k50, k50) & within(sx, -k50, k50) & within(sy, -k50, k50);
+    const __m512d num = _mm512_add_pd(_mm512_mul_pd(nx, dcx), _mm512_mul_pd(ny, dcy));
+    const __m512d zero = _mm512_setzero_pd();
+    const __m512d didx = roundDivPlus8(zero, sx, d, inv), didy = roundDivPlus8(zero, sy, d, inv);
+    const __m512d iref = roundDivPlus8(a0, num, d2, inv2);
+    ok &= within(didx, lo32, hi32) & within(didy, lo32, hi32);
+    const __m512d corner = _mm512_add_pd(_mm512_add_pd(iref, _mm512_mul_pd(didx, bx)), _mm512_mul_pd(didy, by));
+    const __m512d right = _mm512_add_pd(corner, _mm512_mul_pd(didx, across));
+    const __m512d below = _mm512_mul_pd(didy, down);
+    ok &= within(corner, lo32, hi32) & within(right, lo32, hi32) & within(_mm512_add_pd(corner, below), lo32, hi32) &
+          within(_mm512_add_pd(right, below), lo32, hi32);
+    // Integers within int32_t where ok (elsewhere whatever the conversion gives, not stored).
+    _mm512_store_si512(first[k], _mm512_cvtpd_epi64(_mm512_add_pd(corner, _mm512_mul_pd(didx, dx0))));
+    _mm512_store_si512(gx[k], _mm512_cvtpd_epi64(didx));
+    _mm512_store_si512(gy[k], _mm512_cvtpd_epi64(didy));
+  }
+  for (size_t t = 0; t < 8; ++t) {
+    if (((ok >> t) & 1) == 0) continue;
+    for (size_t k = 0; k < 4; ++k) {
+      o[t].a0[k] = first[k][t];
+      o[t].didx[k] = gx[k][t];
+      o[t].didy[k] = gy[k][t];
+    }
+  }
+  return ok;
+}
 }  // namespace
 #pragma GCC diagnostic pop
 #endif
@@ -707,6 +806,10 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
       count = std::min<size_t>(n, 8);
       Front8 f;
       front8(v, count, c, f);
+      Plane8 p;
+      std::array<PlaneGeom, 8> g;
+      std::array<CodesF, 8> codes;
+      __mmask8 planes = 0;  // the triangles whose rows' spans are set, their plane to follow
       for (size_t t = 0; t < count; ++t) {
         const auto bit = [t](__mmask8 m) { return ((m >> t) & 1) != 0; };
         CodesF af;
@@ -732,8 +835,18 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
         fr.r0 = f.r0[t];
         fr.r1 = f.r1[t];
         if (bit(f.swapped)) std::swap(af[1], af[2]);
+        got[t] = spans(fr, c, out[t], g[t]);
+        if (got[t] == RowSpansSetup::Dropped) continue;
+        planes |= static_cast<__mmask8>(1u << t);
+        p.set(t, af, g[t]);
+        codes[t] = af;
+      }
+      // The planes in lanes; those that do not fit there as one triangle's (planeOf).
+      const __mmask8 done = plane8(p, planes, c.S, out);
+      for (size_t t = 0; t < count; ++t) {
+        if (((planes & ~done) >> t & 1) == 0) continue;
         Codes a;
-        got[t] = spansAndPlane(fr, c, a, af, out[t]);
+        got[t] = planeOf(c, a, codes[t], g[t], out[t]);
       }
     }
     return;
