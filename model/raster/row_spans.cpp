@@ -169,8 +169,9 @@ SHD_AVX2 inline bool within(__m256d v, __m256d lo, __m256d hi) {
 //   - The codes |a| < 2^31 (RowSpansConfig::lim), so |a1 - a0| < 2^32; the coordinate
 //     differences are checked below 2^20, so the four products are below 2^52 and nx, ny exact.
 //   - sx = nx 2^S and sy (exact: a power of two), each product of num checked below 2^50 (fl of
-//     a product below 2^50 means the product is, and then fl is exact), and det below 2^50:
-//     the divisions' operands at most 2^51 (roundDivPlus above).
+//     a product below 2^50 means the product is, and then fl is exact), and det = dx1 dy2 -
+//     dx2 dy1 below 2^41 by the coordinates' bound: the divisions' operands at most 2^51
+//     (roundDivPlus above).
 //   - didx, didy checked within int32_t, as the scalar code does; then the corner values
 //     (|iref| <= 2^50 + 2^31, the box's sides below 2^15) are below 2^51, exact, and checked
 //     within int32_t, and so is a0, a value at a covered pixel.
@@ -178,7 +179,6 @@ SHD_AVX2 bool plane(const CodesF& a, const PlaneGeom& g, RowSpans& o) {
   constexpr int64_t kCoord = int64_t{1} << 20;
   if (std::max({std::abs(g.dx1), std::abs(g.dy1), std::abs(g.dx2), std::abs(g.dy2)}) >= kCoord) return false;
   constexpr double k50 = 1125899906842624.0;  // 2^50
-  if (static_cast<double>(g.det) >= k50) return false;
   const __m256d a0 = _mm256_loadu_pd(a[0].data());
   const __m256d da1 = _mm256_sub_pd(_mm256_loadu_pd(a[1].data()), a0), da2 = _mm256_sub_pd(_mm256_loadu_pd(a[2].data()), a0);
   const __m256d nx = _mm256_sub_pd(_mm256_mul_pd(da1, cv(g.dy2)), _mm256_mul_pd(da2, cv(g.dy1)));
@@ -749,11 +749,10 @@ SHD_AVX512 __mmask8 plane8(const Plane8& p, __mmask8 lanes, int S, RowSpans* o) 
   constexpr double kCoord = 1048576.0, k50 = 1125899906842624.0, lo32 = -2147483648.0, hi32 = 2147483647.0;
   const __m512d dx1 = load(p.dx1), dy1 = load(p.dy1), dx2 = load(p.dx2), dy2 = load(p.dy2);
   const __m512d dcx = load(p.dcx), dcy = load(p.dcy), d = load(p.det);
-  // plane's first checks: the coordinate differences below 2^20, det below 2^50.
+  // plane's first check: the coordinate differences below 2^20 (and so det below 2^41).
   __mmask8 ok = lanes & _mm512_cmp_pd_mask(_mm512_max_pd(_mm512_max_pd(_mm512_abs_pd(dx1), _mm512_abs_pd(dy1)),
                                                          _mm512_max_pd(_mm512_abs_pd(dx2), _mm512_abs_pd(dy2))),
-                                           _mm512_set1_pd(kCoord), _CMP_LT_OQ) &
-                _mm512_cmp_pd_mask(d, _mm512_set1_pd(k50), _CMP_LT_OQ);
+                                           _mm512_set1_pd(kCoord), _CMP_LT_OQ);
   const __m512d bx = load(p.bx), by = load(p.by), across = load(p.across), down = load(p.down), dx0 = load(p.dx0);
   const __m512d scale = _mm512_set1_pd(static_cast<double>(int64_t{1} << S));
   const __m512d inv = _mm512_div_pd(_mm512_set1_pd(1.0), d), d2 = _mm512_add_pd(d, d);
