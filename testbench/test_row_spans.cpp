@@ -237,6 +237,24 @@ testing::AssertionResult sameRowSpans(const RowSpans& a, const RowSpans& b) {
       return testing::AssertionFailure() << "row " << i << " differs";
   return testing::AssertionSuccess();
 }
+// The n triangles v set up by setupRowSpansBlock with c: each outcome want[t], and where Drawn,
+// rows' spans the same as ref[t]. first: the number of v[0] among the test's triangles.
+testing::AssertionResult blockEquals(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c,
+                                     const RowSpans* ref, const RowSpansSetup* want, int first) {
+  std::vector<RowSpans> out(n);
+  std::vector<RowSpansSetup> got(n);
+  setupRowSpansBlock(v, n, c, out.data(), got.data());
+  for (size_t t = 0; t < n; ++t) {
+    const int number = first + static_cast<int>(t);
+    if (got[t] != want[t])
+      return testing::AssertionFailure() << "block triangle " << number << ": outcome " << static_cast<int>(got[t])
+                                         << ", setupRowSpans " << static_cast<int>(want[t]);
+    if (got[t] != RowSpansSetup::Drawn) continue;
+    const testing::AssertionResult same = sameRowSpans(ref[t], out[t]);
+    if (!same) return testing::AssertionFailure() << "block triangle " << number << ": " << same.message();
+  }
+  return testing::AssertionSuccess();
+}
 }  // namespace
 
 TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
@@ -309,14 +327,7 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
     block_ref.push_back(a);
     block_got.push_back(ga);
     if (block_in.size() == 13) {
-      std::array<RowSpans, 13> out;
-      std::array<RowSpansSetup, 13> got;
-      setupRowSpansBlock(block_in.data(), block_in.size(), wide, out.data(), got.data());
-      for (size_t t = 0; t < block_in.size(); ++t) {
-        ASSERT_EQ(got[t], block_got[t]) << "block triangle " << n - 12 + static_cast<int>(t);
-        if (got[t] != RowSpansSetup::Drawn) continue;
-        ASSERT_TRUE(sameRowSpans(block_ref[t], out[t])) << "block triangle " << n - 12 + static_cast<int>(t);
-      }
+      ASSERT_TRUE(blockEquals(block_in.data(), block_in.size(), wide, block_ref.data(), block_got.data(), n - 12));
       block_in.clear();
       block_ref.clear();
       block_got.clear();
@@ -372,15 +383,7 @@ TEST(RowSpans, VectorPlaneLeavesWideCoordinatesToTheScalarOne) {
       ASSERT_TRUE(sameRowSpans(ref[t], b)) << "triangle " << n;
     }
     if (t + 1 < block.size()) continue;
-    std::array<RowSpans, 8> out;
-    std::array<RowSpansSetup, 8> got;
-    setupRowSpansBlock(block.data(), block.size(), wide, out.data(), got.data());
-    for (size_t i = 0; i < block.size(); ++i) {
-      ASSERT_EQ(got[i], ref_got[i]) << "block triangle " << n - 7 + static_cast<int>(i);
-      if (got[i] == RowSpansSetup::Drawn) {
-        ASSERT_TRUE(sameRowSpans(ref[i], out[i])) << "block triangle " << n - 7 + static_cast<int>(i);
-      }
-    }
+    ASSERT_TRUE(blockEquals(block.data(), block.size(), wide, ref.data(), ref_got.data(), n - 7));
   }
   EXPECT_GT(wide_drawn, 1000) << "drawn with coordinate differences of 2^20 subpixels and more";
 }

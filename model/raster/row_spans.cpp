@@ -404,9 +404,9 @@ SHD_AVX512 void walk512(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, R
 }  // namespace rowsx86
 #endif
 
-// setupRowSpans from its edges on (`Front`, its vertices snapped and ordered counter-clockwise
-// and its edges' DDAs from row r0): the rows' spans and the plane. a or af: the attribute codes,
-// in the vertices' order (af where c.vector).
+// setupRowSpans from its edges on: its vertices snapped and ordered counter-clockwise, and its
+// edges' DDAs from row r0. Then the rows' spans (spans) and the plane (planeOf), which
+// setupRowSpans and setupRowSpansBlock share.
 struct Front {
   std::array<int64_t, 3> X, Y;
   int64_t det, r0, r1;
@@ -478,12 +478,6 @@ RowSpansSetup planeOf(const RowSpansConfig& c, Codes& a, const CodesF& af, const
 #endif
   if (!planeScalar(a, g, o)) return RowSpansSetup::General;
   return RowSpansSetup::Drawn;
-}
-
-RowSpansSetup spansAndPlane(const Front& f, const RowSpansConfig& c, Codes& a, const CodesF& af, RowSpans& o) {
-  PlaneGeom g;
-  const RowSpansSetup got = spans(f, c, o, g);
-  return got == RowSpansSetup::Dropped ? got : planeOf(c, a, af, g, o);
 }
 
 }  // namespace
@@ -571,8 +565,9 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     if (k >= c.k_lim || k < -c.k_lim) return RowSpansSetup::General;
     e[s] = {q, q * D - N, D, k, -B[s] - k * D, A[s] < 0};
   }
-  Front f{X, Y, det, r0, r1, e};
-  return spansAndPlane(f, c, a, af, o);
+  PlaneGeom g;
+  if (spans(Front{X, Y, det, r0, r1, e}, c, o, g) == RowSpansSetup::Dropped) return RowSpansSetup::Dropped;
+  return planeOf(c, a, af, g, o);
 }
 
 
@@ -727,6 +722,16 @@ struct Plane8 {
     dx1[t] = g.dx1, dy1[t] = g.dy1, dx2[t] = g.dx2, dy2[t] = g.dy2, dcx[t] = g.dcx, dcy[t] = g.dcy, det[t] = g.det;
     bx[t] = g.bx, by[t] = g.by, across[t] = g.across, down[t] = g.down, dx0[t] = g.dx0;
   }
+  // Lane t's codes and geometry back, for planeOf where the lane does not fit (S: the config's).
+  CodesF codes(size_t t) const {
+    CodesF af;
+    for (size_t i = 0; i < 3; ++i)
+      for (size_t k = 0; k < 4; ++k) af[i][k] = a[i][k][t];
+    return af;
+  }
+  PlaneGeom geom(size_t t, int S) const {
+    return {dx1[t], dy1[t], dx2[t], dy2[t], dcx[t], dcy[t], S, det[t], bx[t], by[t], across[t], down[t], dx0[t]};
+  }
 };
 // roundDivPlus of planeavx2 in 8 lanes.
 SHD_AVX512 inline __m512d roundDivPlus8(__m512d base, __m512d n, __m512d d, __m512d inv) {
@@ -806,8 +811,6 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
       Front8 f;
       front8(v, count, c, f);
       Plane8 p;
-      std::array<PlaneGeom, 8> g;
-      std::array<CodesF, 8> codes;
       __mmask8 planes = 0;  // the triangles whose rows' spans are set, their plane to follow
       for (size_t t = 0; t < count; ++t) {
         const auto bit = [t](__mmask8 m) { return ((m >> t) & 1) != 0; };
@@ -834,18 +837,18 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
         fr.r0 = f.r0[t];
         fr.r1 = f.r1[t];
         if (bit(f.swapped)) std::swap(af[1], af[2]);
-        got[t] = spans(fr, c, out[t], g[t]);
+        PlaneGeom g;
+        got[t] = spans(fr, c, out[t], g);
         if (got[t] == RowSpansSetup::Dropped) continue;
         planes |= static_cast<__mmask8>(1u << t);
-        p.set(t, af, g[t]);
-        codes[t] = af;
+        p.set(t, af, g);
       }
       // The planes in lanes; those that do not fit there as one triangle's (planeOf).
       const __mmask8 done = plane8(p, planes, c.S, out);
       for (size_t t = 0; t < count; ++t) {
         if (((planes & ~done) >> t & 1) == 0) continue;
         Codes a;
-        got[t] = planeOf(c, a, codes[t], g[t], out[t]);
+        got[t] = planeOf(c, a, p.codes(t), p.geom(t, c.S), out[t]);
       }
     }
     return;

@@ -91,6 +91,11 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
     return {row(std::min({a.y, b.y, c.y}), -2), row(std::max({a.y, b.y, c.y}), 2)};
   }
   bool owns(int32_t lo) const { return (std::clamp(lo, 0, H - 1) < split()) == top; }
+  // Whether a triangle whose vertices lie at a, b, c may reach this side's rows.
+  bool reaches(const PVertex& a, const PVertex& b, const PVertex& c) const {
+    const auto [lo, hi] = rowsOf(a, b, c);
+    return rows.anyIn(lo, hi);
+  }
   // Whether this side clips the mesh triangle tv, not culled early (and whether it owns it).
   bool takes(const TriangleView& tv, bool& owner) const {
     owner = top;
@@ -407,7 +412,7 @@ class SceneDrawer {
   void drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner);
   bool drawPart(const Part& part, uint32_t ti, uint8_t hand_off);
   bool drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner);
-  uint32_t splitTag(bool owner) const;
+  uint32_t nextTag(bool owner) const;
   void drawSplitSetUp(const Part& part, uint32_t ti, uint32_t k, bool owner, bool meets, const RowSpans* rows,
                       uint32_t tag);
   bool queueSetUp(const Part& part, uint32_t ti, const SetupInput& in, DrawJob& job, uint8_t hand_off);
@@ -687,8 +692,7 @@ bool SceneDrawer::setUpLater(uint32_t ti, bool owner) {
     if (v < verts || v >= verts + scratch_.verts.size()) return false;
   bool meets = true;
   if (side_ != nullptr) {
-    const auto [lo, hi] = side_->rowsOf(*part.v[0], *part.v[1], *part.v[2]);
-    meets = side_->rows.anyIn(lo, hi);
+    meets = side_->reaches(*part.v[0], *part.v[1], *part.v[2]);
     if (!owner && !meets) return false;
   }
   if (waiting_ > 0 && colour_attrs != waiting_colour_) drawSetUp();
@@ -722,7 +726,7 @@ void SceneDrawer::drawSetUp() {
   for (size_t t = 0; t < n; ++t) {
     const Waiting& w = wait_[t];
     const Part& part = w.part;
-    const uint32_t tag = side_ != nullptr ? splitTag(w.owner) : static_cast<uint32_t>(triangles_.size());
+    const uint32_t tag = nextTag(w.owner);
     const bool spans = wait_got_[t] == RowSpansSetup::Drawn;
     const bool set_up = spans || (wait_got_[t] == RowSpansSetup::General &&
                                   setup_config_.general(wait_in_[t], waiting_colour_, tag, setup_));
@@ -774,7 +778,7 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
     job->colour_attrs = colour_attrs;
   }
   if (back_records_) return queueSetUp(part, ti, in, *job, hand_off);
-  const uint32_t tag = static_cast<uint32_t>(triangles_.size());
+  const uint32_t tag = nextTag(true);
   SetupResult& s = job != nullptr ? job->setup : setup_;
   RowSpans& r = job != nullptr ? job->rows : rows_;
   bool spans = false;
@@ -810,11 +814,10 @@ bool SceneDrawer::drawPart(const Part& part, uint32_t ti, uint8_t hand_off) {
 // A part on a side of a frame split by rows (SplitSide): set up (false: dropped, or not this
 // side's), recorded and counted by its owner, its rows of this side drawn (drawSplitSetUp).
 bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool owner) {
-  const auto [lo, hi] = side_->rowsOf(*part.v[0], *part.v[1], *part.v[2]);
-  const bool meets = side_->rows.anyIn(lo, hi);
+  const bool meets = side_->reaches(*part.v[0], *part.v[1], *part.v[2]);
   if (!owner && !meets) return false;
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
-  const uint32_t tag = splitTag(owner);
+  const uint32_t tag = nextTag(owner);
   bool spans = false;
   SetupInput in;
   setupInput(part, colour_attrs, in);
@@ -824,15 +827,17 @@ bool SceneDrawer::drawSplitPart(const Part& part, uint32_t ti, uint32_t k, bool 
   return true;
 }
 
-// On a side of a frame split by rows: the tag of the next part it sets up, its own index of
-// those it owns, or kForeignTag plus the index of those it draws for the other side.
-uint32_t SceneDrawer::splitTag(bool owner) const {
+// The tag of the next screen triangle set up here: the frame's next index; on a side of a frame
+// split by rows, its own index of those it owns (owner), or kForeignTag plus the index of those
+// it draws for the other side.
+uint32_t SceneDrawer::nextTag(bool owner) const {
+  if (side_ == nullptr) return static_cast<uint32_t>(triangles_.size());
   return owner ? static_cast<uint32_t>(side_->keys.size())
                : SplitSide::kForeignTag + static_cast<uint32_t>(side_->foreign.size());
 }
 
 // Part k of mesh triangle ti, set up on a side of a frame split by rows (as rows, else setup_)
-// with its tag (splitTag): recorded and counted if the side owns it, its rows of the side drawn
+// with its tag (nextTag): recorded and counted if the side owns it, its rows of the side drawn
 // if it meets them.
 void SceneDrawer::drawSplitSetUp(const Part& part, uint32_t ti, uint32_t k, bool owner, bool meets,
                                  const RowSpans* rows, uint32_t tag) {
