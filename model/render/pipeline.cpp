@@ -246,11 +246,16 @@ void triangleNormals(const SceneObject& obj, const CameraBasis& basis, const std
     idx[m] = static_cast<uint32_t>(i);
     m += mark[i];  // without a branch
   }
+  vertexNormals(obj, basis, idx.data(), m, verts, vector);
+}
+
+void vertexNormals(const SceneObject& obj, const CameraBasis& basis, const uint32_t* idx, size_t m, PVertex* verts,
+                   bool vector) {
   const NormalTransform to_world(obj.transform);
   size_t j = 0;
 #ifdef SHD_X86_KERNELS
   if (vector && fixed_simd::availableAvx2())
-    for (; j + 4 <= m; j += 4) avx2::normals4(obj, basis, to_world, idx.data() + j, verts);
+    for (; j + 4 <= m; j += 4) avx2::normals4(obj, basis, to_world, idx + j, verts);
 #else
   (void)vector;
 #endif

@@ -103,6 +103,9 @@ void transformVertexRange(const SceneObject& obj, const CameraBasis& basis, cons
 // those of the triangles it draws alone (render.cpp).
 void triangleNormals(const SceneObject& obj, const CameraBasis& basis, const std::vector<uint32_t>& kept,
                      PVertex* verts, std::vector<uint8_t>& mark, std::vector<uint32_t>& idx, bool vector = true);
+// The normals of the m vertices idx lists, as triangleNormals computes them, into verts.
+void vertexNormals(const SceneObject& obj, const CameraBasis& basis, const uint32_t* idx, size_t m, PVertex* verts,
+                   bool vector = true);
 
 // Where a mesh triangle goes before it is clipped.
 struct TriangleView {

@@ -51,6 +51,81 @@ struct PartKey {
   bool operator<(const PartKey& o) const { return std::tie(object, mesh, part) < std::tie(o.object, o.mesh, o.part); }
 };
 
+// Items 0 .. n - 1 worked on in chunks by both threads of a two-thread frame, one claiming
+// chunks from the front and the other from the back, each chunk once, and counted once worked
+// (done): whichever thread comes first does what the other has not claimed, so neither waits
+// for the other to start. On a frame split by rows the top side works from the front and the
+// bottom from the back, so where the mesh's order follows its rows (a sphere's does) each side
+// mostly works on the items it reads next, in its own core's cache. Reset by one thread before
+// the other can see it.
+class SharedChunks {
+ public:
+  void reset(size_t n) {
+    if (n > UINT32_MAX) throw std::length_error("render: an object of more than 2^32 - 1 vertices or triangles");
+    n_ = n;
+    ends_.store(uint64_t{n} << 32, std::memory_order_relaxed);
+    done_.store(0, std::memory_order_relaxed);
+  }
+  // f(b, e) for each chunk [b, e) of up to `chunk` items it claims, from the front or the back.
+  // A chunk f throws in is counted worked all the same (the other thread does not wait forever;
+  // the frame is drawn again on one thread, renderSplit).
+  template <class F>
+  void work(size_t chunk, bool from_back, F&& f) {
+    for (uint64_t ends = ends_.load(std::memory_order_relaxed);;) {
+      const size_t lo = ends & UINT32_MAX, hi = ends >> 32;
+      if (lo >= hi) return;
+      const size_t b = from_back ? hi - std::min(chunk, hi - lo) : lo, e = from_back ? hi : std::min(lo + chunk, hi);
+      const uint64_t rest = from_back ? uint64_t{b} << 32 | lo : uint64_t{hi} << 32 | e;
+      if (!ends_.compare_exchange_weak(ends, rest, std::memory_order_relaxed)) continue;  // ends reloaded
+      struct Count {
+        std::atomic<size_t>& done;
+        size_t n;
+        ~Count() { done.fetch_add(n, std::memory_order_release); }
+      } count{done_, e - b};
+      f(b, e);
+      ends = rest;
+    }
+  }
+  // Returns once every item is worked (what the threads wrote then visible here).
+  void waitAll() const {
+    for (unsigned spin = 0; done_.load(std::memory_order_acquire) < n_; ++spin) spinPause(spin);
+  }
+
+ private:
+  size_t n_ = 0;
+  alignas(64) std::atomic<uint64_t> ends_{0};  // the items not claimed: [low half, high half)
+  alignas(64) std::atomic<size_t> done_{0};
+};
+
+// An object of a frame split by rows, prepared by both sides together, each pass in
+// SharedChunks that both work on and wait for (SceneDrawer::prepareSplitObject): its vertices
+// transformed; per mesh triangle its place (0: culled early, else which sides take it and
+// whether the top side owns it, SplitSide::place) and, where the method is flat, its face
+// colour; then the normals of the vertices of the triangles kept, and where the method reads
+// them their colours. After that both sides only read it.
+struct SplitObject {
+  static constexpr uint8_t kTopTakes = 1, kTopOwns = 2, kBottomTakes = 4;
+  std::vector<PVertex> verts;
+  std::vector<uint8_t> place;
+  std::vector<std::array<double, 3>> faces;
+  std::unique_ptr<std::atomic<uint8_t>[]> used;  // per vertex: in a triangle kept (either side sets it)
+  size_t used_size = 0;
+  SharedChunks transform, cull, light;
+  // Sized for an object of nv vertices and nt triangles, its passes not begun.
+  void reset(size_t nv, size_t nt) {
+    verts.resize(nv);
+    place.resize(nt);
+    faces.resize(nt);
+    if (used_size < nv) {
+      used.reset(new std::atomic<uint8_t>[nv]);
+      used_size = nv;
+    }
+    transform.reset(nv);
+    cull.reset(nt);
+    light.reset(nv);
+  }
+};
+
 // A side of a two-thread frame split by rows (renderSplit): the rows it draws, and the screen
 // triangles it owns. A mesh triangle's owner is the side of its first row that may hold a pixel
 // (the top side for a triangle not wholly in front of the near plane, whose rows are known only
@@ -77,6 +152,7 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
   RecordedWalk walk;                // a part set up without rows' spans, walked for its rows
   double seconds = 0;               // the side's time (drawSide)
   std::exception_ptr error;
+  std::vector<std::unique_ptr<SplitObject>>* objects = nullptr;  // the frame's, shared by both sides
   // The bottom side's first row.
   int32_t split() const { return top ? rows.y1 : rows.y0; }
   // The rows lo .. hi a triangle whose vertices lie at a, b, c may reach: those of the pixel
@@ -90,19 +166,21 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
     };
     return {row(std::min({a.y, b.y, c.y}), -2), row(std::max({a.y, b.y, c.y}), 2)};
   }
-  bool owns(int32_t lo) const { return (std::clamp(lo, 0, H - 1) < split()) == top; }
   // Whether a triangle whose vertices lie at a, b, c may reach this side's rows.
   bool reaches(const PVertex& a, const PVertex& b, const PVertex& c) const {
     const auto [lo, hi] = rowsOf(a, b, c);
     return rows.anyIn(lo, hi);
   }
-  // Whether this side clips the mesh triangle tv, not culled early (and whether it owns it).
-  bool takes(const TriangleView& tv, bool& owner) const {
-    owner = top;
-    if (!tv.all_in) return true;
+  // The place (SplitObject) of the mesh triangle tv, not culled early: which sides clip it, and
+  // whether the top side owns it.
+  uint8_t place(const TriangleView& tv) const {
+    using O = SplitObject;
+    if (!tv.all_in) return O::kTopTakes | O::kTopOwns | O::kBottomTakes;
     const auto [lo, hi] = rowsOf(*tv.v0, *tv.v1, *tv.v2);
-    owner = owns(lo);
-    return owner || rows.anyIn(lo, hi);
+    const int32_t s = split();
+    const bool top_owns = std::clamp(lo, 0, H - 1) < s;
+    const bool top_takes = top_owns || (lo < s && hi >= 0), bottom_takes = !top_owns || (lo < H && hi >= s);
+    return (top_takes ? O::kTopTakes : 0) | (top_owns ? O::kTopOwns : 0) | (bottom_takes ? O::kBottomTakes : 0);
   }
 };
 
@@ -111,6 +189,7 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
 struct RenderScratch {
   DrawScratch main, second;
   std::array<SplitSide, 2> sides;
+  std::vector<std::unique_ptr<SplitObject>> split_objects;  // the sides' objects (SplitSide::objects)
   int32_t split = -1;
   SplitChoice choice;  // Split::Auto's
 };
@@ -153,9 +232,9 @@ void lightObject(Frame& f, const Scene& scene, const SpecEngines& engines, size_
 }
 
 // The face colours (Frame::faceColour) of an object's triangles, its vertices transformed: of
-// those the drawer will draw (kept: keptTriangles's, on a side of a frame split by rows those
-// it takes) wholly in front of the near plane, the polygons it will draw as the triangles
-// themselves unless the guard band clips them (the others' are not set).
+// those the drawer will draw (kept: keptTriangles's) wholly in front of the near plane, the
+// polygons it will draw as the triangles themselves unless the guard band clips them (the
+// others' are not set).
 void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris,
                 const std::vector<uint32_t>& kept, std::vector<std::array<double, 3>>& faces) {
   faces.resize(tris.size());
@@ -165,11 +244,11 @@ void lightFaces(Frame& f, const std::vector<PVertex>& verts, const std::vector<s
   }
 }
 
-// An object's vertices transformed by both threads of a two-thread frame: each claims chunks
-// (next) and counts those it has written (done); the front end, which claims too, waits until
-// all are done before its first triangle. The back end helps when it reaches the object's mark:
-// at once at the frame's start, where it has nothing else to do; later objects the front end
-// mostly transforms alone, the back end still busy with the object before.
+// An object's vertices transformed by both threads of a two-thread frame (SharedChunks); the
+// front end waits until all are done before its first triangle. The back end helps when it
+// reaches the object's mark: at once at the frame's start, where it has nothing else to do;
+// later objects the front end mostly transforms alone, the back end still busy with the object
+// before.
 struct SharedTransform {
   const SceneObject* obj = nullptr;
   const CameraBasis* basis = nullptr;
@@ -179,19 +258,13 @@ struct SharedTransform {
   size_t n = 0;
   bool vector = true;  // Frame::avx2
   bool normals = true;  // not MethodTraits::face_colours
-  alignas(64) std::atomic<size_t> next{0};
-  alignas(64) std::atomic<size_t> done{0};
+  SharedChunks chunks;
 
   static constexpr size_t kChunk = 64;
-  void work() {
-    for (size_t b; (b = next.fetch_add(kChunk, std::memory_order_relaxed)) < n;) {
-      const size_t e = std::min(b + kChunk, n);
+  void work(bool back_end) {
+    chunks.work(kChunk, back_end, [this](size_t b, size_t e) {
       transformVertexRange(*obj, *basis, *cam, *proj, verts, b, e, vector, normals);
-      done.fetch_add(e - b, std::memory_order_release);
-    }
-  }
-  void waitAll() const {
-    for (unsigned spin = 0; done.load(std::memory_order_acquire) < n; ++spin) spinPause(spin);
+    });
   }
 };
 
@@ -405,7 +478,8 @@ class SceneDrawer {
  private:
   void lightVertices(const std::array<uint32_t, 3>& tri);
   void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
-  void keepTaken(const std::vector<std::array<uint32_t, 3>>& tris);
+  void prepareObject(size_t oi);
+  void prepareSplitObject(size_t oi);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   bool setUpLater(uint32_t ti, bool owner);
   void drawSetUp();
@@ -433,7 +507,11 @@ class SceneDrawer {
   // computed (lit), its triangles not culled early (kept, and a side's owner flags), its face
   // colours lit ahead (faces), the normals' scratch.
   DrawScratch& scratch_;
-  bool faces_lit_ = false;            // this object's scratch_.faces (MethodTraits::face_colours)
+  // The object's vertices and face colours: scratch_'s, or on a side of a frame split by rows
+  // the SplitObject's.
+  std::vector<PVertex>* verts_ = nullptr;
+  std::vector<std::array<double, 3>>* faces_ = nullptr;
+  bool faces_lit_ = false;            // this object's faces_ (MethodTraits::face_colours)
   Poly poly_;                         // a clipped triangle
   Fan fan_;                           // the polygon to draw
   Parts parts_;                       // its screen triangles
@@ -541,50 +619,16 @@ void SceneDrawer::drawObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   lightObject(f_, scene_, engines_, oi);
   for (const auto& u : f_.units()) u.second->beginObject();
-  scratch_.verts.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
   // On one thread, where no specular unit counts the lighting (Frame::shadeNow). (On two, the
   // pass delays the back end's first triangles: flat's frame took 1.03-1.06 times as long with
   // it, the pass shared between both threads, docs/performance.md.)
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
-  if (queue_ == nullptr) {
-    transformVertexRange(obj, basis_, scene_.camera, f_.proj, scratch_.verts.data(), 0, scratch_.verts.size(), f_.avx2,
-                         false);
-  } else {
-    DrawJob& j = queue_->slot();
-    j.kind = DrawJob::Kind::BeginObject;
-    j.object = oi;
-    SharedTransform& t = j.transform;
-    t.obj = &obj;
-    t.basis = &basis_;
-    t.cam = &scene_.camera;
-    t.proj = &f_.proj;
-    t.verts = scratch_.verts.data();
-    t.n = scratch_.verts.size();
-    t.vector = f_.avx2;
-    t.normals = !face_colours_;
-    t.next.store(0, std::memory_order_relaxed);
-    t.done.store(0, std::memory_order_relaxed);
-    queue_->push(true);  // shown to the back end at once (release)
-    t.work();
-    t.waitAll();
-  }
-  // The back faces culled early, counted at once (on a side of a frame split by rows, the top
-  // side's); the others drawn in order.
-  std::vector<uint32_t>& kept = scratch_.kept;
-  const size_t culled = keptTriangles(scratch_.verts, obj.mesh.triangles, f_.proj.z_near, kept);
-  RenderStats& culled_st = side_ != nullptr && !side_->top ? side_->others : f_.st;
-  culled_st.triangles += culled;
-  culled_st.culled_back += culled;
-  if (side_ != nullptr) keepTaken(obj.mesh.triangles);
-  // The normals of the vertices drawn (transformed without them above), where the method reads
-  // them; the two-thread frame's shared transform gave every vertex its normal.
-  if (queue_ == nullptr && !face_colours_)
-    triangleNormals(obj, basis_, kept, scratch_.verts.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
-  if (faces_lit_) lightFaces(f_, scratch_.verts, obj.mesh.triangles, kept, scratch_.faces);
-  scratch_.lit.assign(scratch_.verts.size(), 0);
+  if (side_ != nullptr) prepareSplitObject(oi);
+  else prepareObject(oi);
   // (Not where a specular unit counts the requests: a waiting triangle's vertices are lit
   // before the triangles ahead of it are drawn.)
   blocks_ = queue_ == nullptr && f_.obj.spec == nullptr;
+  const std::vector<uint32_t>& kept = scratch_.kept;
   uint32_t ti = 0;
   try {
     for (size_t j = 0; j < kept.size(); ++j) {
@@ -606,6 +650,113 @@ void SceneDrawer::drawObject(size_t oi) {
   }
 }
 
+// One thread, or the front end of a two-thread frame: the object's vertices transformed (by
+// both threads on two), its back faces culled early and counted, the normals of the vertices
+// drawn, the face colours lit ahead.
+void SceneDrawer::prepareObject(size_t oi) {
+  const SceneObject& obj = scene_.objects[oi];
+  verts_ = &scratch_.verts;
+  faces_ = &scratch_.faces;
+  scratch_.verts.resize(obj.mesh.positions.size());  // kept from the frame before: nothing to clear
+  if (queue_ == nullptr) {
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, scratch_.verts.data(), 0, scratch_.verts.size(), f_.avx2,
+                         false);
+  } else {
+    DrawJob& j = queue_->slot();
+    j.kind = DrawJob::Kind::BeginObject;
+    j.object = oi;
+    SharedTransform& t = j.transform;
+    t.obj = &obj;
+    t.basis = &basis_;
+    t.cam = &scene_.camera;
+    t.proj = &f_.proj;
+    t.verts = scratch_.verts.data();
+    t.n = scratch_.verts.size();
+    t.vector = f_.avx2;
+    t.normals = !face_colours_;
+    t.chunks.reset(t.n);
+    queue_->push(true);  // shown to the back end at once (release)
+    t.work(false);
+    t.chunks.waitAll();
+  }
+  std::vector<uint32_t>& kept = scratch_.kept;
+  const size_t culled = keptTriangles(scratch_.verts, obj.mesh.triangles, f_.proj.z_near, kept);
+  f_.st.triangles += culled;
+  f_.st.culled_back += culled;
+  // The normals of the vertices drawn (transformed without them above), where the method reads
+  // them; the two-thread frame's shared transform gave every vertex its normal.
+  if (queue_ == nullptr && !face_colours_)
+    triangleNormals(obj, basis_, kept, scratch_.verts.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
+  if (faces_lit_) lightFaces(f_, scratch_.verts, obj.mesh.triangles, kept, scratch_.faces);
+  scratch_.lit.assign(scratch_.verts.size(), 0);
+}
+
+// A side of a frame split by rows: the object prepared by both sides (SplitObject), its back
+// faces culled early counted by the side that culled them, and then this side's triangles: those
+// it takes, in order, and whether it owns each (DrawScratch::kept, owner).
+void SceneDrawer::prepareSplitObject(size_t oi) {
+  const SceneObject& obj = scene_.objects[oi];
+  const std::vector<std::array<uint32_t, 3>>& tris = obj.mesh.triangles;
+  SplitObject& so = *(*side_->objects)[oi];
+  verts_ = &so.verts;
+  faces_ = &so.faces;
+  const bool from_back = !side_->top, normals = !face_colours_;
+  constexpr size_t kVertexChunk = 64, kTriangleChunk = 256;
+  so.transform.work(kVertexChunk, from_back, [&](size_t b, size_t e) {
+    transformVertexRange(obj, basis_, scene_.camera, f_.proj, so.verts.data(), b, e, f_.avx2, false);
+    if (normals)
+      for (size_t i = b; i < e; ++i) so.used[i].store(0, std::memory_order_relaxed);
+  });
+  so.transform.waitAll();
+  size_t culled = 0;
+  so.cull.work(kTriangleChunk, from_back, [&](size_t b, size_t e) {
+    for (size_t t = b; t < e; ++t) {
+      const TriangleView tv = viewTriangle(so.verts, tris[t], f_.proj.z_near);
+      const bool keep = !culledEarly(tv);
+      so.place[t] = keep ? side_->place(tv) : 0;
+      culled += !keep;
+      if (keep && normals)
+        for (const uint32_t i : tris[t]) so.used[i].store(1, std::memory_order_relaxed);
+      if (keep && faces_lit_ && tv.all_in) so.faces[t] = f_.faceColour(*tv.v0, *tv.v1, *tv.v2);
+    }
+  });
+  f_.st.triangles += culled;
+  f_.st.culled_back += culled;
+  so.cull.waitAll();
+  if (normals) {
+    so.light.work(kVertexChunk, from_back, [&](size_t b, size_t e) {
+      std::array<uint32_t, kVertexChunk> idx;
+      size_t m = 0;
+      for (size_t i = b; i < e; ++i) {
+        idx[m] = static_cast<uint32_t>(i);
+        m += so.used[i].load(std::memory_order_relaxed);
+      }
+      vertexNormals(obj, basis_, idx.data(), m, so.verts.data(), f_.avx2);
+      if (vertex_colours_)
+        for (size_t j = 0; j < m; ++j) {
+          PVertex& v = so.verts[idx[j]];
+          v.colour = f_.shadeNow(v.n, v.cam);
+        }
+    });
+    so.light.waitAll();
+  }
+  const uint8_t takes = side_->top ? SplitObject::kTopTakes : SplitObject::kBottomTakes;
+  const uint8_t owns = side_->top ? SplitObject::kTopOwns : 0;
+  std::vector<uint32_t>& kept = scratch_.kept;
+  std::vector<uint8_t>& owner = scratch_.owner;
+  kept.resize(tris.size());
+  owner.resize(tris.size());
+  size_t n = 0;
+  for (size_t t = 0; t < tris.size(); ++t) {
+    const uint8_t p = so.place[t];
+    kept[n] = static_cast<uint32_t>(t);
+    owner[n] = (p & SplitObject::kTopOwns) == owns;
+    n += (p & takes) != 0;  // without a branch
+  }
+  kept.resize(n);
+  owner.resize(n);
+}
+
 // Gouraud vertex colours: computed when a triangle that is not culled first needs them.
 void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
   for (const uint32_t i : tri)
@@ -615,35 +766,15 @@ void SceneDrawer::lightVertices(const std::array<uint32_t, 3>& tri) {
     }
 }
 
-// On a side of a frame split by rows: of the triangles not culled early (DrawScratch::kept),
-// those the side takes (SplitSide::takes), in order, and whether it owns each (owner).
-void SceneDrawer::keepTaken(const std::vector<std::array<uint32_t, 3>>& tris) {
-  std::vector<uint32_t>& kept = scratch_.kept;
-  std::vector<uint8_t>& owners = scratch_.owner;
-  owners.resize(kept.size());
-  size_t n = 0;
-  for (size_t j = 0; j < kept.size(); ++j) {
-    const uint32_t k = kept[j];
-    bool owner = false;
-    const bool takes = side_->takes(viewTriangle(scratch_.verts, tris[k], f_.proj.z_near), owner);
-    kept[n] = k;  // n <= j: an entry read already
-    owners[n] = owner;
-    n += takes;
-  }
-  kept.resize(n);
-  owners.resize(n);
-}
-
-// A mesh triangle not culled early that a side of a frame split by rows takes (keepTaken): its
-// owner's to count.
+// A mesh triangle not culled early that a side of a frame split by rows takes
+// (prepareSplitObject): its owner's to count. Its vertices' colours are lit already.
 void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti, bool owner) {
-  const TriangleView tv = viewTriangle(scratch_.verts, tri, f_.proj.z_near);
+  const TriangleView tv = viewTriangle(*verts_, tri, f_.proj.z_near);
   RenderStats& st = owner ? f_.st : side_->others;
   ++st.triangles;
-  if (vertex_colours_) lightVertices(tri);
   if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
   parts_.clear();
-  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &scratch_.faces[ti] : nullptr;
+  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &(*faces_)[ti] : nullptr;
   unit_.parts(fan_, parts_);
   if (blocks_ && fan_[0] == tv.v0 && setUpLater(ti, owner)) return;
   drawSetUp();  // the triangles waiting first
@@ -655,11 +786,11 @@ void SceneDrawer::drawSplitTriangle(const std::array<uint32_t, 3>& tri, uint32_t
 void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti) {
   RenderStats& st = f_.st;
   ++st.triangles;
-  const TriangleView tv = viewTriangle(scratch_.verts, tri, f_.proj.z_near);
+  const TriangleView tv = viewTriangle(*verts_, tri, f_.proj.z_near);
   if (vertex_colours_) lightVertices(tri);
   if (!clipToFan(tv, f_.proj, f_.W, f_.H, poly_, fan_, st)) return;
   // Lit ahead: a triangle drawn as itself (a clipped one's fan points into poly_).
-  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &scratch_.faces[ti] : nullptr;
+  f_.face_colour = faces_lit_ && fan_[0] == tv.v0 ? &(*faces_)[ti] : nullptr;
   // The screen triangles to draw (a fan of the polygon), each with the unit that draws it:
   // modified Gouraud may split one into parts, adaptive picks per triangle.
   parts_.clear();
@@ -687,9 +818,9 @@ bool SceneDrawer::setUpLater(uint32_t ti, bool owner) {
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
   const RowSpansConfig* rs = setup_config_.rowSpans(part.method, colour_attrs);
   if (rs == nullptr || !rs->avx512) return false;
-  const PVertex* const verts = scratch_.verts.data();
+  const PVertex* const verts = verts_->data();
   for (const PVertex* v : part.v)
-    if (v < verts || v >= verts + scratch_.verts.size()) return false;
+    if (v < verts || v >= verts + verts_->size()) return false;
   bool meets = true;
   if (side_ != nullptr) {
     meets = side_->reaches(*part.v[0], *part.v[1], *part.v[2]);
@@ -958,7 +1089,7 @@ void drawBackEnd(DrawQueue& q, BackEnd& b, const Scene& scene, const SpecEngines
         q.release();
         return;
       case DrawJob::Kind::BeginObject:
-        j->transform.work();
+        j->transform.work(true);
         lightObject(f, scene, engines, j->object);
         for (const auto& u : f.units()) u.second->beginObject();
         break;
@@ -1139,9 +1270,16 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
   const int32_t H = scene.camera.height;
   if (scratch.split < 0 || scratch.split > H) scratch.split = H / 2;
   const int32_t split = opt.split_row >= 0 ? std::min(opt.split_row, H) : scratch.split;
+  std::vector<std::unique_ptr<SplitObject>>& objects = scratch.split_objects;
+  if (objects.size() < scene.objects.size()) objects.resize(scene.objects.size());
+  for (size_t oi = 0; oi < scene.objects.size(); ++oi) {
+    if (!objects[oi]) objects[oi] = std::make_unique<SplitObject>();
+    objects[oi]->reset(scene.objects[oi].mesh.positions.size(), scene.objects[oi].mesh.triangles.size());
+  }
   std::array<SplitSide, 2>& sides = scratch.sides;
   for (size_t i = 0; i < 2; ++i) {
     SplitSide& s = sides[i];
+    s.objects = &objects;
     s.top = i == 0;
     s.H = H;
     s.rows.y0 = s.top ? 0 : split;
@@ -1327,11 +1465,12 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
   const ClearRect clear =
       prepareClear(res.fb, scene.camera.width, scene.camera.height, traits(opt.method).exact, opt.tags);
   span.beginFrame();
-  // Split::Auto chooses by the frames' times (SplitChoice); its first frame as the method prefers.
+  // Split::Auto chooses by the frames' times (SplitChoice); its first frame by rows, for every
+  // method the faster way on most of the spheres measured (docs/performance.md).
   const bool may_split = opt.threads == 2 && splitsByRows(scene, opt, span);
   const bool measured = may_split && opt.split == RenderOptions::Split::Auto;
   SplitChoice& choice = res.scratch.get().choice;
-  res.split_by_rows = measured ? choice.next(traits(opt.method).two_threads == TwoThreads::AfterWalk) : may_split;
+  res.split_by_rows = measured ? choice.next(true) : may_split;
   if (res.split_by_rows) {
     renderSplit(scene, opt, span, engines, clear, res);  // into the list the frame before left
   } else {
