@@ -658,6 +658,88 @@ TEST(RenderPipeline, VectorTransformEqualsTheScalarOne) {
   EXPECT_GT(zero_normals, 100u);
 }
 
+// The early cull 8 triangles at a time in AVX-512 lanes against one at a time: the same kept
+// triangles, in order, over random vertices (depths at, just off and on either side of the near
+// plane, NaN and infinite coordinates) and triangles (zero areas from a repeated vertex and from
+// collinear vertices, -0 among them; nearly collinear ones, whose sign the products' rounding
+// decides; vertices at the end of the array), over ranges that start and end off a multiple of 8;
+// and keptTriangles's count of those culled.
+TEST(RenderPipeline, VectorCullEqualsTheScalarOne) {
+  if (!fixed_simd::available()) GTEST_SKIP() << "no AVX-512 here (or SHD_SCALAR, SHD_NO_AVX512): the scalar path alone";
+  std::mt19937_64 rng(20261201);
+  std::uniform_real_distribution<double> u(-50, 50);
+  const double z_near = 0.25, nan = std::nan(""), inf = HUGE_VAL;
+  const size_t nv = 5003, nt = 20011;
+  std::vector<PVertex> verts(nv);
+  for (size_t i = 0; i < nv; ++i) {
+    PVertex& v = verts[i];
+    v.x = u(rng);
+    v.y = u(rng);
+    v.cam.z = i % 5 == 0 ? z_near : (i % 5 == 1 ? std::nextafter(z_near, 0.0) : u(rng) * 0.02 + 0.5);
+    if (i % 97 == 0) v.x = nan;
+    if (i % 89 == 0) v.y = -inf;
+    if (i % 83 == 0) v.cam.z = nan;
+    if (i % 7 == 3) v.x = std::round(v.x);  // with the next two, collinear vertices where x and y are integers
+    if (i % 7 == 3) v.y = std::round(v.y);
+  }
+  std::uniform_int_distribution<uint32_t> vertex(0, static_cast<uint32_t>(nv - 1));
+  std::vector<std::array<uint32_t, 3>> tris(nt);
+  size_t zero_areas = 0;
+  for (size_t t = 0; t < nt; ++t) {
+    std::array<uint32_t, 3>& tri = tris[t];
+    tri = {vertex(rng), vertex(rng), vertex(rng)};
+    if (t % 11 == 0) tri[2] = tri[0];                                  // area 0 (or NaN)
+    if (t % 13 == 0) tri = {static_cast<uint32_t>(nv - 1), static_cast<uint32_t>(nv - 2), tri[2]};
+    if (t % 17 == 0) {  // collinear: (a, a + d, a + 2d), -0 or +0 as the order goes
+      tri = {static_cast<uint32_t>(7 * (t % 700) + 3), static_cast<uint32_t>(7 * (t % 700) + 10),
+             static_cast<uint32_t>(7 * (t % 700) + 17)};
+      PVertex &a = verts[tri[0]], &b = verts[tri[1]], &c = verts[tri[2]];
+      b.x = a.x + 3;
+      b.y = a.y - 2;
+      c.x = a.x + 6;
+      c.y = a.y - 4;
+      a.cam.z = b.cam.z = c.cam.z = 1;
+    }
+    if (t % 19 == 0) {  // nearly collinear, (a, a + d, a + 3d) rounded: the products' roundings decide
+      const size_t m = 7 * (t % 700) + 5;
+      tri = {static_cast<uint32_t>(m), static_cast<uint32_t>(m + 7), static_cast<uint32_t>(m + 14)};
+      PVertex &a = verts[tri[0]], &b = verts[tri[1]], &c = verts[tri[2]];
+      const double dx = u(rng) * 0.037, dy = u(rng) * 0.053;
+      b.x = a.x + dx;
+      b.y = a.y + dy;
+      c.x = a.x + 3 * dx;
+      c.y = a.y + 3 * dy;
+      a.cam.z = b.cam.z = c.cam.z = 1;
+    }
+  }
+  for (const std::array<uint32_t, 3>& tri : tris)
+    zero_areas += area2(verts[tri[0]], verts[tri[1]], verts[tri[2]]) == 0;
+  size_t compared = 0, kept_total = 0, culled_in_front = 0;
+  for (const auto& [b, e] : {std::pair<size_t, size_t>{0, nt}, {1, nt - 2}, {3, 6}, {5, 21}, {8, 16}, {nt - 7, nt}}) {
+    std::vector<uint32_t> vec(e - b + 1, 0xdead), scalar(e - b + 1, 0xbeef);
+    const size_t nvec = keptTriangleRange(verts.data(), nv, tris.data(), b, e, z_near, vec.data(), true);
+    const size_t nscalar = keptTriangleRange(verts.data(), nv, tris.data(), b, e, z_near, scalar.data(), false);
+    ASSERT_EQ(nvec, nscalar) << "[" << b << ", " << e << ")";
+    for (size_t j = 0; j < nscalar; ++j) ASSERT_EQ(vec[j], scalar[j]) << "[" << b << ", " << e << ") entry " << j;
+    compared += e - b;
+    kept_total += nscalar;
+  }
+  std::vector<uint32_t> kept;
+  const size_t culled = keptTriangles(verts, tris, z_near, kept, true);
+  EXPECT_EQ(culled + kept.size(), nt);
+  for (const uint32_t t : kept) EXPECT_FALSE(culledEarly(viewTriangle(verts, tris[t], z_near))) << "triangle " << t;
+  for (const std::array<uint32_t, 3>& tri : tris) {
+    const TriangleView tv = viewTriangle(verts, tri, z_near);
+    culled_in_front += tv.all_in && culledEarly(tv);
+  }
+  // Not vacuous: both verdicts, triangles behind the near plane, zero areas.
+  EXPECT_EQ(compared, nt + (nt - 3) + 3 + 16 + 8 + 7);
+  EXPECT_GT(kept_total, compared / 4);
+  EXPECT_GT(culled_in_front, nt / 8);
+  EXPECT_GT(zero_areas, nt / 20);
+  EXPECT_EQ(culled, culled_in_front);
+}
+
 #if defined(__x86_64__) && defined(__GNUC__)
 namespace {
 // a b - c d in a function whose target has FMA, as the AVX-512 kernels' do.
