@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <climits>
 #include <cmath>
-#include <cstddef>
 #include <cstring>
 #include <stdexcept>
 
@@ -200,81 +199,14 @@ SHD_AVX2 void transform4(const SceneObject& obj, const CameraBasis& basis, const
 
 }  // namespace
 
-#ifdef SHD_X86_KERNELS
-namespace avx512 {
-
-// culledEarly of 8 triangles at a time, a triangle per 64-bit lane: each vertex's cam.z, x and y
-// gathered from the vertex array, the same comparisons (ordered: false on NaN, as C++'s) and
-// area2's operations in its order (no FMA: the build's -ffp-contract=off), so each lane's
-// verdict is culledEarly's. The indices of the triangles kept, in order, into kept; returns how
-// many. Vertex indices times 12 (sizeof(PVertex) in doubles) must fit in 32 bits (the caller's
-// check).
-// The field at `field` doubles into each of 8 vertices, at[i] doubles into base (the masked
-// gather, all lanes on: GCC 12 warns of the unmasked one's unset pass-through).
-SHD_AVX512 inline __m512d gather(const double* base, __m256i at, int field) {
-  return _mm512_mask_i32gather_pd(_mm512_setzero_pd(), 0xff, at, base + field, 8);
-}
-
-SHD_AVX512 size_t keptRange(const PVertex* verts, const std::array<uint32_t, 3>* tris, size_t begin, size_t end,
-                            double z_near, uint32_t* kept) {
-  static_assert(sizeof(PVertex) == 12 * sizeof(double), "PVertex: 12 doubles");
-  static_assert(sizeof(std::array<uint32_t, 3>) == 12, "a triangle: 3 packed indices");
-  const double* base = reinterpret_cast<const double*>(verts);
-  constexpr int kZ = offsetof(PVertex, cam) / 8 + 2, kX = offsetof(PVertex, x) / 8, kY = offsetof(PVertex, y) / 8;
-  const __m256i stride3 = _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21), twelve = _mm256_set1_epi32(12);
-  const __m256i lanes = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m512d zn = _mm512_set1_pd(z_near), zero = _mm512_setzero_pd();
-  size_t n = 0, t = begin;
-  for (; t + 8 <= end; t += 8) {
-    const int* idx = reinterpret_cast<const int*>(tris + t);
-    __m512d x[3], y[3];
-    __mmask8 all_in = 0xff;
-    for (int k = 0; k < 3; ++k) {
-      const __m256i at = _mm256_mullo_epi32(_mm256_i32gather_epi32(idx + k, stride3, 4), twelve);
-      all_in &= _mm512_cmp_pd_mask(gather(base, at, kZ), zn, _CMP_GE_OQ);
-      x[k] = gather(base, at, kX);
-      y[k] = gather(base, at, kY);
-    }
-    const __m512d area = _mm512_sub_pd(_mm512_mul_pd(_mm512_sub_pd(x[1], x[0]), _mm512_sub_pd(y[2], y[0])),
-                                       _mm512_mul_pd(_mm512_sub_pd(x[2], x[0]), _mm512_sub_pd(y[1], y[0])));
-    const __mmask8 front = _mm512_cmp_pd_mask(area, zero, _CMP_LT_OQ);
-    const __mmask8 keep = static_cast<__mmask8>(~(all_in & static_cast<__mmask8>(~front)));
-    const __m256i ids = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(t)), lanes);
-    _mm256_mask_compressstoreu_epi32(kept + n, keep, ids);
-    n += static_cast<size_t>(__builtin_popcount(keep));
-  }
-  for (; t < end; ++t) {
-    kept[n] = static_cast<uint32_t>(t);
-    n += culledEarly(viewTriangle(verts, tris[t], z_near)) ? 0 : 1;
-  }
-  return n;
-}
-
-}  // namespace avx512
-#endif
-
-size_t keptTriangleRange(const PVertex* verts, size_t n_verts, const std::array<uint32_t, 3>* tris, size_t begin,
-                         size_t end, double z_near, uint32_t* kept, bool vector) {
-#ifdef SHD_X86_KERNELS
-  if (vector && n_verts <= size_t{INT32_MAX} / 12 && fixed_simd::available())
-    return avx512::keptRange(verts, tris, begin, end, z_near, kept);
-#else
-  (void)vector;
-#endif
-  (void)n_verts;
-  size_t n = 0;
-  for (size_t t = begin; t < end; ++t) {
-    kept[n] = static_cast<uint32_t>(t);
-    n += culledEarly(viewTriangle(verts, tris[t], z_near)) ? 0 : 1;  // without a branch
-  }
-  return n;
-}
-
 size_t keptTriangles(const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris, double z_near,
-                     std::vector<uint32_t>& kept, bool vector) {
+                     std::vector<uint32_t>& kept) {
   kept.resize(tris.size());
-  const size_t n =
-      keptTriangleRange(verts.data(), verts.size(), tris.data(), 0, tris.size(), z_near, kept.data(), vector);
+  size_t n = 0;
+  for (size_t i = 0; i < tris.size(); ++i) {
+    kept[n] = static_cast<uint32_t>(i);
+    n += culledEarly(viewTriangle(verts, tris[i], z_near)) ? 0 : 1;  // without a branch
+  }
   kept.resize(n);
   return tris.size() - n;
 }

@@ -112,25 +112,16 @@ struct TriangleView {
   const PVertex *v0, *v1, *v2;
   bool all_in;  // all three vertices in front of the near plane (so projected)
 };
-inline TriangleView viewTriangle(const PVertex* verts, const std::array<uint32_t, 3>& tri, double z_near) {
+inline TriangleView viewTriangle(const std::vector<PVertex>& verts, const std::array<uint32_t, 3>& tri, double z_near) {
   const PVertex &v0 = verts[tri[0]], &v1 = verts[tri[1]], &v2 = verts[tri[2]];
   return {&v0, &v1, &v2, v0.cam.z >= z_near && v1.cam.z >= z_near && v2.cam.z >= z_near};
-}
-inline TriangleView viewTriangle(const std::vector<PVertex>& verts, const std::array<uint32_t, 3>& tri, double z_near) {
-  return viewTriangle(verts.data(), tri, z_near);
 }
 // Back faces: a triangle wholly in front of the near plane is culled before anything is copied.
 inline bool culledEarly(const TriangleView& t) { return t.all_in && !(area2(*t.v0, *t.v1, *t.v2) < 0); }
 // The indices of an object's mesh triangles (its vertices transformed) that culledEarly keeps,
-// in order, into kept; returns how many it culls. 8 at a time in AVX-512 lanes where the CPU has
-// them (fixed_simd::available: not with SHD_SCALAR or SHD_NO_AVX512) and vector holds, with the
-// same verdicts.
+// in order, into kept; returns how many it culls.
 size_t keptTriangles(const std::vector<PVertex>& verts, const std::vector<std::array<uint32_t, 3>>& tris, double z_near,
-                     std::vector<uint32_t>& kept, bool vector = true);
-// The same over the triangles begin .. end - 1 of tris, of the n_verts vertices verts: their
-// indices kept into kept (room for end - begin); returns how many are kept.
-size_t keptTriangleRange(const PVertex* verts, size_t n_verts, const std::array<uint32_t, 3>* tris, size_t begin,
-                         size_t end, double z_near, uint32_t* kept, bool vector = true);
+                     std::vector<uint32_t>& kept);
 
 // The visible part of a triangle that is not culledEarly as a fan: its own three vertices (the
 // common case, nothing copied), or the polygon clipped by the near plane (camera space) and the

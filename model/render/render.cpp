@@ -680,7 +680,7 @@ void SceneDrawer::prepareObject(size_t oi) {
     t.chunks.waitAll();
   }
   std::vector<uint32_t>& kept = scratch_.kept;
-  const size_t culled = keptTriangles(scratch_.verts, obj.mesh.triangles, f_.proj.z_near, kept, f_.avx2);
+  const size_t culled = keptTriangles(scratch_.verts, obj.mesh.triangles, f_.proj.z_near, kept);
   f_.st.triangles += culled;
   f_.st.culled_back += culled;
   // The normals of the vertices drawn (transformed without them above), where the method reads
@@ -710,18 +710,14 @@ void SceneDrawer::prepareSplitObject(size_t oi) {
   so.transform.waitAll();
   size_t culled = 0;
   so.cull.work(kTriangleChunk, from_back, [&](size_t b, size_t e) {
-    std::array<uint32_t, kTriangleChunk> kept;
-    const size_t n = keptTriangleRange(so.verts.data(), so.verts.size(), tris.data(), b, e, f_.proj.z_near,
-                                       kept.data(), f_.avx2);
-    culled += (e - b) - n;
-    std::fill(so.place.begin() + static_cast<ptrdiff_t>(b), so.place.begin() + static_cast<ptrdiff_t>(e), 0);
-    for (size_t j = 0; j < n; ++j) {
-      const uint32_t t = kept[j];
+    for (size_t t = b; t < e; ++t) {
       const TriangleView tv = viewTriangle(so.verts, tris[t], f_.proj.z_near);
-      so.place[t] = side_->place(tv);
-      if (normals)
+      const bool keep = !culledEarly(tv);
+      so.place[t] = keep ? side_->place(tv) : 0;
+      culled += !keep;
+      if (keep && normals)
         for (const uint32_t i : tris[t]) so.used[i].store(1, std::memory_order_relaxed);
-      if (faces_lit_ && tv.all_in) so.faces[t] = f_.faceColour(*tv.v0, *tv.v1, *tv.v2);
+      if (keep && faces_lit_ && tv.all_in) so.faces[t] = f_.faceColour(*tv.v0, *tv.v1, *tv.v2);
     }
   });
   f_.st.triangles += culled;
