@@ -190,10 +190,9 @@ struct RenderOptions {
   // How two threads split a frame. By rows only where no count depends on the order of the
   // frame's triangles (no device lobe, the paper's span unit), else into front and back end.
   // Auto: the faster of the two, measured over the frames drawn into one RenderResult
-  // (SplitChoice, split_choice.h); its first frame by rows for a method walked ahead
-  // (phong-fixed, whose shading per pixel is the longer half), in front and back end for flat
-  // and Gouraud. Every choice gives the same bytes and counts (the tests compare each with one
-  // thread); RenderResult::split_by_rows says which way a frame went.
+  // (SplitChoice, split_choice.h); its first frame by rows. Every choice gives the same bytes
+  // and counts (the tests compare each with one thread); RenderResult::split_by_rows says which
+  // way a frame went.
   enum class Split { Auto, Rows, FrontBack };
   Split split = Split::Auto;
   // A frame split by rows: the first row of the bottom side (from 0, all rows the bottom's, to
