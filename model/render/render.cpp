@@ -179,7 +179,8 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
     const auto [lo, hi] = rowsOf(*tv.v0, *tv.v1, *tv.v2);
     const int32_t s = split();
     const bool top_owns = std::clamp(lo, 0, H - 1) < s;
-    const bool top_takes = top_owns || (lo < s && hi >= 0), bottom_takes = !top_owns || (lo < H && hi >= s);
+    const RowShare top_rows{RowShare::Side::Rows, 0, s}, bottom_rows{RowShare::Side::Rows, s, H};
+    const bool top_takes = top_owns || top_rows.anyIn(lo, hi), bottom_takes = !top_owns || bottom_rows.anyIn(lo, hi);
     return (top_takes ? O::kTopTakes : 0) | (top_owns ? O::kTopOwns : 0) | (bottom_takes ? O::kBottomTakes : 0);
   }
 };
@@ -255,7 +256,6 @@ struct SharedTransform {
   const Camera* cam = nullptr;
   const Projection* proj = nullptr;
   PVertex* verts = nullptr;
-  size_t n = 0;
   bool vector = true;  // Frame::avx2
   bool normals = true;  // not MethodTraits::face_colours
   SharedChunks chunks;
@@ -478,8 +478,8 @@ class SceneDrawer {
  private:
   void lightVertices(const std::array<uint32_t, 3>& tri);
   void walkAhead(const SpanDesc& d, RecordedWalk& w, bool count = true);
-  void prepareObject(size_t oi);
-  void prepareSplitObject(size_t oi);
+  size_t prepareObject(size_t oi);
+  size_t prepareSplitObject(size_t oi);
   void drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t ti);
   bool setUpLater(uint32_t ti, bool owner);
   void drawSetUp();
@@ -623,8 +623,11 @@ void SceneDrawer::drawObject(size_t oi) {
   // pass delays the back end's first triangles: flat's frame took 1.03-1.06 times as long with
   // it, the pass shared between both threads, docs/performance.md.)
   faces_lit_ = face_colours_ && queue_ == nullptr && f_.obj.spec == nullptr;
-  if (side_ != nullptr) prepareSplitObject(oi);
-  else prepareObject(oi);
+  // The back faces culled early, counted at once (on a side of a frame split by rows, those it
+  // culled).
+  const size_t culled = side_ != nullptr ? prepareSplitObject(oi) : prepareObject(oi);
+  f_.st.triangles += culled;
+  f_.st.culled_back += culled;
   // (Not where a specular unit counts the requests: a waiting triangle's vertices are lit
   // before the triangles ahead of it are drawn.)
   blocks_ = queue_ == nullptr && f_.obj.spec == nullptr;
@@ -651,9 +654,9 @@ void SceneDrawer::drawObject(size_t oi) {
 }
 
 // One thread, or the front end of a two-thread frame: the object's vertices transformed (by
-// both threads on two), its back faces culled early and counted, the normals of the vertices
-// drawn, the face colours lit ahead.
-void SceneDrawer::prepareObject(size_t oi) {
+// both threads on two), its back faces culled early (returns how many), the normals of the
+// vertices drawn, the face colours lit ahead.
+size_t SceneDrawer::prepareObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   verts_ = &scratch_.verts;
   faces_ = &scratch_.faces;
@@ -671,30 +674,28 @@ void SceneDrawer::prepareObject(size_t oi) {
     t.cam = &scene_.camera;
     t.proj = &f_.proj;
     t.verts = scratch_.verts.data();
-    t.n = scratch_.verts.size();
     t.vector = f_.avx2;
     t.normals = !face_colours_;
-    t.chunks.reset(t.n);
+    t.chunks.reset(scratch_.verts.size());
     queue_->push(true);  // shown to the back end at once (release)
     t.work(false);
     t.chunks.waitAll();
   }
   std::vector<uint32_t>& kept = scratch_.kept;
   const size_t culled = keptTriangles(scratch_.verts, obj.mesh.triangles, f_.proj.z_near, kept);
-  f_.st.triangles += culled;
-  f_.st.culled_back += culled;
   // The normals of the vertices drawn (transformed without them above), where the method reads
   // them; the two-thread frame's shared transform gave every vertex its normal.
   if (queue_ == nullptr && !face_colours_)
     triangleNormals(obj, basis_, kept, scratch_.verts.data(), scratch_.mark, scratch_.normal_idx, f_.avx2);
   if (faces_lit_) lightFaces(f_, scratch_.verts, obj.mesh.triangles, kept, scratch_.faces);
   scratch_.lit.assign(scratch_.verts.size(), 0);
+  return culled;
 }
 
-// A side of a frame split by rows: the object prepared by both sides (SplitObject), its back
-// faces culled early counted by the side that culled them, and then this side's triangles: those
-// it takes, in order, and whether it owns each (DrawScratch::kept, owner).
-void SceneDrawer::prepareSplitObject(size_t oi) {
+// A side of a frame split by rows: the object prepared by both sides (SplitObject; returns how
+// many back faces this side culled early), and then this side's triangles: those it takes, in
+// order, and whether it owns each (DrawScratch::kept, owner).
+size_t SceneDrawer::prepareSplitObject(size_t oi) {
   const SceneObject& obj = scene_.objects[oi];
   const std::vector<std::array<uint32_t, 3>>& tris = obj.mesh.triangles;
   SplitObject& so = *(*side_->objects)[oi];
@@ -720,8 +721,6 @@ void SceneDrawer::prepareSplitObject(size_t oi) {
       if (keep && faces_lit_ && tv.all_in) so.faces[t] = f_.faceColour(*tv.v0, *tv.v1, *tv.v2);
     }
   });
-  f_.st.triangles += culled;
-  f_.st.culled_back += culled;
   so.cull.waitAll();
   if (normals) {
     so.light.work(kVertexChunk, from_back, [&](size_t b, size_t e) {
@@ -755,6 +754,7 @@ void SceneDrawer::prepareSplitObject(size_t oi) {
   }
   kept.resize(n);
   owner.resize(n);
+  return culled;
 }
 
 // Gouraud vertex colours: computed when a triangle that is not culled first needs them.
