@@ -93,7 +93,8 @@ void checkExpected(const nlohmann::json& value, const std::string& where, const 
     throw std::invalid_argument(fmt::format("{}: \"expected\" must be an object of figure groups", where));
   const auto& groups = expectedGroups(unit);
   for (const auto& [gk, gv] : value.items()) {
-    const auto g = std::find_if(groups.begin(), groups.end(), [&](const ExpectedGroup& e) { return gk == e.group; });
+    const auto g =
+        std::find_if(groups.begin(), groups.end(), [&key = gk](const ExpectedGroup& e) { return key == e.group; });
     if (g == groups.end()) {
       std::vector<std::string> names;
       for (const ExpectedGroup& e : groups) names.emplace_back(e.group);
@@ -108,7 +109,7 @@ void checkExpected(const nlohmann::json& value, const std::string& where, const 
     if (!gv.is_object())
       throw std::invalid_argument(fmt::format("{}: expected.{} must be an object of figures", where, gk));
     for (const auto& [fk, fv] : gv.items()) {
-      if (std::find_if(g->figures.begin(), g->figures.end(), [&](const char* f) { return fk == f; }) ==
+      if (std::find_if(g->figures.begin(), g->figures.end(), [&key = fk](const char* f) { return key == f; }) ==
           g->figures.end())
         throw std::invalid_argument(fmt::format("{}: expected.{}.{}: unknown figure (known: {})", where, gk, fk,
                                                 fmt::join(g->figures, ", ")));

@@ -347,7 +347,9 @@ SHD_AVX2 bool walk(const std::array<RowEdge, 3>& e, int64_t n, int64_t W, RowTal
 // intrinsics, which -Wmaybe-uninitialized reports (GCC bug 105593, as in render/fixed_simd.cpp).
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#ifndef __clang__
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC's own: clang has no such group
+#endif
 // walk in AVX-512 (RowSpansConfig::avx512), its pass 1 in closed form, 8 rows at once in 64-bit
 // lanes and an edge a vector: the DDA's bound after i steps is q0 + i k + ceil((i m - r0) / D)
 // (q_i = ceil(N_i / D) with N_i = q0 D - r0 + i (k D + m)). Its quotient in doubles, without a
@@ -575,7 +577,9 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
 #ifdef SHD_X86_KERNELS
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#ifndef __clang__
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC's own: clang has no such group
+#endif
 namespace {
 // setupRowSpans's steps before its rows, for triangle lane t of v (t < n; the lanes past n take
 // triangle n - 1), in 64-bit lanes: the same integers, from the same operations. Snapping as

@@ -106,7 +106,9 @@ template <class Buffer>
 // 105593); the values are never read. Silenced for this file's kernel only.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#ifndef __clang__
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // GCC's own: clang has no such group
+#endif
 
 bool cpuHasAvx512() {
   static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
@@ -410,8 +412,8 @@ struct RunGroups {
 // bufferRun's loop from its groups' values at fragment k (g), inlined into bufferRun and
 // bufferSpans: each group z-tested, its passing fragments buffered, its values stepped by 8
 // fragments with adds (the same values mod 2^64 as the closed forms).
-SHD_AVX512 [[gnu::always_inline]] inline size_t bufferGroups(RunGroups g, const RunPixels& px, size_t k, const Target& t,
-                                                             Batch& b, uint64_t& fresh) {
+[[gnu::always_inline]] SHD_AVX512 inline size_t bufferGroups(RunGroups g, const RunPixels& px, size_t k,
+                                                             const Target& t, Batch& b, uint64_t& fresh) {
   size_t n = b.n;
   uint64_t covered = 0;
   for (; k < px.count && n + 8 <= Batch::kCap; k += 8) {
@@ -438,7 +440,7 @@ SHD_AVX512 [[gnu::always_inline]] inline size_t bufferGroups(RunGroups g, const 
 // bufferRun's loop from fragment `first` (k < 2^32): the quadratic, l and h at fragments k .. k
 // + 7 (mod 2^64), the squared norm's step dsq = sq(k + 8) - sq(k) = 16 b + c (16 k + 64), itself
 // stepped by 128 c.
-SHD_AVX512 [[gnu::always_inline]] inline size_t bufferRunIn(const Run& r, size_t first, const Target& t, Batch& b,
+[[gnu::always_inline]] SHD_AVX512 inline size_t bufferRunIn(const Run& r, size_t first, const Target& t, Batch& b,
                                                             uint64_t& fresh) {
   const __m512i lane = _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0);
   const __m512i two_b = _mm512_set1_epi64(static_cast<int64_t>(r.two_b)), c = _mm512_set1_epi64(static_cast<int64_t>(r.c));
@@ -519,9 +521,10 @@ SHD_AVX2 inline RunSteps runSteps(uint32_t dz, const std::array<int32_t, 3>& dc)
 // colourRunAvx2 is one run: count fragments at pixels p, p + 1, ... (room: to the end of its
 // row), its first group's codes in z and code[ch]; it adds to covered and passed as
 // colourRunsAvx2. Both AVX2 kernels (colourRunsAvx2, colourSpansAvx2) run their runs through it.
-SHD_AVX2_PRFCHW [[gnu::always_inline]] inline void colourRunAvx2(const RunLanes& l, const RunSteps& step, const Target& t,
-                                                             uint8_t* rgb, size_t p, size_t count, size_t room, __m256i z,
-                                                             __m256i (&code)[3], uint64_t& covered, uint64_t& passed) {
+[[gnu::always_inline]] SHD_AVX2_PRFCHW inline void colourRunAvx2(const RunLanes& l, const RunSteps& step,
+                                                                  const Target& t, uint8_t* rgb, size_t p, size_t count,
+                                                                  size_t room, __m256i z, __m256i (&code)[3],
+                                                                  uint64_t& covered, uint64_t& passed) {
   const __m256i join = _mm256_setr_epi32(0, 1, 2, 4, 5, 6, 3, 7);  // the two 12-byte halves, adjacent
   for (size_t k = 0; k < count; k += 8) {
     const int n = static_cast<int>(std::min<size_t>(8, count - k));
@@ -609,7 +612,7 @@ static_assert(offsetof(ColourRuns::Row, c) == offsetof(ColourRuns::Row, z) + 4, 
 // there (RowSpans::at mod 2^32) as (z, c0, c1, c2) in 32-bit lanes (W: pixels per framebuffer
 // row). One 4-lane multiply-add per row from the row's left (x0) codes.
 template <class Row>
-SHD_AVX2 [[gnu::always_inline]] inline void eachSpanRow(const RowSpans& s, size_t W, Row row) {
+[[gnu::always_inline]] SHD_AVX2 inline void eachSpanRow(const RowSpans& s, size_t W, Row row) {
   auto lanes = [](const std::array<int64_t, 4>& v) {
     return _mm_setr_epi32(static_cast<int32_t>(v[3]), static_cast<int32_t>(v[0]), static_cast<int32_t>(v[1]),
                           static_cast<int32_t>(v[2]));
@@ -739,7 +742,7 @@ SHD_AVX2 inline __m256i bitLength4(__m256i v) {
 // scaleGroup's datapath on the 4 squared norms at sq (`valid`: the lanes that are fragments),
 // their cosine scales stored at r64_out; false (nothing stored) when a valid lane needs the
 // scalar path.
-SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m256i valid, uint64_t* r64_out) {
+[[gnu::always_inline]] SHD_AVX2 inline bool scaleLanes4(const uint64_t* sq, __m256i valid, uint64_t* r64_out) {
   const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sq));
   // rsqrtCore<10>: the bit length (bitLength4: not of 0, which goes to the scalar path), shift.
   const __m256i bits = bitLength4(v);
@@ -770,7 +773,7 @@ SHD_AVX2 [[gnu::always_inline]] inline bool scaleLanes4(const uint64_t* sq, __m2
 //                (nl), the lobe table's pair of entries at N.H and the step to the next (frac),
 //                stored at the lanes' entries of a LobeLanes;
 //   codeLanes4   from those, the 12-fraction-bit codes.
-SHD_AVX2 [[gnu::always_inline]] inline void lobeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
+[[gnu::always_inline]] SHD_AVX2 inline void lobeLanes4(const NhParams& p, const uint64_t* r64s, const uint64_t* l,
                                                        const uint64_t* h, __m256i valid, LobeLanes& out, size_t i) {
   const __m256i r64 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r64s));
   const __m256i dot_l = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l));
@@ -788,7 +791,7 @@ SHD_AVX2 [[gnu::always_inline]] inline void lobeLanes4(const NhParams& p, const 
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.frac + i), _mm256_and_si256(c, _mm256_set1_epi64x(0xFFFF)));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(out.pair + i), pair);
 }
-SHD_AVX2 [[gnu::always_inline]] inline void codeLanes4(const NhParams& p, const LobeLanes& in, size_t i,
+[[gnu::always_inline]] SHD_AVX2 inline void codeLanes4(const NhParams& p, const LobeLanes& in, size_t i,
                                                        __m256i (&code)[3]) {
   const __m256i nl = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.nl + i));
   const __m256i frac = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.frac + i));
@@ -934,7 +937,7 @@ SHD_AVX2 inline RunInputs4 runInputs4(const Run& r, __m256i kv) {
 // bufferRun's loop with zTest8Avx2, and the passing fragments' inputs computed in two halves of
 // 4 64-bit lanes, each packed by a permutation (AVX2 has no compress); inlined into
 // bufferRunAvx2 and bufferSpansAvx2.
-SHD_AVX2 [[gnu::always_inline]] inline size_t bufferRunAvx2In(const Run& r, size_t first, const Target& t, Batch& b,
+[[gnu::always_inline]] SHD_AVX2 inline size_t bufferRunAvx2In(const Run& r, size_t first, const Target& t, Batch& b,
                                                               uint64_t& fresh) {
   const __m256i lanes = lanes8(), dz_lanes = laneSteps(r.px.dz);
   const __m256i lane4 = _mm256_setr_epi64x(0, 1, 2, 3);
@@ -988,7 +991,7 @@ struct RowLanes {
 // False where that does not hold: a normal's code at the first pixel of a row drawn from row
 // `from` on (`drawn`) outside int32_t (RowSpans keeps the codes within, and the gradients,
 // which the caller checks; the tests' random planes do not).
-SHD_AVX512 [[gnu::always_inline]] inline bool rowLanes(const NhSpans& r, int32_t base, int32_t from, RowLanes& out) {
+[[gnu::always_inline]] SHD_AVX512 inline bool rowLanes(const NhSpans& r, int32_t base, int32_t from, RowLanes& out) {
   const RowSpans& s = *r.s;
   // Rows base .. base + 7 (of the 64 of span): lo and hi (int16_t pairs) to 64-bit lanes.
   const __m256i pairs = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(s.span.data() + base));

@@ -52,7 +52,8 @@ nlohmann::json shinUseJson(const RecordingSpecEngine& rec) {
       zero = z;
       below = n;
     }
-    const auto e = std::find_if(t.entries.begin(), t.entries.end(), [&](const PromEntry& p) { return p.address == address; });
+    const auto e =
+        std::find_if(t.entries.begin(), t.entries.end(), [a = address](const PromEntry& p) { return p.address == a; });
     out.push_back({{"address", address},
                    {"n", e == t.entries.end() ? nlohmann::json() : nlohmann::json(e->n)},
                    {"requests", u.requests},
