@@ -202,6 +202,12 @@ Mesh importMeshInProcess(const std::string& path) {
   //     normals are inverted against a correct winding exist (assimp-testmodels'
   //     STL/Spider_*.stl: every facet normal points inward), and shading them unflipped would
   //     light the back of every visible face.
+  //   - A normal perpendicular to face_sum (|cos| <= kPerpendicular: zero but for rounding)
+  //     points to neither side, and the sign of its dot product is the rounding's (another
+  //     order of the same operations gave the other sign: fuzz_mesh, corpus file
+  //     finding-normal-perpendicular-to-faces): replaced as a missing one. Where face_sum is
+  //     zero (faces that cancel) or not finite there is no side to tell, and the normal stays.
+  constexpr double kPerpendicular = 1e-9;  // some 10^6 times the dot product's rounding error
   std::vector<Vec3> face_sum(m.positions.size(), Vec3{0, 0, 0});
   for (const auto& t : m.triangles) {
     const Vec3 w = outwardAreaNormal(m, t);
@@ -209,12 +215,12 @@ Mesh importMeshInProcess(const std::string& path) {
   }
   for (size_t v = 0; v < m.normals.size(); ++v) {
     const Vec3 n = m.normals[v], f = face_sum[v];
-    const double len = length(n);
-    if (std::isfinite(len) && len > 1e-12) {
-      m.normals[v] = (dot(n, f) < 0 ? -1.0 / len : 1.0 / len) * n;
+    const double len = length(n), flen = length(f), d = dot(n, f);
+    const bool sided = flen == 0.0 || !std::isfinite(flen) || std::fabs(d) > kPerpendicular * len * flen;
+    if (std::isfinite(len) && len > 1e-12 && sided) {
+      m.normals[v] = (d < 0 ? -1.0 / len : 1.0 / len) * n;
       continue;
     }
-    const double flen = length(f);
     if (!(flen > 0.0) || !std::isfinite(flen))
       failMeshFile(path, fmt::format("vertex at ({}, {}, {}) has a zero-length normal and its faces' "
                              "normals cancel",

@@ -215,8 +215,9 @@ Mesh worldMesh(const SceneObject& obj);
 //     vertex's outward face normals; if that sum is zero as well (faces that cancel, as a
 //     two-sided sheet), SceneError. A normal pointing against that sum is negated: the
 //     winding decides the outside, as it does for culling (assimp-testmodels' STL spiders have
-//     an outward winding and inward facet normals). A file wound inside out throughout loads
-//     inside out (OFF/Wuson.off);
+//     an outward winding and inward facet normals). One perpendicular to it (|cos| <= 1e-9,
+//     where rounding decides the sign) is replaced as a missing one; where the sum is zero the
+//     normal stays. A file wound inside out throughout loads inside out (OFF/Wuson.off);
 //   - truncated files: the faces of the plain import are checked before post-processing (a
 //     truncated ASCII PLY leaves faces without indices, on which Debian's assimp 5.2 aborts
 //     in an assertion instead of failing), and a PLY header without end_header is refused up
