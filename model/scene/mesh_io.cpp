@@ -38,8 +38,10 @@ Vec3 outwardAreaNormal(const Mesh& m, const std::array<uint32_t, 3>& t) {
 }
 
 // assimp 5.2's PLY reader loops forever on a header without "end_header" (a file cut inside its
-// header): refuse such a file before assimp sees it. assimp takes a file as PLY when it starts
-// with "ply" in any case and any fourth byte (test fuzz_replay_mesh keeps "ply " and "plY").
+// header), and on one whose "end_header" is the file's last bytes (a file cut right after it:
+// fuzz_mesh, corpus file finding-ply-end-header-at-end-of-file): refuse such a file before assimp
+// sees it, as a header whose last line has no line break. assimp takes a file as PLY when it
+// starts with "ply" in any case and any fourth byte (test fuzz_replay_mesh keeps "ply " and "plY").
 void checkPlyHeader(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   char magic[4] = {};
@@ -50,7 +52,10 @@ void checkPlyHeader(const std::string& path) {
   std::string line;
   for (int lines = 0; lines < 10000 && std::getline(in, line); ++lines) {
     while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
-    if (line == "end_header") return;
+    if (line == "end_header") {
+      if (in.eof()) failMeshFile(path, "PLY header without a line break after end_header (truncated file)");
+      return;
+    }
   }
   failMeshFile(path, "PLY header without end_header (truncated file)");
 }

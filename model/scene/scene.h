@@ -220,9 +220,9 @@ Mesh worldMesh(const SceneObject& obj);
 //     normal stays. A file wound inside out throughout loads inside out (OFF/Wuson.off);
 //   - truncated files: the faces of the plain import are checked before post-processing (a
 //     truncated ASCII PLY leaves faces without indices, on which Debian's assimp 5.2 aborts
-//     in an assertion instead of failing), and a PLY header without end_header is refused up
-//     front (assimp 5.2 loops forever on it). A text file cut at a line boundary is a valid
-//     smaller file and loads;
+//     in an assertion instead of failing), and a PLY header without end_header, or with no
+//     line break after it, is refused up front (assimp 5.2 loops forever on either). A text
+//     file cut at a line boundary is a valid smaller file and loads;
 //   - resource limits: the import runs in a child process (mesh_child.cpp) with 4 GB of
 //     memory (address space beyond the parent's, and resident memory) and 120 s of wall time.
 //     assimp 5.2 terminates on some truncated COB files (an exception thrown where it cannot be

@@ -4,7 +4,8 @@
 // in every build.
 //   fuzz_<name> [FILE | DIR]...
 // Exit 0 when every input ran; 1 when an exception escaped the target (the target catches the
-// rejections its reader documents: any other is a finding) or an argument cannot be read. A
+// rejections its reader documents: any other is a finding), an input ran over 10 s (a hang, as
+// libFuzzer's -timeout in scripts/fuzz.sh) or an argument cannot be read. A
 // crash, an abort (a target's finding()) or a sanitizer report ends the process with the
 // input's path on stderr.
 #include <algorithm>
@@ -51,6 +52,18 @@ void onSignal(int sig) {
   std::raise(sig);
 }
 
+// An input that runs longer than scripts/fuzz.sh's libFuzzer -timeout is a hang: the process
+// ends naming it (exit 1), instead of the test waiting for ctest's 1500 s.
+constexpr unsigned kHangSeconds = 10;
+void onHang(int) {
+  const char prefix[] = "fuzz replay: a hang (over 10 s) on input ";
+  ssize_t ignored = write(STDERR_FILENO, prefix, sizeof prefix - 1);
+  ignored = write(STDERR_FILENO, g_current, strnlen(g_current, sizeof g_current));
+  ignored = write(STDERR_FILENO, "\n", 1);
+  (void)ignored;
+  _exit(1);
+}
+
 std::vector<std::string> inputsOf(const std::string& arg) {
   std::vector<std::string> files;
   if (std::filesystem::is_directory(arg)) {
@@ -67,6 +80,7 @@ std::vector<std::string> inputsOf(const std::string& arg) {
 
 int main(int argc, char** argv) {
   for (int sig : {SIGSEGV, SIGABRT, SIGFPE, SIGILL, SIGBUS}) std::signal(sig, onSignal);
+  std::signal(SIGALRM, onHang);
 #ifdef SHD_FUZZ_SANITIZER
   __sanitizer_set_death_callback(sayCurrent);  // a sanitizer report exits without a signal
 #endif
@@ -80,6 +94,7 @@ int main(int argc, char** argv) {
       }
       const std::vector<uint8_t> data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
       std::snprintf(g_current, sizeof g_current, "%s", path.c_str());
+      alarm(kHangSeconds);
       try {
         LLVMFuzzerTestOneInput(data.data(), data.size());
       } catch (const std::exception& e) {
@@ -89,6 +104,7 @@ int main(int argc, char** argv) {
         std::fprintf(stderr, "fuzz replay: %s: uncaught exception of unknown type\n", path.c_str());
         return 1;
       }
+      alarm(0);
       ++runs;
     }
   }
