@@ -221,12 +221,12 @@ Mesh importMeshInProcess(const std::string& path) {
   for (size_t v = 0; v < m.normals.size(); ++v) {
     const Vec3 n = m.normals[v], f = face_sum[v];
     const double len = length(n), flen = length(f), d = dot(n, f);
-    const bool sided = flen == 0.0 || !std::isfinite(flen) || std::fabs(d) > kPerpendicular * len * flen;
-    if (std::isfinite(len) && len > 1e-12 && sided) {
+    const bool faces_tell = flen > 0.0 && std::isfinite(flen);  // face_sum gives a side
+    if (std::isfinite(len) && len > 1e-12 && (!faces_tell || std::fabs(d) > kPerpendicular * len * flen)) {
       m.normals[v] = (d < 0 ? -1.0 / len : 1.0 / len) * n;
       continue;
     }
-    if (!(flen > 0.0) || !std::isfinite(flen))
+    if (!faces_tell)
       failMeshFile(path, fmt::format("vertex at ({}, {}, {}) has a zero-length normal and its faces' "
                              "normals cancel",
                              m.positions[v].x, m.positions[v].y, -m.positions[v].z));

@@ -38,13 +38,16 @@ namespace {
 // The input running now, for the crash message (written by a signal handler: a fixed buffer).
 char g_current[4096];
 
-void sayCurrent() {
-  const char prefix[] = "fuzz replay: the process died on input ";
-  ssize_t ignored = write(STDERR_FILENO, prefix, sizeof prefix - 1);
+// "<what><the input running now>" on stderr, with write() alone (safe in a signal handler).
+template <size_t N>
+void sayWithCurrent(const char (&what)[N]) {
+  ssize_t ignored = write(STDERR_FILENO, what, N - 1);
   ignored = write(STDERR_FILENO, g_current, strnlen(g_current, sizeof g_current));
   ignored = write(STDERR_FILENO, "\n", 1);
   (void)ignored;
 }
+
+void sayCurrent() { sayWithCurrent("fuzz replay: the process died on input "); }
 
 void onSignal(int sig) {
   sayCurrent();
@@ -56,11 +59,7 @@ void onSignal(int sig) {
 // ends naming it (exit 1), instead of the test waiting for ctest's 1500 s.
 constexpr unsigned kHangSeconds = 10;
 void onHang(int) {
-  const char prefix[] = "fuzz replay: a hang (over 10 s) on input ";
-  ssize_t ignored = write(STDERR_FILENO, prefix, sizeof prefix - 1);
-  ignored = write(STDERR_FILENO, g_current, strnlen(g_current, sizeof g_current));
-  ignored = write(STDERR_FILENO, "\n", 1);
-  (void)ignored;
+  sayWithCurrent("fuzz replay: a hang (over 10 s) on input ");
   _exit(1);
 }
 
