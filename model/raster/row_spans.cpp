@@ -489,7 +489,12 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   // Snapped as setup snaps them (snapVertices); what it refuses, setupTriangle refuses, naming it.
   // Within these bounds |x 2^S| < 2^29 and |a 2^frac| < 2^31: snapSmall's range. The checks
   // are summed into one test, the rare refusal being the one branch.
-  std::array<int64_t, 3> X, Y;
+  // The front part is built in place: a Front assembled from local arrays was copied with
+  // 16-byte loads of what had just been stored 8 bytes at a time, which the processor cannot
+  // forward (a store-forwarding stall: a tenth of this function's samples).
+  Front f;
+  std::array<int64_t, 3>& X = f.X;
+  std::array<int64_t, 3>& Y = f.Y;
   Codes a;   // the attribute codes: of the scalar plane
   CodesF af;  // of the AVX2 plane (vector)
 #ifdef SHD_X86_KERNELS
@@ -552,7 +557,7 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
   if (r1 - r0 >= RowSpans::kMaxRows) return RowSpansSetup::General;
   // Each edge's DDA from row r0; a horizontal edge bounds nothing in these rows (a left bound
   // far to the left, never stepped).
-  std::array<RowEdge, 3> e;
+  std::array<RowEdge, 3>& e = f.e;
   for (size_t s = 0; s < 3; ++s) {
     if (A[s] == 0) {
       e[s] = {-(int64_t{1} << 40), 0, 1, 0, 0, false};
@@ -567,8 +572,11 @@ RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowS
     if (k >= c.k_lim || k < -c.k_lim) return RowSpansSetup::General;
     e[s] = {q, q * D - N, D, k, -B[s] - k * D, A[s] < 0};
   }
+  f.det = det;
+  f.r0 = r0;
+  f.r1 = r1;
   PlaneGeom g;
-  if (spans(Front{X, Y, det, r0, r1, e}, c, o, g) == RowSpansSetup::Dropped) return RowSpansSetup::Dropped;
+  if (spans(f, c, o, g) == RowSpansSetup::Dropped) return RowSpansSetup::Dropped;
   return planeOf(c, a, af, g, o);
 }
 
