@@ -322,12 +322,15 @@ TEST(RowSpans, VectorPlaneEqualsTheScalarOne) {
         ++exact_planes;
       }
     }
-    // The same triangles through setupRowSpansBlock, 13 at a time (a block of 8 and one of 5).
+    // The same triangles through setupRowSpansBlock, 13 at a time (a block of 8 and one of 5),
+    // in AVX2 (vector) and AVX-512 (wide, where the CPU has it).
     block_in.push_back(v);
     block_ref.push_back(a);
     block_got.push_back(ga);
     if (block_in.size() == 13) {
-      ASSERT_TRUE(blockEquals(block_in.data(), block_in.size(), wide, block_ref.data(), block_got.data(), n - 12));
+      for (const RowSpansConfig* c : {&vector, &wide})
+        ASSERT_TRUE(blockEquals(block_in.data(), block_in.size(), *c, block_ref.data(), block_got.data(), n - 12))
+            << (c->avx512 ? "AVX-512" : "AVX2");
       block_in.clear();
       block_ref.clear();
       block_got.clear();
@@ -383,9 +386,36 @@ TEST(RowSpans, VectorPlaneLeavesWideCoordinatesToTheScalarOne) {
       ASSERT_TRUE(sameRowSpans(ref[t], b)) << "triangle " << n;
     }
     if (t + 1 < block.size()) continue;
-    ASSERT_TRUE(blockEquals(block.data(), block.size(), wide, ref.data(), ref_got.data(), n - 7));
+    for (const RowSpansConfig* c : {&vector, &wide})  // the block in AVX2, and in AVX-512 where the CPU has it
+      ASSERT_TRUE(blockEquals(block.data(), block.size(), *c, ref.data(), ref_got.data(), n - 7))
+          << (c->avx512 ? "AVX-512" : "AVX2");
   }
   EXPECT_GT(wide_drawn, 1000) << "drawn with coordinate differences of 2^20 subpixels and more";
+  // Triangles 2^17 .. 2^21 px across in x and in y whose near vertex dips into the viewport's
+  // first rows (fewer than RowSpans::kMaxRows of them): edge functions and determinants of 2^40
+  // to 2^55, which the AVX2 block takes in doubles up to vertex differences of 2^25 subpixels
+  // (2^21 px) and leaves to setupRowSpans whole beyond.
+  long huge_drawn = 0;
+  for (int n = 0; n < 8000; ++n) {
+    const size_t t = static_cast<size_t>(n % 8);
+    std::array<RowSpans::Vertex, 3>& v = block[t];
+    const double reach = std::ldexp(1.0, 17 + static_cast<int>(rng() % 4));
+    v[0].x = 10 + u(rng) * 490;
+    v[0].y = 5 + u(rng) * 40;
+    v[1].x = -reach * (0.25 + u(rng));
+    v[1].y = -reach * (0.25 + u(rng));
+    v[2].x = reach * (0.25 + u(rng));
+    v[2].y = -reach * (0.25 + u(rng));
+    for (size_t k = 0; k < 4; ++k)
+      for (RowSpans::Vertex& x : v) x.attr[k] = static_cast<double>(rng() % 64) / scalar.scale[k];
+    ref_got[t] = setupRowSpans(v, scalar, ref[t]);
+    huge_drawn += ref_got[t] == RowSpansSetup::Drawn;
+    if (t + 1 < block.size()) continue;
+    for (const RowSpansConfig* c : {&vector, &wide})
+      ASSERT_TRUE(blockEquals(block.data(), block.size(), *c, ref.data(), ref_got.data(), n - 7))
+          << "huge, " << (c->avx512 ? "AVX-512" : "AVX2");
+  }
+  EXPECT_GT(huge_drawn, 1000) << "drawn, 2^17 px and more across both ways";
 }
 
 // The colour kernels straight from the rows' spans (fixed_simd::colourSpansAvx2 and
@@ -528,23 +558,25 @@ TEST(RowSpans, DeclineWhatSetupRefusesOrTheyCannotHold) {
       tris.push_back({vtx(4000, 10), vtx(4000 + sign * across, 10.125), vtx(4000, 40)});
       tris.push_back({vtx(4000, 40), vtx(4000 + sign * across, 10.125), vtx(4000, 10)});
     }
-  RowSpansConfig block = rc;
-  block.vector = fixed_simd::availableAvx2();
-  block.avx512 = block.vector && fixed_simd::available();
-  std::vector<RowSpans> out(tris.size());
-  std::vector<RowSpansSetup> got(tris.size());
-  setupRowSpansBlock(tris.data(), tris.size(), block, out.data(), got.data());
-  std::map<RowSpansSetup, int> outcomes;
-  for (size_t t = 0; t < tris.size(); ++t) {
-    RowSpans ref;
-    const RowSpansSetup want = setupRowSpans(tris[t], rc, ref);
-    ++outcomes[want];
-    EXPECT_EQ(got[t], want) << "triangle " << t;
-    if (want == RowSpansSetup::Drawn && got[t] == want) {
-      EXPECT_TRUE(ref.y0 == out[t].y0 && ref.rows == out[t].rows && ref.x0 == out[t].x0 && ref.a0 == out[t].a0 &&
-                  ref.didx == out[t].didx && ref.didy == out[t].didy)
-          << "triangle " << t;
+  for (const bool avx512 : {false, true}) {  // the block in AVX2, and in AVX-512 where the CPU has it
+    RowSpansConfig block = rc;
+    block.vector = fixed_simd::availableAvx2();
+    block.avx512 = avx512 && block.vector && fixed_simd::available();
+    std::vector<RowSpans> out(tris.size());
+    std::vector<RowSpansSetup> got(tris.size());
+    setupRowSpansBlock(tris.data(), tris.size(), block, out.data(), got.data());
+    std::map<RowSpansSetup, int> outcomes;
+    for (size_t t = 0; t < tris.size(); ++t) {
+      RowSpans ref;
+      const RowSpansSetup want = setupRowSpans(tris[t], rc, ref);
+      ++outcomes[want];
+      EXPECT_EQ(got[t], want) << "triangle " << t << (block.avx512 ? " (AVX-512)" : "");
+      if (want == RowSpansSetup::Drawn && got[t] == want) {
+        EXPECT_TRUE(ref.y0 == out[t].y0 && ref.rows == out[t].rows && ref.x0 == out[t].x0 && ref.a0 == out[t].a0 &&
+                    ref.didx == out[t].didx && ref.didy == out[t].didy)
+            << "triangle " << t << (block.avx512 ? " (AVX-512)" : "");
+      }
     }
+    EXPECT_EQ(outcomes[RowSpansSetup::Drawn], 4);  // the first two, and the two of step k_lim - 1
   }
-  EXPECT_EQ(outcomes[RowSpansSetup::Drawn], 4);  // the first two, and the two of step k_lim - 1
 }

@@ -604,6 +604,36 @@ struct Front8 {
   alignas(64) int64_t q[3][8], r[3][8], D[3][8], k[3][8], m[3][8];
   __mmask8 general = 0, dropped = 0, whole = 0, swapped = 0, right[3] = {0, 0, 0};
 };
+// What a block's lanes found (a bit per lane), and setupRowSpans's order of outcomes from them
+// into f's lanes `lanes`: General outside the guard band (not ok), the lane whole where its
+// arithmetic would not be exact (inexact: front4's doubles), Dropped at zero area, a horizontal
+// edge whole, Dropped outside the viewport, General for too many rows, an N beyond 2^51 whole,
+// General for a DDA step beyond the register bound.
+struct LaneFindings {
+  __mmask8 ok, inexact, flat, horizontal, box_out, tall, wide, steep, swapped;
+};
+void setOutcomes(Front8& f, __mmask8 lanes, const LaneFindings& l) {
+  __mmask8 open = l.ok & lanes;
+  __mmask8 general = static_cast<__mmask8>(lanes & ~l.ok);
+  __mmask8 whole = open & l.inexact;
+  open &= static_cast<__mmask8>(~l.inexact);
+  __mmask8 dropped = open & l.flat;
+  open &= static_cast<__mmask8>(~l.flat);
+  whole |= open & l.horizontal;
+  open &= static_cast<__mmask8>(~l.horizontal);
+  dropped |= open & l.box_out;
+  open &= static_cast<__mmask8>(~l.box_out);
+  general |= open & l.tall;
+  open &= static_cast<__mmask8>(~l.tall);
+  whole |= open & l.wide;
+  open &= static_cast<__mmask8>(~l.wide);
+  general |= open & l.steep;
+  const auto keep = static_cast<__mmask8>(~lanes);
+  f.general = static_cast<__mmask8>((f.general & keep) | general);
+  f.dropped = static_cast<__mmask8>((f.dropped & keep) | dropped);
+  f.whole = static_cast<__mmask8>((f.whole & keep) | whole);
+  f.swapped = static_cast<__mmask8>((f.swapped & keep) | (l.swapped & lanes));
+}
 SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, Front8& f) {
   static_assert(sizeof(RowSpans::Vertex) == 6 * sizeof(double), "a vertex: x, y and 4 attributes");
   const int S = c.S;
@@ -699,23 +729,138 @@ SHD_AVX512 void front8(const std::array<RowSpans::Vertex, 3>* v, size_t n, const
   _mm512_store_si512(f.det, det);
   _mm512_store_si512(f.r0, r0);
   _mm512_store_si512(f.r1, r1);
-  // setupRowSpans's order of outcomes: General outside the guard band, Dropped at zero area, a
-  // horizontal edge its own, Dropped outside the viewport, General for too many rows, an N
-  // beyond 2^51 its own, General for a DDA step beyond the register bound.
-  __mmask8 open = ok;
-  f.general = static_cast<__mmask8>(~ok);
-  f.dropped = open & flat;
-  open &= static_cast<__mmask8>(~flat);
-  f.whole = open & horizontal;
-  open &= static_cast<__mmask8>(~horizontal);
-  f.dropped |= open & box_out;
-  open &= static_cast<__mmask8>(~box_out);
-  f.general |= open & tall;
-  open &= static_cast<__mmask8>(~tall);
-  f.whole |= open & wide;
-  open &= static_cast<__mmask8>(~wide);
-  f.general |= open & steep;
-  f.swapped = neg;
+  setOutcomes(f, 0xFF, {ok, 0, flat, horizontal, box_out, tall, wide, steep, neg});
+}
+
+// front8 in AVX2 for the block's lanes t0 .. t0 + 3 (lane t0 + j takes triangle t0 + j, those
+// past n triangle n - 1), into the same Front8: setupRowSpans's steps on doubles, which hold
+// every integer of them exactly where the lane's magnitudes allow; a lane where they do not goes
+// to setupRowSpans whole. Snapping as front8. With the vertices' differences below 2^25
+// subpixels (checked) the determinant's products lie below 2^50. In a lane whose box meets the
+// viewport (the others are dropped before the DDA) the edge functions' factors dx, dy, half - yu
+// and half - xu are even and below 2^28 (u units: the vertices within 2^27 of each other, one
+// of them by the viewport, below 2^16 px), so their products are multiples of 4 below 2^55,
+// exact; B r0 is below 2^47. Where |C| rounds (2^53 and more), |N| = |B r0 + C| lies above
+// 2^51 however it rounds, and N is checked below 2^51 (as front8 checks it): then C and N are
+// exact, N / D, -B / D and their correctly rounded quotients give front8's q and k (its
+// argument), and q D - N, -B - k D are exact. Integers leave the doubles by the magic constant
+// (1.5 2^52: for |v| < 2^51 the sum's low bits are v in two's complement).
+namespace front4x {
+SHD_AVX2 inline __m256d abs(__m256d x) { return _mm256_andnot_pd(_mm256_set1_pd(-0.0), x); }
+SHD_AVX2 inline __m256d lt(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_LT_OQ); }
+SHD_AVX2 inline __m256d le(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_LE_OQ); }
+SHD_AVX2 inline __m256d eq(__m256d a, __m256d b) { return _mm256_cmp_pd(a, b, _CMP_EQ_OQ); }
+// Coordinate i (x, or y where y) of the four lanes' triangles.
+SHD_AVX2 inline __m256d coords(const std::array<RowSpans::Vertex, 3>* v, const std::array<size_t, 4>& tri, size_t i,
+                               bool y) {
+  auto at = [&](size_t j) { return y ? v[tri[j]][i].y : v[tri[j]][i].x; };
+  return _mm256_setr_pd(at(0), at(1), at(2), at(3));
+}
+// centreRows: -floor((half - lo) / step) and floor((hi - half) / step), exact (a power of two).
+SHD_AVX2 inline __m256d rowsLo(__m256d lo, __m256d half, __m256d inv_step) {
+  return _mm256_sub_pd(_mm256_setzero_pd(), _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(half, lo), inv_step)));
+}
+SHD_AVX2 inline __m256d rowsHi(__m256d hi, __m256d half, __m256d inv_step) {
+  return _mm256_floor_pd(_mm256_mul_pd(_mm256_sub_pd(hi, half), inv_step));
+}
+}  // namespace front4x
+SHD_AVX2 void front4(const std::array<RowSpans::Vertex, 3>* v, size_t n, size_t t0, const RowSpansConfig& c,
+                     Front8& f) {
+  using front4x::abs, front4x::lt, front4x::le, front4x::eq;
+  const int S = c.S;
+  std::array<size_t, 4> tri;
+  for (size_t j = 0; j < 4; ++j) tri[j] = std::min(t0 + j, n - 1);
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d magic = _mm256_set1_pd(6755399441055744.0);  // 1.5 2^52
+  auto bits = [t0](__m256d m) SHD_AVX2 { return static_cast<__mmask8>(_mm256_movemask_pd(m) << t0); };
+  const auto mine = static_cast<__mmask8>(0xFu << t0);  // this call's lanes of the block
+  auto store = [&](int64_t* out, __m256d x) SHD_AVX2 {
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + t0),
+                        _mm256_sub_epi64(_mm256_castpd_si256(_mm256_add_pd(x, magic)), _mm256_castpd_si256(magic)));
+  };
+  const __m256d scale = _mm256_set1_pd(static_cast<double>(int64_t{1} << S)), guard = _mm256_set1_pd(c.guard);
+  __m256d X[3], Y[3];
+  __m256d ok = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));
+  for (size_t i = 0; i < 3; ++i) {
+    const __m256d x = front4x::coords(v, tri, i, false), y = front4x::coords(v, tri, i, true);
+    ok = _mm256_and_pd(ok, _mm256_and_pd(le(abs(x), guard), le(abs(y), guard)));
+    X[i] = _mm256_sub_pd(_mm256_add_pd(_mm256_and_pd(ok, _mm256_mul_pd(x, scale)), magic), magic);
+    Y[i] = _mm256_sub_pd(_mm256_add_pd(_mm256_and_pd(ok, _mm256_mul_pd(y, scale)), magic), magic);
+  }
+  const __m256d lim25 = _mm256_set1_pd(33554432.0), lim51 = _mm256_set1_pd(2251799813685248.0);
+  const __m256d d1x = _mm256_sub_pd(X[1], X[0]), d1y = _mm256_sub_pd(Y[1], Y[0]);
+  const __m256d d2x = _mm256_sub_pd(X[2], X[0]), d2y = _mm256_sub_pd(Y[2], Y[0]);
+  const __m256d exact = _mm256_and_pd(_mm256_and_pd(lt(abs(d1x), lim25), lt(abs(d1y), lim25)),
+                                      _mm256_and_pd(lt(abs(d2x), lim25), lt(abs(d2y), lim25)));
+  __m256d det = _mm256_sub_pd(_mm256_mul_pd(d1x, d2y), _mm256_mul_pd(d2x, d1y));
+  const __m256d flat = eq(det, zero), neg = lt(det, zero);
+  {
+    const __m256d x1 = X[1], y1 = Y[1];
+    X[1] = _mm256_blendv_pd(X[1], X[2], neg);
+    Y[1] = _mm256_blendv_pd(Y[1], Y[2], neg);
+    X[2] = _mm256_blendv_pd(X[2], x1, neg);
+    Y[2] = _mm256_blendv_pd(Y[2], y1, neg);
+  }
+  det = abs(det);
+  __m256d xu[3], yu[3];
+  for (size_t i = 0; i < 3; ++i) {
+    xu[i] = _mm256_add_pd(X[i], X[i]);
+    yu[i] = _mm256_add_pd(Y[i], Y[i]);
+  }
+  const __m256d half = _mm256_set1_pd(static_cast<double>(int64_t{1} << S));
+  const __m256d step = _mm256_set1_pd(static_cast<double>(int64_t{1} << (S + 1)));
+  const __m256d inv_step = _mm256_set1_pd(1.0 / static_cast<double>(int64_t{1} << (S + 1)));
+  __m256d A[3], B[3], C[3];
+  __m256d horizontal = zero;
+  for (size_t s = 0; s < 3; ++s) {
+    const size_t q = (s + 1) % 3;
+    const __m256d dx = _mm256_sub_pd(xu[q], xu[s]), dy = _mm256_sub_pd(yu[q], yu[s]);
+    A[s] = _mm256_sub_pd(zero, _mm256_mul_pd(dy, step));
+    B[s] = _mm256_mul_pd(dx, step);
+    const __m256d p1 = _mm256_mul_pd(dx, _mm256_sub_pd(half, yu[s]));
+    const __m256d p2 = _mm256_mul_pd(dy, _mm256_sub_pd(half, xu[s]));
+    const __m256d a0 = eq(A[s], zero);
+    const __m256d top_left = _mm256_or_pd(lt(zero, A[s]), _mm256_and_pd(a0, lt(zero, B[s])));
+    C[s] = _mm256_sub_pd(_mm256_sub_pd(p1, p2), _mm256_andnot_pd(top_left, _mm256_set1_pd(1.0)));
+    horizontal = _mm256_or_pd(horizontal, a0);
+  }
+  const __m256d ylo = _mm256_min_pd(_mm256_min_pd(yu[0], yu[1]), yu[2]);
+  const __m256d yhi = _mm256_max_pd(_mm256_max_pd(yu[0], yu[1]), yu[2]);
+  const __m256d r0 = _mm256_max_pd(front4x::rowsLo(ylo, half, inv_step), zero);
+  const __m256d r1 = _mm256_min_pd(front4x::rowsHi(yhi, half, inv_step),
+                                   _mm256_set1_pd(static_cast<double>(c.H - 1)));
+  const __m256d c0 = front4x::rowsLo(_mm256_min_pd(_mm256_min_pd(xu[0], xu[1]), xu[2]), half, inv_step);
+  const __m256d c1 = front4x::rowsHi(_mm256_max_pd(_mm256_max_pd(xu[0], xu[1]), xu[2]), half, inv_step);
+  const __m256d box_out = _mm256_or_pd(_mm256_or_pd(lt(r1, r0), lt(c1, zero)),
+                                       lt(_mm256_set1_pd(static_cast<double>(c.W - 1)), c0));
+  const __m256d tall = le(_mm256_set1_pd(RowSpans::kMaxRows), _mm256_sub_pd(r1, r0));
+  const __m256d k_lim = _mm256_set1_pd(static_cast<double>(c.k_lim));
+  __m256d steep = zero, narrow = _mm256_castsi256_pd(_mm256_set1_epi64x(-1));  // every N below 2^51
+  for (size_t s = 0; s < 3; ++s) {
+    const __m256d D = abs(A[s]);
+    const __m256d Br0 = _mm256_mul_pd(B[s], r0);
+    const __m256d N = _mm256_sub_pd(zero, _mm256_add_pd(Br0, C[s]));
+    narrow = _mm256_and_pd(narrow, lt(abs(N), lim51));
+    const __m256d negB = _mm256_sub_pd(zero, B[s]);
+    const __m256d q = _mm256_ceil_pd(_mm256_div_pd(N, D));
+    const __m256d k = _mm256_floor_pd(_mm256_div_pd(negB, D));
+    steep = _mm256_or_pd(steep, _mm256_or_pd(le(k_lim, k), lt(k, _mm256_sub_pd(zero, k_lim))));
+    store(f.q[s], q);
+    store(f.r[s], _mm256_sub_pd(_mm256_mul_pd(q, D), N));
+    store(f.D[s], D);
+    store(f.k[s], k);
+    store(f.m[s], _mm256_sub_pd(negB, _mm256_mul_pd(k, D)));
+    f.right[s] = static_cast<__mmask8>((f.right[s] & ~mine) | bits(lt(A[s], zero)));
+  }
+  for (size_t i = 0; i < 3; ++i) {
+    store(f.X[i], X[i]);
+    store(f.Y[i], Y[i]);
+  }
+  store(f.det, det);
+  store(f.r0, r0);
+  store(f.r1, r1);
+  setOutcomes(f, mine, {bits(ok), static_cast<__mmask8>(~bits(exact)), bits(flat), bits(horizontal), bits(box_out),
+                       bits(tall), static_cast<__mmask8>(~bits(narrow)), bits(steep), bits(neg)});
 }
 
 // planeavx2::plane of 8 triangles at once, a triangle per lane and an attribute at a time: the
@@ -817,11 +962,16 @@ SHD_AVX512 __mmask8 plane8(const Plane8& p, __mmask8 lanes, int S, RowSpans* o) 
 void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, RowSpans* out,
                         RowSpansSetup* got) {
 #ifdef SHD_X86_KERNELS
-  if (c.vector && c.avx512) {
+  if (c.vector) {
     for (size_t count; n > 0; v += count, out += count, got += count, n -= count) {
       count = std::min<size_t>(n, 8);
       Front8 f;
-      front8(v, count, c, f);
+      if (c.avx512) {
+        front8(v, count, c, f);
+      } else {
+        front4(v, count, 0, c, f);
+        if (count > 4) front4(v, count, 4, c, f);
+      }
       Plane8 p;
       __mmask8 planes = 0;  // the triangles whose rows' spans are set, their plane to follow
       for (size_t t = 0; t < count; ++t) {
@@ -852,10 +1002,16 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
         PlaneGeom g;
         got[t] = spans(fr, c, out[t], g);
         if (got[t] == RowSpansSetup::Dropped) continue;
+        if (!c.avx512) {  // the plane as one triangle's (AVX2, then scalar)
+          Codes a;
+          got[t] = planeOf(c, a, af, g, out[t]);
+          continue;
+        }
         planes |= static_cast<__mmask8>(1u << t);
         p.set(t, af, g);
       }
       // The planes in lanes; those that do not fit there as one triangle's (planeOf).
+      if (!c.avx512) continue;
       const __mmask8 done = plane8(p, planes, c.S, out);
       for (size_t t = 0; t < count; ++t) {
         if (((planes & ~done) >> t & 1) == 0) continue;

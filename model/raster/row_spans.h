@@ -84,8 +84,10 @@ enum class RowSpansSetup {
 };
 RowSpansSetup setupRowSpans(const std::array<RowSpans::Vertex, 3>& v, const RowSpansConfig& c, RowSpans& out);
 // setupRowSpans of the n triangles v[0 .. n - 1] into out[i] and got[i]: the same outcomes and
-// rows' spans. Where the row loop runs in AVX-512 (RowSpansConfig::avx512), 8 triangles at a time
-// up to their edges' DDAs, one in each 64-bit lane.
+// rows' spans. Where the vector kernels run (RowSpansConfig::vector), 8 triangles at a time up to
+// their edges' DDAs, one in each 64-bit lane of AVX-512 (RowSpansConfig::avx512: in integers,
+// then their planes together) or 4 in each pass of AVX2 (in doubles, where they hold the
+// integers exactly; then the planes one triangle at a time).
 void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, const RowSpansConfig& c, RowSpans* out,
                         RowSpansSetup* got);
 

@@ -520,8 +520,8 @@ class SceneDrawer {
   SplitSide* const side_;
   SetupResult setup_;                 // of the triangle being drawn here (no queue)
   RowSpans rows_;                     // the same as rows' spans
-  // One thread or a side of a frame split by rows, where the rows' spans' row loop runs in
-  // AVX-512: mesh triangles drawn as themselves (one part, the mesh's own vertices), set up to
+  // One thread or a side of a frame split by rows, where the rows' spans' vector kernels run
+  // (AVX-512 or AVX2): mesh triangles drawn as themselves (one part, the mesh's own vertices), set up to
   // their rows' spans 8 at a time (setupRowSpansBlock) and then drawn in order, before anything
   // else is drawn (drawSetUp). On a side: whether it owns each and whether it may reach its rows.
   struct Waiting {
@@ -809,7 +809,7 @@ void SceneDrawer::drawMeshTriangle(const std::array<uint32_t, 3>& tri, uint32_t 
 }
 
 // The triangle drawn as itself (parts_) into the triangles waiting for setupRowSpansBlock, where
-// its one part has the mesh's vertices and is set up to its rows' spans in AVX-512 with the
+// its one part has the mesh's vertices and is set up to its rows' spans in vector lanes with the
 // configuration of those waiting (else they are drawn first), and on a side of a frame split by
 // rows, where the side sets it up (drawSplitPart): false where it is not. owner: the side's.
 bool SceneDrawer::setUpLater(uint32_t ti, bool owner) {
@@ -817,7 +817,7 @@ bool SceneDrawer::setUpLater(uint32_t ti, bool owner) {
   const Part& part = parts_[0];
   const bool colour_attrs = traits(part.method).attributes == Attributes::Colour;
   const RowSpansConfig* rs = setup_config_.rowSpans(part.method, colour_attrs);
-  if (rs == nullptr || !rs->avx512) return false;
+  if (rs == nullptr || !rs->vector) return false;
   const PVertex* const verts = verts_->data();
   for (const PVertex* v : part.v)
     if (v < verts || v >= verts + verts_->size()) return false;
