@@ -1010,9 +1010,9 @@ void setupRowSpansBlock(const std::array<RowSpans::Vertex, 3>* v, size_t n, cons
         planes |= static_cast<__mmask8>(1u << t);
         p.set(t, af, g);
       }
-      // The planes in lanes; those that do not fit there as one triangle's (planeOf).
-      if (!c.avx512) continue;
-      const __mmask8 done = plane8(p, planes, c.S, out);
+      // The planes in lanes (AVX-512: none wait in AVX2); those that do not fit there as one
+      // triangle's (planeOf).
+      const __mmask8 done = planes != 0 ? plane8(p, planes, c.S, out) : 0;
       for (size_t t = 0; t < count; ++t) {
         if (((planes & ~done) >> t & 1) == 0) continue;
         Codes a;
