@@ -193,10 +193,12 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
 // The batch kernels (render/fixed_simd.h: shadeNh, shadeNhAvx2, shadeNhScalar) against shade(),
 // lane by lane: runs of 1 to 8 fragments with normals from 2^-27 to 8 in length (squared norms of
 // every bit length up to 64; codes up to 2^31), facing the light or away, for each lobe they take,
-// with factor codes up to saturation. Lanes with a squared norm below 2^8 (and a zero normal) must
-// make a kernel decline the group. Each vector kernel where the CPU has its instructions, and the
-// plain C++ one everywhere.
-static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
+// with factor codes up to saturation. A group must be declined exactly where a lane's squared norm
+// is outside the kernel's domain: below 2^8 (a zero normal too) for the AVX-512 and the plain C++
+// kernel, outside [2^32, 2^62) for the AVX2 one. Each vector kernel where the CPU has its
+// instructions, and the plain C++ one everywhere.
+static void checkNhKernel(const char* name, fixed_simd::NhKernel nh, uint64_t from = uint64_t{1} << 8,
+                          uint64_t below = ~uint64_t{0}) {
   SCOPED_TRACE(name);
   std::mt19937_64 rng(12);
   std::normal_distribution<double> g;
@@ -216,9 +218,11 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
           if constexpr (decltype(kernel)::kGroups) {
             for (int t = 0; t < 3000; ++t) {
               // A run: N_j = n0 + j dn, as the span unit interpolates it.
-              // 2^-27 to 8 in length: codes from a few units (squared norms below 2^8: declined)
-              // to 2^31 (squared norms of 64 bits).
-              const double len = std::ldexp(1.0, -27 + static_cast<int>(rng() % 30)) * (1 + u01(rng));
+              // 2^-27 to 11.2 in length: codes from a few units (squared norms below 2^8) to
+              // 2^31.5 (squared norms of 63 bits, their squares within int64_t); two runs in
+              // three from 2^-12 to 4 (the AVX2 kernel's domain).
+              const int e = t % 3 == 0 ? -27 + static_cast<int>(rng() % 31) : -12 + static_cast<int>(rng() % 14);
+              const double len = std::ldexp(1.0, e) * (1 + (e == 3 ? 0.4 : 1.0) * u01(rng));
               Vec3 v{g(rng), g(rng), g(rng)};
               if (t % 2 != 0) v = normalize(normalize(v) + 3.0 * ctx.lights[0].half);
               if (t % 10 == 1) v = ctx.lights[0].half;  // N.H at 1 and a hair either side (the clamp at 2^32)
@@ -233,11 +237,11 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
               std::array<uint64_t, 8> sq{}, l{}, h{};
               std::array<std::array<int64_t, 3>, 8> nj{};
               kernel.start(c.n.data(), dn.data());
-              bool small = false;
+              bool outside = false;
               for (int j = 0; j < count; ++j) {
                 for (size_t k = 0; k < 3; ++k) nj[j][k] = c.n[k] + j * dn[k];
                 for (size_t k = 0; k < 3; ++k) sq[j] += static_cast<uint64_t>(nj[j][k] * nj[j][k]);
-                small = small || sq[j] < (uint64_t{1} << 8);
+                outside = outside || sq[j] < from || sq[j] >= below;
                 l[j] = kernel.dotL();
                 h[j] = kernel.dotH();
                 kernel.step();
@@ -247,7 +251,7 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
               int64_t* const codes_out[3] = {codes[0], codes[1], codes[2]};
               const bool vec =
                   nh(kernel.nhParams(), sq.data(), l.data(), h.data(), static_cast<size_t>(count), rgb, codes_out) == 0;
-              ASSERT_EQ(vec, !small) << "n " << n << " " << toString(lobe);
+              ASSERT_EQ(vec, !outside) << "n " << n << " " << toString(lobe);
               if (!vec) {
                 ++declined;
                 continue;
@@ -278,7 +282,7 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh) {
 
 TEST(FixedSimd, LanesEqualTheScalarDatapath) {
   if (fixed_simd::cpuHasAvx512()) checkNhKernel("avx512", fixed_simd::shadeNh);
-  if (fixed_simd::cpuHasAvx2()) checkNhKernel("avx2", fixed_simd::shadeNhAvx2);
+  if (fixed_simd::cpuHasAvx2()) checkNhKernel("avx2", fixed_simd::shadeNhAvx2, uint64_t{1} << 32, uint64_t{1} << 62);
   checkNhKernel("scalar", fixed_simd::shadeNhScalar);
 }
 

@@ -89,6 +89,26 @@ TEST(RsqrtCore, NormalisesByTheBitLengthWithinItsSeedsError) {
   RecordProperty("worst_relative_error_seed10", std::to_string(w10));
 }
 
+// rsqrtCore's Newton step r0 (3 2^32 - m r0^2) >> 17 is not negative with either seed table:
+// m r0^2 (mr, Q32) stays below 3 2^32 at the top of every entry's interval of m (mr grows with
+// m), so 3 2^32 - mr > 0. The AVX2 kernel (shadeNhAvx2) shifts the product right logically.
+template <int SeedBits>
+void checkSeedProducts() {
+  const auto& table = RsqrtSeed<SeedBits>::table;
+  for (size_t i = 0; i < table.size(); ++i) {
+    // The largest Q32 mantissa mq whose index ((mq - 2^30) << SeedBits) / (3 2^30) is i.
+    const uint64_t top = (uint64_t{1} << 30) + (i + 1) * (uint64_t{3} << (30 - SeedBits)) - 1;
+    const uint64_t r0 = table[i];
+    const uint64_t mr = static_cast<uint64_t>((static_cast<unsigned __int128>(top) * (r0 * r0)) >> 32);
+    EXPECT_LT(mr, uint64_t{3} << 32) << "seed bits " << SeedBits << " entry " << i;
+    EXPECT_GT(rsqrtCore<SeedBits>(top << 30).r, 0) << "seed bits " << SeedBits << " entry " << i;
+  }
+}
+TEST(RsqrtCore, SeedProductsStayBelowThree) {
+  checkSeedProducts<8>();
+  checkSeedProducts<10>();
+}
+
 // phong-fixed's cosines: (N.u) / |N| from the integer dot product, the exact squared norm and
 // the 10-bit-seed rsqrtCore, against the exact value of the same codes, for normals of length
 // 1/16 to 1.2 (interpolation shortens them).

@@ -710,12 +710,6 @@ SHD_AVX2 inline __m256i mulHiRoundU64x4(__m256i a, __m256i b) {
   return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(ah, bh), _mm256_srli_epi64(u, 32)),
                           _mm256_srli_epi64(_mm256_add_epi64(v, _mm256_set1_epi64x(int64_t{1} << 31)), 32));
 }
-// x >> S, arithmetic (0 < S < 64): the logical shift with the sign's copies shifted in.
-template <int S>
-SHD_AVX2 inline __m256i sra64(__m256i x) {
-  const __m256i sign = _mm256_cmpgt_epi64(_mm256_setzero_si256(), x);
-  return _mm256_or_si256(_mm256_srli_epi64(x, S), _mm256_slli_epi64(sign, 64 - S));
-}
 SHD_AVX2 inline __m256i max64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(b, a)); }
 SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(a, b)); }
 // scaleCosines' operations.
@@ -724,36 +718,31 @@ SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
   return _mm256_sub_epi64(mulHiRoundU64x4(d, r64), _mm256_and_si256(neg, r64));
 }
 
-// The bit length of each lane's value v > 0 (64 less its count of leading zeros, which AVX2
-// lacks): that of its high word plus 32 where the high word is not 0, else that of its low
-// word. A word y below 2^32 is exact in a double, d = (2^52 + y) - 2^52 (the sum's bits are
-// y's with 2^52's exponent), whose exponent field is 1023 + floor(log2 y) for y > 0.
-SHD_AVX2 inline __m256i bitLength4(__m256i v) {
-  const __m256i hi = _mm256_srli_epi64(v, 32);
-  const __m256i low_word = _mm256_cmpeq_epi64(hi, _mm256_setzero_si256());
-  const __m256i y = _mm256_blendv_epi8(hi, _mm256_and_si256(v, _mm256_set1_epi64x(0xFFFFFFFF)), low_word);
-  const __m256d two52 = _mm256_set1_pd(4503599627370496.0);
-  const __m256d d = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(y, _mm256_castpd_si256(two52))), two52);
-  const __m256i exponent = _mm256_srli_epi64(_mm256_castpd_si256(d), 52);
-  return _mm256_add_epi64(_mm256_sub_epi64(exponent, _mm256_set1_epi64x(1022)),
-                          _mm256_andnot_si256(low_word, _mm256_set1_epi64x(32)));
-}
-
 // scaleGroup's datapath on the 4 squared norms at sq (`valid`: the lanes that are fragments),
 // their cosine scales stored at r64_out; false (nothing stored) when a valid lane needs the
-// scalar path.
+// scalar path. This kernel takes squared norms in [2^32, 2^62) only (|N| from 2^-12 to 8: an
+// interpolated unit normal's is near 2^56) and declines the rest, which spares it what AVX2
+// lacks for the others:
+// - the bit length, 64 less the count of leading zeros (no instruction), is that of the high
+//   word y plus 32. y, below 2^32, is exact in a double, d = (2^52 + y) - 2^52, whose exponent
+//   field is 1023 + floor(log2 y) for y > 0;
+// - rsqrtCore's shift is (62 - bits) / 2, in [0, 14] (no shift down by 4 for bits above 62),
+//   so s = 61 - shift >= 35, cosineScale's fast path;
+// - r0 (3 2^32 - m r0^2) >> 17 is not negative: the seed's m r0^2 stays near 2^32, below
+//   3 2^32 (RsqrtCore.SeedProductsStayBelowThree checks every entry at its interval's top), so
+//   the shift is logical.
 [[gnu::always_inline]] SHD_AVX2 inline bool scaleLanes4(const uint64_t* sq, __m256i valid, uint64_t* r64_out) {
   const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sq));
-  // rsqrtCore<10>: the bit length (bitLength4: not of 0, which goes to the scalar path), shift.
-  const __m256i bits = bitLength4(v);
-  const __m256i up = _mm256_cmpgt_epi64(_mm256_set1_epi64x(63), bits);  // bits <= 62
-  const __m256i shift = _mm256_blendv_epi8(_mm256_set1_epi64x(-1),
-                                           _mm256_srli_epi64(_mm256_sub_epi64(_mm256_set1_epi64x(62), bits), 1), up);
-  const __m256i scalar = _mm256_or_si256(_mm256_cmpgt_epi64(shift, _mm256_set1_epi64x(26)),
-                                         _mm256_cmpeq_epi64(v, _mm256_setzero_si256()));
-  if (!_mm256_testz_si256(scalar, valid)) return false;
-  const __m256i m = _mm256_blendv_epi8(_mm256_srli_epi64(v, 2), _mm256_sllv_epi64(v, _mm256_add_epi64(shift, shift)), up);
-  const __m256i mq = _mm256_srli_epi64(m, 30);
+  const __m256i hi = _mm256_srli_epi64(v, 32);
+  const __m256i outside = _mm256_or_si256(_mm256_cmpeq_epi64(hi, _mm256_setzero_si256()),
+                                          _mm256_cmpgt_epi64(hi, _mm256_set1_epi64x((int64_t{1} << 30) - 1)));
+  if (!_mm256_testz_si256(outside, valid)) return false;
+  const __m256d two52 = _mm256_set1_pd(4503599627370496.0);
+  const __m256d d = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, _mm256_castpd_si256(two52))), two52);
+  // bits = exponent - 1023 + 1 + 32; shift = (62 - bits) / 2 = (1052 - exponent) / 2.
+  const __m256i exponent = _mm256_srli_epi64(_mm256_castpd_si256(d), 52);
+  const __m256i shift = _mm256_srli_epi64(_mm256_sub_epi64(_mm256_set1_epi64x(1052), exponent), 1);
+  const __m256i mq = _mm256_srli_epi64(_mm256_sllv_epi64(v, _mm256_add_epi64(shift, shift)), 30);
   const __m256i y = _mm256_srli_epi64(_mm256_sub_epi64(mq, _mm256_set1_epi64x(int64_t{1} << 30)), 20);
   const __m256i idx = _mm256_srli_epi64(_mm256_mul_epu32(y, _mm256_set1_epi64x(43691)), 17);
   // The seed entries, gathered by the valid lanes (the others' indexes are not entries).
@@ -763,7 +752,7 @@ SHD_AVX2 inline __m256i bitLength4(__m256i v) {
   const __m256i r0sq = _mm256_mul_epu32(r0, r0);
   const __m256i mr = _mm256_add_epi64(_mm256_mul_epu32(mq, _mm256_srli_epi64(r0sq, 32)),
                                       _mm256_srli_epi64(_mm256_mul_epu32(mq, r0sq), 32));
-  const __m256i r = sra64<17>(mulLo64By32(r0, _mm256_sub_epi64(_mm256_set1_epi64x(int64_t{3} << 32), mr)));
+  const __m256i r = _mm256_srli_epi64(mulLo64By32(r0, _mm256_sub_epi64(_mm256_set1_epi64x(int64_t{3} << 32), mr)), 17);
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(r64_out), _mm256_sllv_epi64(r, _mm256_add_epi64(shift, _mm256_set1_epi64x(3))));
   return true;
 }

@@ -55,9 +55,10 @@ constexpr uint32_t packedRgb(const std::array<uint8_t, 3>& c) {
 // (56 fraction bits) and the raw dot products N.L = l[i] and N.H = h[i] (58 fraction bits,
 // two's complement) give the output colour rgb[i] (packedRgb) and, where codes is not null, the
 // 12-fraction-bit code of channel k before the output rounding (FixedShade::code) in codes[k][i].
-// Returns the groups it declines (bit g: a fragment of group g needs the scalar path); their
-// outputs are untouched. The inputs hold n rounded up to a multiple of 8 readable entries
-// (those past n are read and ignored), the outputs as many writable ones.
+// Returns the groups it declines (bit g: a fragment of group g needs the scalar path: a squared
+// norm below 2^8, or, in the AVX2 kernel, outside [2^32, 2^62)); their outputs are untouched.
+// The inputs hold n rounded up to a multiple of 8 readable entries (those past n are read and
+// ignored), the outputs as many writable ones.
 // Two kernels, each for a CPU with its instructions: AVX-512 (8 64-bit lanes) and AVX2 (4 lanes,
 // two per group; the 64-bit products, shifts and the bit length that AVX2 lacks made of its
 // 32 x 32 products, shifts, compares and double subtraction); and one in plain C++ for any CPU
