@@ -710,13 +710,7 @@ SHD_AVX2 inline __m256i mulHiRoundU64x4(__m256i a, __m256i b) {
   return _mm256_add_epi64(_mm256_add_epi64(_mm256_mul_epu32(ah, bh), _mm256_srli_epi64(u, 32)),
                           _mm256_srli_epi64(_mm256_add_epi64(v, _mm256_set1_epi64x(int64_t{1} << 31)), 32));
 }
-SHD_AVX2 inline __m256i max64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(b, a)); }
 SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(a, b, _mm256_cmpgt_epi64(a, b)); }
-// scaleCosines' operations.
-SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
-  const __m256i neg = _mm256_cmpgt_epi64(_mm256_setzero_si256(), d);
-  return _mm256_sub_epi64(mulHiRoundU64x4(d, r64), _mm256_and_si256(neg, r64));
-}
 
 // scaleGroup's datapath on the 4 squared norms at sq (`valid`: the lanes that are fragments),
 // their cosine scales stored at r64_out; false (nothing stored) when a valid lane needs the
@@ -767,10 +761,15 @@ SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
   const __m256i r64 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(r64s));
   const __m256i dot_l = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(l));
   const __m256i dot_h = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(h));
-  const __m256i nl = scaleCosines4(dot_l, r64);
-  const __m256i lit = _mm256_cmpgt_epi64(nl, _mm256_setzero_si256());
-  const __m256i nh = scaleCosines4(dot_h, r64);
-  const __m256i c = min64(max64(nh, _mm256_setzero_si256()), _mm256_set1_epi64x(int64_t{1} << 32));
+  // scaleCosines less its correction for a negative dot product, whose cosine is not positive
+  // (d r64 + 2^63 < 2^63): such a lane is unlit, and its N.H clamps to 0, which they are set to.
+  // The others' products are those of scaleCosines, below 2^51 (r64 < 2^51 in scaleLanes4's
+  // range): N.H needs no clamp at 0.
+  const __m256i zero = _mm256_setzero_si256();
+  const __m256i nl = _mm256_andnot_si256(_mm256_cmpgt_epi64(zero, dot_l), mulHiRoundU64x4(dot_l, r64));
+  const __m256i lit = _mm256_cmpgt_epi64(nl, zero);
+  const __m256i c = _mm256_andnot_si256(_mm256_cmpgt_epi64(zero, dot_h),
+                                        min64(mulHiRoundU64x4(dot_h, r64), _mm256_set1_epi64x(int64_t{1} << 32)));
   const __m256i ti = _mm256_srli_epi64(c, 16);
   const __m256i reads = _mm256_and_si256(
       _mm256_and_si256(valid, lit), _mm256_cmpgt_epi64(ti, _mm256_set1_epi64x(static_cast<int64_t>(p.zero_below) - 1)));
@@ -812,12 +811,6 @@ SHD_AVX2 inline __m256i scaleCosines4(__m256i d, __m256i r64) {
   }
 }
 
-// The output byte of each channel's code (as colourGroup's out) in the low byte of the 64-bit lanes.
-SHD_AVX2 inline __m256i outputs4(__m256i code) {
-  return _mm256_srli_epi64(
-      _mm256_add_epi64(min64(code, _mm256_set1_epi64x(int64_t{255} << 12)), _mm256_set1_epi64x(1 << 11)), 12);
-}
-
 // The valid lanes of a group of n fragments: of its first four (half 0) or last four (half 1).
 SHD_AVX2 inline __m256i validLanes4(int n, int half) {
   return _mm256_cmpgt_epi64(_mm256_set1_epi64x(n - 4 * half), _mm256_setr_epi64x(0, 1, 2, 3));
@@ -838,20 +831,29 @@ SHD_AVX2 inline void colourGroupAvx2(const NhParams& p, const LobeLanes& in, siz
   __m256i a[3], b[3];
   codeLanes4(p, in, i, a);
   codeLanes4(p, in, i + 4, b);
-  // The lanes' packedRgb in 64-bit lanes, then their low words to 32-bit lanes 0-3 (a) and 4-7 (b).
-  __m256i pa = _mm256_setzero_si256(), pb = _mm256_setzero_si256();
+  // The output bytes as colourGroup's, min(code, 255 2^12) rounded by 12 bits, here as
+  // (code + 2^11) >> 12 saturated at 255 by the packs (the codes are not negative and below
+  // 2^39, so the shifted value fits an int32_t's low word; above 255 both give 255). Each
+  // channel's 8 values as 32-bit lanes a0 b0 a1 b1 | a2 b2 a3 b3 (fragments 0 4 1 5 | 2 6 3 7),
+  // packed to 16 and then 8 bits (per 128-bit half: the 4 red bytes, the 4 green, the 4 blue),
+  // gathered into each fragment's word by a byte shuffle, and the words put in fragment order.
+  __m256i x[3];
   for (size_t k = 0; k < 3; ++k) {
-    pa = _mm256_or_si256(pa, _mm256_slli_epi64(outputs4(a[k]), static_cast<int>(8 * k)));
-    pb = _mm256_or_si256(pb, _mm256_slli_epi64(outputs4(b[k]), static_cast<int>(8 * k)));
+    const __m256i half = _mm256_set1_epi64x(1 << 11);
+    const __m256i ta = _mm256_srli_epi64(_mm256_add_epi64(a[k], half), 12);
+    const __m256i tb = _mm256_srli_epi64(_mm256_add_epi64(b[k], half), 12);
+    x[k] = _mm256_blend_epi32(ta, _mm256_slli_epi64(tb, 32), 0xAA);
     if constexpr (kCodes) {
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i), a[k]);
       _mm256_storeu_si256(reinterpret_cast<__m256i*>(codes[k] + i + 4), b[k]);
     }
   }
-  const __m256i low_words = _mm256_setr_epi32(0, 2, 4, 6, 0, 2, 4, 6);
+  const __m256i bytes = _mm256_packus_epi16(_mm256_packs_epi32(x[0], x[1]), _mm256_packs_epi32(x[2], x[2]));
+  const __m256i words = _mm256_shuffle_epi8(
+      bytes, _mm256_setr_epi8(0, 4, 8, -1, 1, 5, 9, -1, 2, 6, 10, -1, 3, 7, 11, -1,  //
+                              0, 4, 8, -1, 1, 5, 9, -1, 2, 6, 10, -1, 3, 7, 11, -1));
   _mm256_storeu_si256(reinterpret_cast<__m256i*>(rgb + i),
-                      _mm256_blend_epi32(_mm256_permutevar8x32_epi32(pa, low_words),
-                                         _mm256_permutevar8x32_epi32(pb, low_words), 0xF0));
+                      _mm256_permutevar8x32_epi32(words, _mm256_setr_epi32(0, 2, 4, 6, 1, 3, 5, 7)));
 }
 
 }  // namespace
