@@ -196,16 +196,14 @@ SHD_AVX512 inline bool scaleGroup(const uint64_t* sq, int n, uint64_t* r64_out) 
   const __mmask8 valid = static_cast<__mmask8>((1u << n) - 1);
   const __m512i v = _mm512_loadu_si512(sq);
 
-  // rsqrtCore<10>: bits, shift = bits <= 62 ? (62 - bits) / 2 : -1, m, mq = m >> 30.
-  const __m512i bits = _mm512_sub_epi64(_mm512_set1_epi64(64), _mm512_lzcnt_epi64(v));
-  const __mmask8 up = _mm512_cmple_epi64_mask(bits, _mm512_set1_epi64(62));
-  const __m512i shift = _mm512_mask_blend_epi64(up, _mm512_set1_epi64(-1),
-                                                _mm512_srli_epi64(_mm512_sub_epi64(_mm512_set1_epi64(62), bits), 1));
-  // The scalar path's lanes: sqnorm 0 (bits 0) and s = 61 - shift < 35, i.e. shift > 26.
-  const __mmask8 scalar = _mm512_cmpgt_epi64_mask(shift, _mm512_set1_epi64(26)) |
-                          _mm512_cmpeq_epi64_mask(v, _mm512_setzero_si512());
-  if ((scalar & valid) != 0) return false;
-  const __m512i m = _mm512_mask_blend_epi64(up, _mm512_srli_epi64(v, 2), _mm512_sllv_epi64(v, _mm512_add_epi64(shift, shift)));
+  // rsqrtCore<10> on squared norms in [2^32, 2^62) (the others declined, as shadeNhAvx2's
+  // scaleLanes4 declines them): bits = 64 - lzcnt, shift = (62 - bits) / 2 = (lzcnt - 2) / 2 in
+  // [0, 14], never the shift down; s = 61 - shift >= 35, cosineScale's fast path.
+  const __mmask8 outside = _mm512_cmplt_epu64_mask(v, _mm512_set1_epi64(int64_t{1} << 32)) |
+                           _mm512_cmpge_epu64_mask(v, _mm512_set1_epi64(int64_t{1} << 62));
+  if ((outside & valid) != 0) return false;
+  const __m512i shift = _mm512_srli_epi64(_mm512_sub_epi64(_mm512_lzcnt_epi64(v), _mm512_set1_epi64(2)), 1);
+  const __m512i m = _mm512_sllv_epi64(v, _mm512_add_epi64(shift, shift));
   const __m512i mq = _mm512_srli_epi64(m, 30);  // in [2^30, 2^32)
   // idx = ((mq - 2^30) << 10) / (3 2^30) = y / 3, y = (mq - 2^30) >> 20 < 3072: (y 43691) >> 17.
   const __m512i y = _mm512_srli_epi64(_mm512_sub_epi64(mq, _mm512_set1_epi64(int64_t{1} << 30)), 20);
@@ -227,8 +225,8 @@ SHD_AVX512 inline bool scaleGroup(const uint64_t* sq, int n, uint64_t* r64_out) 
   const __m512i r0sq = _mm512_mul_epu32(r0, r0);
   const __m512i mr = _mm512_add_epi64(_mm512_mul_epu32(mq, _mm512_srli_epi64(r0sq, 32)),
                                       _mm512_srli_epi64(_mm512_mul_epu32(mq, r0sq), 32));
-  const __m512i r = _mm512_srai_epi64(
-      _mm512_mullo_epi64(r0, _mm512_sub_epi64(_mm512_set1_epi64(int64_t{3} << 32), mr)), 17);
+  const __m512i r = _mm512_srli_epi64(
+      _mm512_mullo_epi64(r0, _mm512_sub_epi64(_mm512_set1_epi64(int64_t{3} << 32), mr)), 17);  // not negative
   // cosineScale: s = 61 - shift, r64 = r << (64 - s) = r << (3 + shift).
   _mm512_storeu_si512(r64_out, _mm512_sllv_epi64(r, _mm512_add_epi64(shift, _mm512_set1_epi64(3))));
   return true;
@@ -714,9 +712,9 @@ SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(
 
 // scaleGroup's datapath on the 4 squared norms at sq (`valid`: the lanes that are fragments),
 // their cosine scales stored at r64_out; false (nothing stored) when a valid lane needs the
-// scalar path. This kernel takes squared norms in [2^32, 2^62) only (|N| from 2^-12 to 8: an
-// interpolated unit normal's is near 2^56) and declines the rest, which spares it what AVX2
-// lacks for the others:
+// scalar path. As the AVX-512 kernel, it takes squared norms in [2^32, 2^62) only (|N| from
+// 2^-12 to 8: an interpolated unit normal's is near 2^56) and declines the rest, which spares it
+// what AVX2 lacks for the others:
 // - the bit length, 64 less the count of leading zeros (no instruction), is that of the high
 //   word y plus 32. y, below 2^32, is exact in a double, d = (2^52 + y) - 2^52, whose exponent
 //   field is 1023 + floor(log2 y) for y > 0;

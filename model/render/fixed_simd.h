@@ -56,7 +56,8 @@ constexpr uint32_t packedRgb(const std::array<uint8_t, 3>& c) {
 // two's complement) give the output colour rgb[i] (packedRgb) and, where codes is not null, the
 // 12-fraction-bit code of channel k before the output rounding (FixedShade::code) in codes[k][i].
 // Returns the groups it declines (bit g: a fragment of group g needs the scalar path: a squared
-// norm below 2^8, or, in the AVX2 kernel, outside [2^32, 2^62)); their outputs are untouched.
+// norm outside [2^32, 2^62) in the vector kernels, below 2^8 in the plain C++ one); their
+// outputs are untouched.
 // The inputs hold n rounded up to a multiple of 8 readable entries (those past n are read and
 // ignored), the outputs as many writable ones.
 // Two kernels, each for a CPU with its instructions: AVX-512 (8 64-bit lanes) and AVX2 (4 lanes,
