@@ -5,8 +5,8 @@
 // so the same colours. Where neither runs, phong-fixed's batch is kept in plain C++ kernels
 // (shadeNhScalar, bufferRunScalar, bufferSpansScalar).
 // The datapath covers the common case, one directional light and a lobe of N.H from a table
-// (blinn, pow, normalized-blinn, schlick); everything else, and lanes it cannot take (a squared
-// norm below 2^8, see CosineScale), stays scalar.
+// (blinn, pow, normalized-blinn, schlick); everything else, and lanes it does not take (a squared
+// norm outside [2^32, 2^62): |N| below 2^-12 or from 8 on, see shadeNh), stays scalar.
 //
 // The 128-bit products of the scalar path become 64-bit lane operations:
 //   m r0^2 >> 32   r0^2 < 2^34 split at 2^32: mq a + (mq b >> 32), each product below 2^64;
