@@ -1247,6 +1247,11 @@ uint64_t colourSpansPlain(const RowSpans& s, size_t W, Frac frac, const Target& 
   auto row = [&](size_t p, size_t count, std::array<uint32_t, 4> c, auto unorm8) {
     int32_t* const depth = t.depth + p;
     uint8_t* const out = rgb + 3 * p;
+    // The one colour's first two bytes as one 16-bit store and its third as one byte: two stores
+    // a pixel instead of three, the values held in a local (the byte stores may alias what a
+    // reference reaches, so the compiler would read the colour again after each).
+    const std::array<uint8_t, 2> one01 = {colour[0], colour[1]};
+    const uint8_t one2 = colour[2];
     for (size_t k = 0; k < count; ++k) {
       const int32_t z = static_cast<int32_t>(c[0]), old = depth[k];
       if (z > old) {
@@ -1254,9 +1259,11 @@ uint64_t colourSpansPlain(const RowSpans& s, size_t W, Frac frac, const Target& 
         ++pass_count;
         depth[k] = z;
         if constexpr (kTags) t.tri[p + k] = t.tag;
-        for (size_t ch = 0; ch < 3; ++ch) {
-          if constexpr (std::is_same_v<decltype(unorm8), std::nullptr_t>) out[3 * k + ch] = colour[ch];
-          else out[3 * k + ch] = unorm8(c[ch + 1]);
+        if constexpr (std::is_same_v<decltype(unorm8), std::nullptr_t>) {
+          std::memcpy(out + 3 * k, one01.data(), 2);
+          out[3 * k + 2] = one2;
+        } else {
+          for (size_t ch = 0; ch < 3; ++ch) out[3 * k + ch] = unorm8(c[ch + 1]);
         }
       }
       c[0] += dx[0];
