@@ -91,7 +91,8 @@ TEST(RsqrtCore, NormalisesByTheBitLengthWithinItsSeedsError) {
 
 // rsqrtCore's Newton step r0 (3 2^32 - m r0^2) >> 17 is not negative with either seed table:
 // m r0^2 (mr, Q32) stays below 3 2^32 at the top of every entry's interval of m (mr grows with
-// m), so 3 2^32 - mr > 0. The AVX2 kernel (shadeNhAvx2) shifts the product right logically.
+// m), so 3 2^32 - mr > 0. The vector kernels (shadeNh, shadeNhAvx2) shift the product right
+// logically.
 template <int SeedBits>
 void checkSeedProducts() {
   const auto& table = RsqrtSeed<SeedBits>::table;
