@@ -282,9 +282,9 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh, uint64_t fr
 }
 
 TEST(FixedSimd, LanesEqualTheScalarDatapath) {
-  const uint64_t from = uint64_t{1} << 32, below = uint64_t{1} << 62;  // the vector kernels' domain
-  if (fixed_simd::cpuHasAvx512()) checkNhKernel("avx512", fixed_simd::shadeNh, from, below);
-  if (fixed_simd::cpuHasAvx2()) checkNhKernel("avx2", fixed_simd::shadeNhAvx2, from, below);
+  using fixed_simd::kVectorSqBelow, fixed_simd::kVectorSqFrom;
+  if (fixed_simd::cpuHasAvx512()) checkNhKernel("avx512", fixed_simd::shadeNh, kVectorSqFrom, kVectorSqBelow);
+  if (fixed_simd::cpuHasAvx2()) checkNhKernel("avx2", fixed_simd::shadeNhAvx2, kVectorSqFrom, kVectorSqBelow);
   checkNhKernel("scalar", fixed_simd::shadeNhScalar);
 }
 

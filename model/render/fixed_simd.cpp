@@ -199,8 +199,8 @@ SHD_AVX512 inline bool scaleGroup(const uint64_t* sq, int n, uint64_t* r64_out) 
   // rsqrtCore<10> on squared norms in [2^32, 2^62) (the others declined, as shadeNhAvx2's
   // scaleLanes4 declines them): bits = 64 - lzcnt, shift = (62 - bits) / 2 = (lzcnt - 2) / 2 in
   // [0, 14], never the shift down; s = 61 - shift >= 35, cosineScale's fast path.
-  const __mmask8 outside = _mm512_cmplt_epu64_mask(v, _mm512_set1_epi64(int64_t{1} << 32)) |
-                           _mm512_cmpge_epu64_mask(v, _mm512_set1_epi64(int64_t{1} << 62));
+  const __mmask8 outside = _mm512_cmplt_epu64_mask(v, _mm512_set1_epi64(static_cast<int64_t>(kVectorSqFrom))) |
+                           _mm512_cmpge_epu64_mask(v, _mm512_set1_epi64(static_cast<int64_t>(kVectorSqBelow)));
   if ((outside & valid) != 0) return false;
   const __m512i shift = _mm512_srli_epi64(_mm512_sub_epi64(_mm512_lzcnt_epi64(v), _mm512_set1_epi64(2)), 1);
   const __m512i m = _mm512_sllv_epi64(v, _mm512_add_epi64(shift, shift));
@@ -725,9 +725,12 @@ SHD_AVX2 inline __m256i min64(__m256i a, __m256i b) { return _mm256_blendv_epi8(
 //   the shift is logical.
 [[gnu::always_inline]] SHD_AVX2 inline bool scaleLanes4(const uint64_t* sq, __m256i valid, uint64_t* r64_out) {
   const __m256i v = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(sq));
+  // Outside the range by the high word: 0 below 2^32, above its top's high word less 1 from it on.
+  static_assert(kVectorSqFrom == uint64_t{1} << 32 && kVectorSqBelow % (uint64_t{1} << 32) == 0);
   const __m256i hi = _mm256_srli_epi64(v, 32);
-  const __m256i outside = _mm256_or_si256(_mm256_cmpeq_epi64(hi, _mm256_setzero_si256()),
-                                          _mm256_cmpgt_epi64(hi, _mm256_set1_epi64x((int64_t{1} << 30) - 1)));
+  const __m256i outside = _mm256_or_si256(
+      _mm256_cmpeq_epi64(hi, _mm256_setzero_si256()),
+      _mm256_cmpgt_epi64(hi, _mm256_set1_epi64x(static_cast<int64_t>(kVectorSqBelow >> 32) - 1)));
   if (!_mm256_testz_si256(outside, valid)) return false;
   const __m256d two52 = _mm256_set1_pd(4503599627370496.0);
   const __m256d d = _mm256_sub_pd(_mm256_castsi256_pd(_mm256_or_si256(hi, _mm256_castpd_si256(two52))), two52);

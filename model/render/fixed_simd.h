@@ -6,7 +6,7 @@
 // (shadeNhScalar, bufferRunScalar, bufferSpansScalar).
 // The datapath covers the common case, one directional light and a lobe of N.H from a table
 // (blinn, pow, normalized-blinn, schlick); everything else, and lanes it does not take (a squared
-// norm outside [2^32, 2^62): |N| below 2^-12 or from 8 on, see shadeNh), stays scalar.
+// norm outside [kVectorSqFrom, kVectorSqBelow), see shadeNh), stays scalar.
 //
 // The 128-bit products of the scalar path become 64-bit lane operations:
 //   m r0^2 >> 32   r0^2 < 2^34 split at 2^32: mq a + (mq b >> 32), each product below 2^64;
@@ -56,8 +56,8 @@ constexpr uint32_t packedRgb(const std::array<uint8_t, 3>& c) {
 // two's complement) give the output colour rgb[i] (packedRgb) and, where codes is not null, the
 // 12-fraction-bit code of channel k before the output rounding (FixedShade::code) in codes[k][i].
 // Returns the groups it declines (bit g: a fragment of group g needs the scalar path: a squared
-// norm outside [2^32, 2^62) in the vector kernels, below 2^8 in the plain C++ one); their
-// outputs are untouched.
+// norm outside [kVectorSqFrom, kVectorSqBelow) in the vector kernels, below 2^8 in the plain C++
+// one); their outputs are untouched.
 // The inputs hold n rounded up to a multiple of 8 readable entries (those past n are read and
 // ignored), the outputs as many writable ones.
 // Two kernels, each for a CPU with its instructions: AVX-512 (8 64-bit lanes) and AVX2 (4 lanes,
@@ -65,6 +65,9 @@ constexpr uint32_t packedRgb(const std::array<uint8_t, 3>& c) {
 // 32 x 32 products, shifts, compares and double subtraction); and one in plain C++ for any CPU
 // (shadeNhScalar: the scalar datapath's functions, fragment by fragment, in the same passes).
 constexpr size_t kMaxBatch = 512;
+// The squared norms the vector kernels take, [kVectorSqFrom, kVectorSqBelow) (|N| from 2^-12 to
+// 8); a group with any other goes to the scalar path.
+constexpr uint64_t kVectorSqFrom = uint64_t{1} << 32, kVectorSqBelow = uint64_t{1} << 62;
 uint64_t shadeNh(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
                  uint32_t* rgb, int64_t* const codes[3] = nullptr);
 uint64_t shadeNhAvx2(const NhParams& p, const uint64_t* sq, const uint64_t* l, const uint64_t* h, size_t n,
