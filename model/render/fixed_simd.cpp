@@ -838,9 +838,9 @@ SHD_AVX2 inline void colourGroupAvx2(const NhParams& p, const LobeLanes& in, siz
   // channel's 8 values as 32-bit lanes a0 b0 a1 b1 | a2 b2 a3 b3 (fragments 0 4 1 5 | 2 6 3 7),
   // packed to 16 and then 8 bits (per 128-bit half: the 4 red bytes, the 4 green, the 4 blue),
   // gathered into each fragment's word by a byte shuffle, and the words put in fragment order.
+  const __m256i half = _mm256_set1_epi64x(1 << 11);
   __m256i x[3];
   for (size_t k = 0; k < 3; ++k) {
-    const __m256i half = _mm256_set1_epi64x(1 << 11);
     const __m256i ta = _mm256_srli_epi64(_mm256_add_epi64(a[k], half), 12);
     const __m256i tb = _mm256_srli_epi64(_mm256_add_epi64(b[k], half), 12);
     x[k] = _mm256_blend_epi32(ta, _mm256_slli_epi64(tb, 32), 0xAA);
