@@ -96,13 +96,19 @@ struct PlaneGeom {
 // and didy; false where it does not fit.
 bool planeScalar(const Codes& a, const PlaneGeom& g, RowSpans& o) {
   for (size_t k = 0; k < 4; ++k) {
-    int64_t sx = 0, sy = 0, num = 0;
     const std::array<int64_t, 3> ak = {a[0][k], a[1][k], a[2][k]};
+    // A constant attribute (flat's colour): its numerators are 0, and so are its gradients; the
+    // plane is its code everywhere (what the steps below give).
+    if (ak[0] == ak[1] && ak[0] == ak[2]) {
+      if (!fits32(ak[0])) return false;
+      o.a0[k] = ak[0];
+      o.didx[k] = o.didy[k] = 0;
+      continue;
+    }
+    int64_t sx = 0, sy = 0, num = 0;
     if (!planeNumerators64(ak, g.dx1, g.dy1, g.dx2, g.dy2, g.dcx, g.dcy, g.S, sx, sy, num)) return false;
-    // A constant attribute (flat's colour) has the numerators 0: no division (what it would give).
-    const bool constant = ak[0] == ak[1] && ak[0] == ak[2];
-    const int64_t didx = constant ? 0 : roundDivPlus(0, sx, g.det), didy = constant ? 0 : roundDivPlus(0, sy, g.det);
-    const int64_t iref = constant ? ak[0] : roundDivPlus(ak[0], num, 2 * g.det);
+    const int64_t didx = roundDivPlus(0, sx, g.det), didy = roundDivPlus(0, sy, g.det);
+    const int64_t iref = roundDivPlus(ak[0], num, 2 * g.det);
     int64_t corner = 0;
     if (!fits32(didx) || !fits32(didy) || !planeAt(iref, didx, didy, g.bx, g.by, corner)) return false;
     // |didx|, |didy| < 2^31 and the box's sides below 2^15: exact in int64_t from its corner.
@@ -923,8 +929,17 @@ SHD_AVX512 __mmask8 plane8(const Plane8& p, __mmask8 lanes, int S, RowSpans* o) 
   alignas(64) int64_t first[4][8], gx[4][8], gy[4][8];
   for (size_t k = 0; k < 4; ++k) {
     const __m512d a0 = _mm512_maskz_load_pd(lanes, p.a[0][k]);
-    const __m512d da1 = _mm512_sub_pd(_mm512_maskz_load_pd(lanes, p.a[1][k]), a0);
-    const __m512d da2 = _mm512_sub_pd(_mm512_maskz_load_pd(lanes, p.a[2][k]), a0);
+    const __m512d a1 = _mm512_maskz_load_pd(lanes, p.a[1][k]), a2 = _mm512_maskz_load_pd(lanes, p.a[2][k]);
+    // An attribute constant on every triangle (flat's colours): the numerators are 0, and the
+    // steps below give the plane a0 with gradients 0 and change no check (|a0| < 2^31,
+    // RowSpansConfig::lim), as planeScalar's shortcut for such an attribute.
+    if ((_mm512_cmp_pd_mask(a1, a0, _CMP_EQ_OQ) & _mm512_cmp_pd_mask(a2, a0, _CMP_EQ_OQ)) == 0xFF) {
+      _mm512_store_si512(first[k], _mm512_cvtpd_epi64(a0));
+      _mm512_store_si512(gx[k], _mm512_setzero_si512());
+      _mm512_store_si512(gy[k], _mm512_setzero_si512());
+      continue;
+    }
+    const __m512d da1 = _mm512_sub_pd(a1, a0), da2 = _mm512_sub_pd(a2, a0);
     const __m512d nx = _mm512_sub_pd(_mm512_mul_pd(da1, dy2), _mm512_mul_pd(da2, dy1));
     const __m512d ny = _mm512_sub_pd(_mm512_mul_pd(dx1, da2), _mm512_mul_pd(dx2, da1));
     const __m512d px = _mm512_mul_pd(_mm512_abs_pd(nx), adcx), py = _mm512_mul_pd(_mm512_abs_pd(ny), adcy);
