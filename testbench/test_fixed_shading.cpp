@@ -194,9 +194,9 @@ TEST(FixedShading, DeviceRequestsCarryTheRoundedCosine) {
 // lane by lane: runs of 1 to 8 fragments with normals from 2^-27 to 11.2 in length (squared norms
 // of every bit length up to 63), facing the light or away, for each lobe they take,
 // with factor codes up to saturation. A group must be declined exactly where a lane's squared norm
-// is outside the kernel's domain: [2^32, 2^62) for the vector kernels, from 2^8 on (a zero normal
-// is below) for the plain C++ one. Each vector kernel where the CPU has its instructions, and the
-// plain C++ one everywhere.
+// is outside the kernel's domain: [kVectorSqFrom, kVectorSqBelow) for the vector kernels, from 2^8
+// on (a zero normal is below) for the plain C++ one. Each vector kernel where the CPU has its
+// instructions, and the plain C++ one everywhere.
 static void checkNhKernel(const char* name, fixed_simd::NhKernel nh, uint64_t from = uint64_t{1} << 8,
                           uint64_t below = ~uint64_t{0}) {
   SCOPED_TRACE(name);
@@ -221,8 +221,7 @@ static void checkNhKernel(const char* name, fixed_simd::NhKernel nh, uint64_t fr
               // 2^-27 to 11.2 in length: codes from a few units (squared norms below 2^8) to
               // 2^31.5 (squared norms of 63 bits, their squares within int64_t); two runs in
               // three from 2^-12 to 4 (the vector kernels' domain).
-              const int e = t % 3 == 0 ? -27 + static_cast<int>(rng() % 31)  //
-                                       : -12 + static_cast<int>(rng() % 14);
+              const int e = t % 3 == 0 ? -27 + static_cast<int>(rng() % 31) : -12 + static_cast<int>(rng() % 14);
               const double len = std::ldexp(1.0, e) * (1 + (e == 3 ? 0.4 : 1.0) * u01(rng));
               Vec3 v{g(rng), g(rng), g(rng)};
               if (t % 2 != 0) v = normalize(normalize(v) + 3.0 * ctx.lights[0].half);
