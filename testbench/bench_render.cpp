@@ -32,7 +32,7 @@ void BM_Frame(benchmark::State& state, Method method, const char* mode, const ch
   RenderOptions opt;
   opt.method = method;
   opt.brdf = brdf;
-  opt.tags = false;  // as `shadesim render` draws without the RTL check
+  opt.tags = opt.triangles = false;  // as `shadesim render` draws without the RTL check
   ModelSpanEngine span(spanConfig(mode).rtl);
   const SpecUnitConfig cfg = specConfig("default");
   ModelSpecEngine quadratic(buildPromTable(PromRequest::fromContent(cfg.prom), cfg.rtl));

@@ -924,13 +924,14 @@ void expectSameFrames(const RenderResult& a, const RenderResult& b, const std::s
   EXPECT_EQ(std::memcmp(&sa, &sb, sizeof sa), 0) << what << ": the counts differ";
 }
 
-// The triangle buffer left out (RenderOptions::tags false) changes nothing else: for every
-// method, on one thread and on two where it allows, the same colours, depths, exact buffers,
-// triangle list and counts as with it, and no triangle buffer. With it, a pixel has a triangle
-// exactly where its depth is above 0 (Framebuffer::covered reads the depth), and those pixels
-// are the frame's pixels_covered. Frames with and without it over each other into the same
-// buffers equal the frames drawn afresh.
-TEST(Render, TagsLeftOutChangeNothingElse) {
+// The triangle buffer and the triangle list left out (RenderOptions::tags, triangles) change
+// nothing else: for every method, on one thread and on two where it allows, the same colours,
+// depths, exact buffers and counts as with both, and the buffer and the list as with both where
+// asked for, empty where not. With the buffer, a pixel has a triangle exactly where its depth is
+// above 0 (Framebuffer::covered reads the depth), and those pixels are the frame's
+// pixels_covered. Frames of each choice over the frame before in the same buffers equal the
+// frames drawn afresh.
+TEST(Render, TagsAndTriangleListLeftOutChangeNothingElse) {
   const SpecUnitConfig cubic_config = specConfig("cubic");
   ModelSpecEngine cubic(buildPromTable(PromRequest::fromContent(cubic_config.prom), cubic_config.rtl));
   int compared = 0;
@@ -947,6 +948,7 @@ TEST(Render, TagsLeftOutChangeNothingElse) {
         o.threads = threads;
         const RenderResult with = render(s, o, e.span, e.view);
         ASSERT_EQ(with.fb.tri.size(), with.fb.depth.size()) << what;
+        EXPECT_FALSE(with.triangles.empty()) << what;
         uint64_t covered = 0;
         for (size_t p = 0; p < with.fb.depth.size(); ++p) {
           ASSERT_EQ(with.fb.depth[p] > 0, with.fb.tri[p] >= 0) << what << " pixel " << p;
@@ -954,21 +956,24 @@ TEST(Render, TagsLeftOutChangeNothingElse) {
         }
         EXPECT_EQ(covered, with.stats.pixels_covered) << what;
         EXPECT_GT(covered, 0u) << what;
-        o.tags = false;
-        RenderResult over = with;  // its buffers, tags and all, then a frame without tags over them
-        const RenderResult without = render(s, o, e.span, e.view);
-        render(s, o, e.span, e.view, over);
-        for (const RenderResult* r : {&without, static_cast<const RenderResult*>(&over)}) {
-          EXPECT_TRUE(r->fb.tri.empty()) << what;
-          RenderResult as_with = *r;
-          as_with.fb.tri = with.fb.tri;
-          expectSameFrames(with, as_with, what);
-          EXPECT_EQ(r->fb.lsb, with.fb.lsb) << what;
-          EXPECT_EQ(r->fb.spec_lsb, with.fb.spec_lsb) << what;
+        RenderResult over = with;  // its buffers, tags and all, then each choice's frame over them
+        for (const auto& [tags, list] : {std::pair{false, true}, {true, false}, {false, false}, {true, true}}) {
+          const std::string how = fmt::format("{}, tags {}, triangle list {}", what, tags, list);
+          o.tags = tags;
+          o.triangles = list;
+          const RenderResult fresh = render(s, o, e.span, e.view);
+          render(s, o, e.span, e.view, over);
+          for (const RenderResult* r : {&fresh, static_cast<const RenderResult*>(&over)}) {
+            EXPECT_EQ(r->fb.tri.empty(), !tags) << how;
+            EXPECT_EQ(r->triangles.empty(), !list) << how;
+            RenderResult as_with = *r;
+            if (!tags) as_with.fb.tri = with.fb.tri;
+            if (!list) as_with.triangles = with.triangles;
+            expectSameFrames(with, as_with, how);
+            EXPECT_EQ(r->fb.lsb, with.fb.lsb) << how;
+            EXPECT_EQ(r->fb.spec_lsb, with.fb.spec_lsb) << how;
+          }
         }
-        o.tags = true;  // and a frame with tags over the one without
-        render(s, o, e.span, e.view, over);
-        expectSameFrames(with, over, what);
         ++compared;
       }
     }

@@ -140,6 +140,10 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
   RowShare rows{RowShare::Side::Rows};  // its rows, y0 .. y1 - 1
   int32_t H = 0;                        // the frame's rows
   bool top = true;
+  // Whether the frame ranks both sides' triangles (rankSides): for its tags or its triangle
+  // list (RenderOptions::tags, triangles); else keys, foreign and owned stay empty.
+  bool ranks = true;
+  bool lists = true;  // whether it describes its triangles in owned (RenderOptions::triangles)
   // The triangles it owns, in key order: their keys, apart from the rest (the other side reads
   // them to rank both sides' triangles, rankSides), and their descriptions.
   std::vector<PartKey> keys;
@@ -976,12 +980,13 @@ void SceneDrawer::drawSplitSetUp(const Part& part, uint32_t ti, uint32_t k, bool
   const bool spans = rows != nullptr;
   const PartKey key{static_cast<uint32_t>(f_.obj.index), ti, k};
   if (owner) {
-    side.keys.push_back(key);
-    ScreenTriangleInfo& info = side.owned.emplace_back();
+    if (side.ranks) side.keys.push_back(key);
+    ScreenTriangleInfo here;
+    ScreenTriangleInfo& info = side.lists ? side.owned.emplace_back() : here;
     describeTriangle(f_.obj.index, ti, partXY(part), spans, info, f_.st);  // placed among the frame's later
     markDrawn(side.drawn, info);
     if (spans) f_.countRows(*rows);
-  } else {
+  } else if (side.ranks) {
     side.foreign.push_back(key);
   }
   if (!spans) walkAhead(*setup_.desc, side.walk, owner);
@@ -1281,6 +1286,8 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     SplitSide& s = sides[i];
     s.objects = &objects;
     s.top = i == 0;
+    s.ranks = opt.tags || opt.triangles;
+    s.lists = opt.triangles;
     s.H = H;
     s.rows.y0 = s.top ? 0 : split;
     s.rows.y1 = s.top ? split : H;
@@ -1319,12 +1326,14 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     worker.wait();
     // Once both sides have drawn, each places its own triangles in the frame's list.
     error = sides[0].error ? sides[0].error : sides[1].error;
-    if (!error) try {
-        res.triangles.resize(rankSides(sides));  // kept from the frame before: mostly nothing to fill
+    if (!error && !opt.triangles) res.triangles.clear();
+    if (!error && sides[0].ranks) try {
+        const size_t n = rankSides(sides);
+        if (opt.triangles) res.triangles.resize(n);  // kept from the frame before: mostly nothing to fill
       } catch (...) {
         error = std::current_exception();
       }
-    if (!error) {
+    if (!error && opt.triangles) {
       const std::function<void()> place = [&] { placeOwned(sides[1], res.triangles); };
       worker.start(place);
       placeOwned(sides[0], res.triangles);
@@ -1482,6 +1491,9 @@ void render(const Scene& scene, const RenderOptions& opt, SpanEngine& span, cons
     } else {
       renderTwoThreads(scene, span, engines, frame, clear, res);
     }
+    // Here a triangle's tag is its index in the list, so the list is made either way. (Left
+    // out, with a count for the tags, one thread's frame took as long: docs/performance.md.)
+    if (!opt.triangles) res.triangles.clear();
   }
   span.endFrame();
   res.stats.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -173,8 +173,14 @@ struct RenderOptions {
   // The triangle buffer (Framebuffer::tri: which screen triangle wrote each pixel), for a report
   // that names the triangle at a pixel (the RTL-in-the-loop check); false: left empty, neither
   // written nor cleared, which spares a frame a third of its buffer traffic (the same image,
-  // depths and counts: test Render.TagsLeftOutChangeNothingElse).
+  // depths and counts: test Render.TagsAndTriangleListLeftOutChangeNothingElse).
   bool tags = true;
+  // Where each screen triangle came from (RenderResult::triangles), for a report that names the
+  // triangle at a pixel (with tags) or sorts the frame's triangles by size; false: left empty,
+  // which spares a frame split by rows its sides' ranking and placing where tags are left out
+  // too (the same image, depths, tags and counts: test
+  // Render.TagsAndTriangleListLeftOutChangeNothingElse).
+  bool triangles = true;
   // phong-fixed only (std::invalid_argument with another method or invalid widths): absent, the
   // fixed datapath of render/fixed_shading.h with its run and vector kernels; present, the same
   // datapath at these widths, fragment by fragment (render/fixed_widths.h), the span unit

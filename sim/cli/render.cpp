@@ -152,7 +152,8 @@ int RenderCmd::run(const CLI::App& app) {
   ro.method = parseMethod(method_);
   ro.brdf = brdf_;
   ro.threads = threads_;
-  ro.tags = rtl_;  // the triangle buffer: for checkRtlFrame's report of the first differing pixel
+  // The triangle buffer and list: for checkRtlFrame's report of the first differing pixel.
+  ro.tags = ro.triangles = rtl_;
   if (threads_ == 2 && traits(ro.method).two_threads == TwoThreads::No)
     throw ArgError(fmt::format("--threads 2: --method {} draws on one thread (two: {})", method_, twoThreadMethods()));
   // A lobe configuration no object evaluates with the specular unit would be silently unused.

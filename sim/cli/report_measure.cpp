@@ -130,7 +130,8 @@ nlohmann::json measureCell(const ReportSetup& s, Method m, size_t gi, LobeImages
   RenderOptions ro;
   ro.method = m;
   ro.brdf = g.brdf;
-  ro.tags = s.rtl;  // the triangle buffer: for checkRtlFrame's report of the first differing pixel
+  // The triangle buffer and list: for checkRtlFrame's report of the first differing pixel.
+  ro.tags = ro.triangles = s.rtl;
   LobeConfigs lobes = s.lobes;
   if (!g.unit.empty()) lobes.quadratic = g.unit;
   std::vector<std::string> spec_configs;
