@@ -140,12 +140,9 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
   RowShare rows{RowShare::Side::Rows};  // its rows, y0 .. y1 - 1
   int32_t H = 0;                        // the frame's rows
   bool top = true;
-  // Whether the frame ranks both sides' triangles (rankSides): for its tags or its triangle
-  // list (RenderOptions::tags, triangles); else keys, foreign and owned stay empty.
-  bool ranks = true;
-  bool lists = true;  // whether it describes its triangles in owned (RenderOptions::triangles)
   // The triangles it owns, in key order: their keys, apart from the rest (the other side reads
-  // them to rank both sides' triangles, rankSides), and their descriptions.
+  // them to rank both sides' triangles, rankSides), and their descriptions. Only where the
+  // frame's order is read (needsOrder), and the descriptions only for the list.
   std::vector<PartKey> keys;
   std::vector<ScreenTriangleInfo> owned;
   Framebuffer drawn;                // no buffers: the rectangle its owned triangles may draw
@@ -188,6 +185,12 @@ struct alignas(64) SplitSide {  // in lines of its own, as DrawScratch
     return (top_takes ? O::kTopTakes : 0) | (top_owns ? O::kTopOwns : 0) | (bottom_takes ? O::kBottomTakes : 0);
   }
 };
+
+// Whether anything reads the order of a frame's triangles: the tags or the triangle list. A
+// frame split by rows ranks its sides' triangles (rankSides) only then.
+namespace {
+bool needsOrder(const RenderOptions& opt) { return opt.tags || opt.triangles; }
+}  // namespace
 
 // A frame's buffers kept in its result (ScratchBuffers): the drawers' buffers (second: the
 // second side's of a frame split by rows), the split's sides, and the row it split at last.
@@ -979,14 +982,15 @@ void SceneDrawer::drawSplitSetUp(const Part& part, uint32_t ti, uint32_t k, bool
   SplitSide& side = *side_;
   const bool spans = rows != nullptr;
   const PartKey key{static_cast<uint32_t>(f_.obj.index), ti, k};
+  const bool ranks = needsOrder(f_.opt);
   if (owner) {
-    if (side.ranks) side.keys.push_back(key);
+    if (ranks) side.keys.push_back(key);
     ScreenTriangleInfo here;
-    ScreenTriangleInfo& info = side.lists ? side.owned.emplace_back() : here;
+    ScreenTriangleInfo& info = f_.opt.triangles ? side.owned.emplace_back() : here;
     describeTriangle(f_.obj.index, ti, partXY(part), spans, info, f_.st);  // placed among the frame's later
     markDrawn(side.drawn, info);
     if (spans) f_.countRows(*rows);
-  } else if (side.ranks) {
+  } else if (ranks) {
     side.foreign.push_back(key);
   }
   if (!spans) walkAhead(*setup_.desc, side.walk, owner);
@@ -1286,8 +1290,6 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     SplitSide& s = sides[i];
     s.objects = &objects;
     s.top = i == 0;
-    s.ranks = opt.tags || opt.triangles;
-    s.lists = opt.triangles;
     s.H = H;
     s.rows.y0 = s.top ? 0 : split;
     s.rows.y1 = s.top ? split : H;
@@ -1326,10 +1328,9 @@ void renderSplit(const Scene& scene, const RenderOptions& opt, SpanEngine& span,
     worker.wait();
     // Once both sides have drawn, each places its own triangles in the frame's list.
     error = sides[0].error ? sides[0].error : sides[1].error;
-    if (!error && !opt.triangles) res.triangles.clear();
-    if (!error && sides[0].ranks) try {
-        const size_t n = rankSides(sides);
-        if (opt.triangles) res.triangles.resize(n);  // kept from the frame before: mostly nothing to fill
+    if (!error) try {
+        const size_t n = needsOrder(opt) ? rankSides(sides) : 0;
+        res.triangles.resize(opt.triangles ? n : 0);  // kept from the frame before: mostly nothing to fill
       } catch (...) {
         error = std::current_exception();
       }
