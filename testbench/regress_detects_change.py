@@ -10,7 +10,6 @@ ice40 figures while leaving the xc7 ones as recorded.
 import argparse
 import json
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
